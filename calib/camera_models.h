@@ -1,0 +1,292 @@
+#ifndef PUZZLECAL_CALIB_CAMERA_MODELS_H_
+#define PUZZLECAL_CALIB_CAMERA_MODELS_H_
+
+// Camera models: stateless structs with a fixed parameter count, named
+// parameters, a templated Project (double and ceres::Jet) and an iterative
+// Unproject. One closed list of models (CameraModelId) and one dispatch point
+// (DispatchCameraModel).
+//
+// Conventions (shared with OpenCV, so results can be checked against
+// cv::projectPoints / cv::fisheye::projectPoints):
+// - camera frame: x right, y down, z forward;
+// - pixels: the centre of the top-left pixel is (0, 0);
+// - every model's parameters start with fx fy cx cy; the rest is distortion.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace puzzlecal {
+
+enum class CameraModelId {
+  kPinholeRadtan,
+  kPinholeRational,
+  kKannalaBrandt,
+};
+
+// Parameter groups, the same index ranges for every model.
+inline constexpr int kFocalLengthBegin = 0;     // fx fy
+inline constexpr int kPrincipalPointBegin = 2;  // cx cy
+inline constexpr int kDistortionBegin = 4;      // model-specific
+
+// Why Unproject did not return a ray.
+struct UnprojectStatus {
+  bool converged = false;  // the iteration met its tolerance
+  int iterations = 0;      // iterations used
+  double residual_px = 0;  // |Project(ray) - pixel| at the end, in pixels
+};
+
+namespace internal {
+
+// Pinhole with OpenCV's rational radial + tangential distortion. `Rational`
+// selects the 12-parameter form (k4 k5 k6 in the denominator).
+template <bool Rational>
+struct PinholeDistorted {
+  template <typename T>
+  static void Distort(const T* params, const T& x, const T& y, T* xd, T* yd) {
+    const T& k1 = params[4];
+    const T& k2 = params[5];
+    const T& p1 = params[6];
+    const T& p2 = params[7];
+    const T& k3 = params[8];
+    const T r2 = x * x + y * y;
+    const T r4 = r2 * r2;
+    const T r6 = r4 * r2;
+    T radial = T(1) + k1 * r2 + k2 * r4 + k3 * r6;
+    if constexpr (Rational) {
+      const T& k4 = params[9];
+      const T& k5 = params[10];
+      const T& k6 = params[11];
+      radial = radial / (T(1) + k4 * r2 + k5 * r4 + k6 * r6);
+    }
+    const T xy = x * y;
+    *xd = x * radial + T(2) * p1 * xy + p2 * (r2 + T(2) * x * x);
+    *yd = y * radial + p1 * (r2 + T(2) * y * y) + T(2) * p2 * xy;
+  }
+
+  // point_cam: 3 coordinates in the camera frame; pixel: 2 outputs. Returns
+  // false for points on or behind the image plane (z <= 0).
+  template <typename T>
+  static bool Project(const T* params, const T* point_cam, T* pixel) {
+    if (!(point_cam[2] > T(0))) return false;
+    const T x = point_cam[0] / point_cam[2];
+    const T y = point_cam[1] / point_cam[2];
+    T xd, yd;
+    Distort(params, x, y, &xd, &yd);
+    pixel[0] = params[0] * xd + params[2];
+    pixel[1] = params[1] * yd + params[3];
+    return true;
+  }
+
+  // Gauss-Newton on the normalised image plane with a numeric 2x2 Jacobian,
+  // started at the distorted point. ray: unit vector with z > 0.
+  static UnprojectStatus Unproject(const double* params, const double* pixel,
+                                   double* ray) {
+    UnprojectStatus status;
+    const double xd = (pixel[0] - params[2]) / params[0];
+    const double yd = (pixel[1] - params[3]) / params[1];
+    double x = xd, y = yd;
+    constexpr int kMaxIterations = 50;
+    constexpr double kStep = 1e-7;
+    for (int it = 0; it < kMaxIterations; ++it) {
+      status.iterations = it + 1;
+      double fx, fy, fx_dx, fy_dx, fx_dy, fy_dy;
+      Distort(params, x, y, &fx, &fy);
+      Distort(params, x + kStep, y, &fx_dx, &fy_dx);
+      Distort(params, x, y + kStep, &fx_dy, &fy_dy);
+      const double ex = fx - xd, ey = fy - yd;
+      const double j00 = (fx_dx - fx) / kStep, j10 = (fy_dx - fy) / kStep;
+      const double j01 = (fx_dy - fx) / kStep, j11 = (fy_dy - fy) / kStep;
+      const double det = j00 * j11 - j01 * j10;
+      if (!std::isfinite(det) || std::abs(det) < 1e-12) break;
+      const double dx = (j11 * ex - j01 * ey) / det;
+      const double dy = (-j10 * ex + j00 * ey) / det;
+      x -= dx;
+      y -= dy;
+      if (!std::isfinite(x) || !std::isfinite(y)) break;
+      if (std::hypot(dx, dy) < 1e-14 * (1.0 + std::hypot(x, y))) break;
+    }
+    double fx, fy;
+    Distort(params, x, y, &fx, &fy);
+    status.residual_px =
+        std::hypot((fx - xd) * params[0], (fy - yd) * params[1]);
+    status.converged = std::isfinite(status.residual_px) &&
+                       status.residual_px < 1e-6;
+    const double norm = std::sqrt(x * x + y * y + 1.0);
+    ray[0] = x / norm;
+    ray[1] = y / norm;
+    ray[2] = 1.0 / norm;
+    return status;
+  }
+};
+
+}  // namespace internal
+
+// fx fy cx cy k1 k2 p1 p2 k3: OpenCV's 5-coefficient model (plumb_bob).
+struct PinholeRadtanModel : internal::PinholeDistorted<false> {
+  static constexpr CameraModelId kId = CameraModelId::kPinholeRadtan;
+  static constexpr const char* kName = "pinhole-radtan";
+  static constexpr int kNumParams = 9;
+  static constexpr std::array<const char*, kNumParams> kParamNames = {
+      "fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
+};
+
+// fx fy cx cy k1 k2 p1 p2 k3 k4 k5 k6: OpenCV's rational model
+// (CALIB_RATIONAL_MODEL, ROS rational_polynomial).
+struct PinholeRationalModel : internal::PinholeDistorted<true> {
+  static constexpr CameraModelId kId = CameraModelId::kPinholeRational;
+  static constexpr const char* kName = "pinhole-rational";
+  static constexpr int kNumParams = 12;
+  static constexpr std::array<const char*, kNumParams> kParamNames = {
+      "fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
+};
+
+// fx fy cx cy k1 k2 k3 k4: Kannala-Brandt / OpenCV fisheye (equidistant).
+// theta = atan2(|(x, y)|, z), so rays beyond 90 degrees from the axis project
+// as well (OpenCV's version divides by z first and cannot).
+struct KannalaBrandtModel {
+  static constexpr CameraModelId kId = CameraModelId::kKannalaBrandt;
+  static constexpr const char* kName = "kannala-brandt";
+  static constexpr int kNumParams = 8;
+  static constexpr std::array<const char*, kNumParams> kParamNames = {
+      "fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4"};
+
+  template <typename T>
+  static T DistortTheta(const T* params, const T& theta) {
+    const T t2 = theta * theta;
+    const T t4 = t2 * t2;
+    const T t6 = t4 * t2;
+    const T t8 = t4 * t4;
+    return theta * (T(1) + params[4] * t2 + params[5] * t4 + params[6] * t6 +
+                    params[7] * t8);
+  }
+
+  // Returns false only for the camera centre itself.
+  template <typename T>
+  static bool Project(const T* params, const T* point_cam, T* pixel) {
+    using std::atan2;
+    using std::sqrt;
+    const T& x = point_cam[0];
+    const T& y = point_cam[1];
+    const T& z = point_cam[2];
+    const T r2 = x * x + y * y;
+    T mx, my;
+    // Near the optical axis theta_d / r -> 1 / z; use the limit there so the
+    // Jet derivative of sqrt(r2) at 0 is never taken.
+    if (r2 < T(1e-20) * z * z && z > T(0)) {
+      mx = x / z;
+      my = y / z;
+    } else {
+      if (!(r2 > T(0))) return false;
+      const T r = sqrt(r2);
+      const T theta = atan2(r, z);
+      const T scale = DistortTheta(params, theta) / r;
+      mx = x * scale;
+      my = y * scale;
+    }
+    pixel[0] = params[0] * mx + params[2];
+    pixel[1] = params[1] * my + params[3];
+    return true;
+  }
+
+  // Newton on theta_d(theta) = |m|, theta in [0, pi].
+  static UnprojectStatus Unproject(const double* params, const double* pixel,
+                                   double* ray) {
+    UnprojectStatus status;
+    const double mx = (pixel[0] - params[2]) / params[0];
+    const double my = (pixel[1] - params[3]) / params[1];
+    const double theta_d = std::hypot(mx, my);
+    double theta = std::min(theta_d, M_PI);
+    constexpr int kMaxIterations = 50;
+    for (int it = 0; it < kMaxIterations; ++it) {
+      status.iterations = it + 1;
+      const double t2 = theta * theta, t4 = t2 * t2, t6 = t4 * t2,
+                   t8 = t4 * t4;
+      const double f = DistortTheta(params, theta) - theta_d;
+      const double df = 1.0 + 3.0 * params[4] * t2 + 5.0 * params[5] * t4 +
+                        7.0 * params[6] * t6 + 9.0 * params[7] * t8;
+      if (!std::isfinite(df) || std::abs(df) < 1e-12) break;
+      const double step = f / df;
+      theta = std::clamp(theta - step, 0.0, M_PI);
+      if (std::abs(step) < 1e-15) break;
+    }
+    const double f_end = DistortTheta(params, theta) - theta_d;
+    status.residual_px =
+        std::abs(f_end) * std::max(std::abs(params[0]), std::abs(params[1]));
+    status.converged =
+        std::isfinite(status.residual_px) && status.residual_px < 1e-6;
+    const double s = std::sin(theta);
+    if (theta_d > 0) {
+      ray[0] = s * mx / theta_d;
+      ray[1] = s * my / theta_d;
+    } else {
+      ray[0] = ray[1] = 0.0;
+    }
+    ray[2] = std::cos(theta);
+    return status;
+  }
+};
+
+// Calls fn(Model{}) with the model struct for `id`; the one dispatch point from
+// a runtime model id to the templates above.
+template <typename Fn>
+decltype(auto) DispatchCameraModel(CameraModelId id, Fn&& fn) {
+  switch (id) {
+    case CameraModelId::kPinholeRadtan:
+      return fn(PinholeRadtanModel{});
+    case CameraModelId::kPinholeRational:
+      return fn(PinholeRationalModel{});
+    case CameraModelId::kKannalaBrandt:
+      return fn(KannalaBrandtModel{});
+  }
+  return fn(PinholeRadtanModel{});  // unreachable for valid ids
+}
+
+// All models, in the order of CameraModelId.
+inline constexpr std::array<CameraModelId, 3> kAllCameraModels = {
+    CameraModelId::kPinholeRadtan, CameraModelId::kPinholeRational,
+    CameraModelId::kKannalaBrandt};
+
+// "pinhole-radtan", "pinhole-rational", "kannala-brandt".
+const char* CameraModelName(CameraModelId id);
+// Parses a model name; false for unknown names.
+bool CameraModelIdFromName(const std::string& name, CameraModelId* id);
+// Names of all models, comma separated (for messages).
+std::string CameraModelNames();
+int CameraModelNumParams(CameraModelId id);
+std::vector<std::string> CameraModelParamNames(CameraModelId id);
+// True for the pinhole models (points must have z > 0).
+bool CameraModelIsPinhole(CameraModelId id);
+
+// Runtime wrappers around Model::Project / Model::Unproject. `params` must
+// hold CameraModelNumParams(id) values.
+bool ProjectPoint(CameraModelId id, const double* params,
+                  const Eigen::Vector3d& point_cam, Eigen::Vector2d* pixel);
+UnprojectStatus UnprojectPixel(CameraModelId id, const double* params,
+                               const Eigen::Vector2d& pixel,
+                               Eigen::Vector3d* ray);
+
+// A camera: a model and its parameters, plus the image size it was made for.
+struct Camera {
+  CameraModelId model = CameraModelId::kPinholeRadtan;
+  std::vector<double> params;  // CameraModelNumParams(model) values
+  int width = 0;               // image size in pixels
+  int height = 0;
+
+  bool Project(const Eigen::Vector3d& point_cam, Eigen::Vector2d* pixel) const {
+    return ProjectPoint(model, params.data(), point_cam, pixel);
+  }
+  UnprojectStatus Unproject(const Eigen::Vector2d& pixel,
+                            Eigen::Vector3d* ray) const {
+    return UnprojectPixel(model, params.data(), pixel, ray);
+  }
+};
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_CALIB_CAMERA_MODELS_H_
