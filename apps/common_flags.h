@@ -1,0 +1,19 @@
+#ifndef PUZZLECAL_APPS_COMMON_FLAGS_H_
+#define PUZZLECAL_APPS_COMMON_FLAGS_H_
+
+// Flags shared by several subcommands (gflags allows one definition each).
+
+#include <gflags/gflags.h>
+
+DECLARE_string(images);
+DECLARE_string(board);
+DECLARE_string(out);
+DECLARE_string(model);
+DECLARE_string(format);
+DECLARE_string(report);
+DECLARE_string(draw);
+DECLARE_string(scene);
+DECLARE_int32(threads);
+DECLARE_int32(dpi);
+
+#endif  // PUZZLECAL_APPS_COMMON_FLAGS_H_

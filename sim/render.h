@@ -1,0 +1,100 @@
+#ifndef PUZZLECAL_SIM_RENDER_H_
+#define PUZZLECAL_SIM_RENDER_H_
+
+// Rendering a board through a camera model with exact ground truth.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "calib/camera_models.h"
+#include "decode/board.h"
+
+namespace puzzlecal {
+
+// A disc in the image that hides whatever lies behind it (a finger, a clip).
+struct Occluder {
+  Eigen::Vector2d center_px = Eigen::Vector2d::Zero();  // disc centre, pixels
+  double radius_px = 0.0;                               // disc radius, pixels
+  double grey = 0.5;  // grey level of the occluder in [0, 1]
+};
+
+// How the board is printed on the torus, for refusal tests: the code bits of
+// a PuzzleBoard can be replaced by another random code, the print mirrored or
+// its contrast inverted. The default is the true pattern.
+struct PatternVariant {
+  // Seed of a random replacement for the A and B codes; 0 keeps the true codes.
+  uint64_t random_code_seed = 0;
+  // Mirror the print left-right (x -> cols - 1 - x about the board centre).
+  bool mirrored = false;
+  // Swap black and white everywhere (tiles and discs).
+  bool inverted = false;
+};
+
+// Everything that turns the ideal pattern into a realistic 8-bit image.
+struct RenderOptions {
+  // Supersamples per pixel along each axis (n x n per pixel) for
+  // anti-aliasing; >= 1.
+  int supersampling = 4;
+  // Standard deviation of the Gaussian optical blur in pixels; 0 = none.
+  double blur_sigma_px = 0.7;
+  // Grey level of black print and of white paper in [0, 1] (before lighting,
+  // gamma and noise); black < white.
+  double black_level = 0.1;
+  double white_level = 0.9;
+  // Grey level of everything that is not the board, in [0, 1].
+  double background_level = 0.45;
+  // Margin of paper around the outermost inner corners, in tiles (the
+  // printed page of SPEC.md has half-tile border tiles plus this white).
+  double paper_margin_tiles = 1.0;
+  // Linear lighting gradient across the image: relative change of brightness
+  // from the left to the right edge (0 = uniform).
+  double lighting_gradient = 0.0;
+  // Vignetting: brightness falls as cos^4-like 1 - v * (r / r_max)^2 with the
+  // distance r from the image centre; 0 = none, in [0, 1).
+  double vignetting = 0.0;
+  // Display gamma applied to the linear intensity (1 = none).
+  double gamma = 1.0;
+  // Standard deviation of additive Gaussian noise as a fraction of the
+  // black-white contrast (white_level - black_level); 0 = none.
+  double noise_sigma = 0.0;
+  // Seed of the noise generator (renders are deterministic).
+  uint64_t seed = 1;
+  // Discs drawn over the image after the board (occluders).
+  std::vector<Occluder> occluders;
+  // True pattern or a variant for refusal tests.
+  PatternVariant variant;
+
+  // False with a reason when a field is out of range.
+  bool Check(std::string* why = nullptr) const;
+};
+
+// One inner corner of the board as the image shows it.
+struct TruthCorner {
+  Eigen::Vector2i id = Eigen::Vector2i::Zero();  // absolute (col, row) id
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // exact pixel position
+  // Inside the image (with a margin of 1 px), in front of the camera and not
+  // under an occluder.
+  bool visible = false;
+};
+
+// The exact geometry behind a render.
+struct RenderTruth {
+  Camera camera;                                       // model, params, size
+  Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
+  std::vector<TruthCorner> corners;  // every printed inner corner of the board
+};
+
+// Renders `board` seen by `camera` from `cam_from_board` into an 8-bit grey
+// image of camera.width x camera.height. Fills `truth` when not null.
+cv::Mat RenderBoard(const Board& board, const Camera& camera,
+                    const Eigen::Isometry3d& cam_from_board,
+                    const RenderOptions& options, RenderTruth* truth = nullptr);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_SIM_RENDER_H_
