@@ -1,0 +1,43 @@
+#ifndef PUZZLECAL_APPS_IMAGE_IO_H_
+#define PUZZLECAL_APPS_IMAGE_IO_H_
+
+// Finding and loading the photos of a calibration run.
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace puzzlecal {
+
+// What ListImages found.
+struct ImageListing {
+  std::vector<std::string> images;   // image files, sorted by name
+  std::vector<std::string> skipped;  // other entries, with the reason
+};
+
+// Lists the image files (png, jpg/jpeg, tif/tiff, bmp; any case) of a folder,
+// sorted by file name, or the one file `path` names. False with a message
+// naming `path` when it does not exist, is not readable, or holds no image.
+bool ListImages(const std::string& path, ImageListing* listing,
+                std::string* error);
+
+// Limits applied while loading.
+struct ImageLoadOptions {
+  // Images with more pixels than this are refused (decoding alone would
+  // need too much memory). 0 disables the check.
+  long long max_pixels = 120'000'000;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+// Loads one image as 8-bit grey (colour and alpha are converted, 16-bit is
+// scaled to 8 bits by its own maximum so dark 16-bit photos keep their
+// contrast). False with a message naming the file and the reason (missing,
+// unreadable, not an image, truncated, too large, empty).
+bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
+                   cv::Mat* grey, std::string* error);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_APPS_IMAGE_IO_H_

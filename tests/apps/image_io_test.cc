@@ -1,0 +1,147 @@
+#include "apps/image_io.h"
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace puzzlecal {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ImageIoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("puzzlecal_image_io_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    // A grey ramp with a known value at (10, 20).
+    ramp_ = cv::Mat(40, 60, CV_8UC1);
+    for (int y = 0; y < ramp_.rows; ++y) {
+      for (int x = 0; x < ramp_.cols; ++x) ramp_.at<uint8_t>(y, x) = 3 * x + y;
+    }
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Path(const std::string& name) const {
+    return (dir_ / name).string();
+  }
+
+  void WriteBytes(const std::string& name, const std::string& bytes) const {
+    std::ofstream(Path(name), std::ios::binary) << bytes;
+  }
+
+  std::string ReadBytes(const std::string& name) const {
+    std::ifstream in(Path(name), std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
+
+  fs::path dir_;
+  cv::Mat ramp_;
+};
+
+TEST_F(ImageIoTest, ListsImagesSortedAndSkipsOthers) {
+  cv::imwrite(Path("b.png"), ramp_);
+  cv::imwrite(Path("a.JPG"), ramp_);
+  WriteBytes("notes.txt", "hello");
+  ImageListing listing;
+  std::string error;
+  ASSERT_TRUE(ListImages(dir_.string(), &listing, &error)) << error;
+  ASSERT_EQ(listing.images.size(), 2u);
+  EXPECT_EQ(fs::path(listing.images[0]).filename(), "a.JPG");
+  EXPECT_EQ(fs::path(listing.images[1]).filename(), "b.png");
+  ASSERT_EQ(listing.skipped.size(), 1u);
+  EXPECT_NE(listing.skipped[0].find("notes.txt"), std::string::npos);
+}
+
+TEST_F(ImageIoTest, MissingAndEmptyFoldersNameThePath) {
+  ImageListing listing;
+  std::string error;
+  EXPECT_FALSE(ListImages(Path("missing"), &listing, &error));
+  EXPECT_NE(error.find("missing"), std::string::npos);
+  EXPECT_NE(error.find("no such"), std::string::npos);
+  fs::create_directories(Path("empty"));
+  EXPECT_FALSE(ListImages(Path("empty"), &listing, &error));
+  EXPECT_NE(error.find("empty"), std::string::npos);
+  EXPECT_NE(error.find("no image"), std::string::npos);
+}
+
+TEST_F(ImageIoTest, LoadsEightBitGreyExactly) {
+  cv::imwrite(Path("ramp.png"), ramp_);
+  cv::Mat grey;
+  std::string error;
+  ASSERT_TRUE(LoadGreyImage(Path("ramp.png"), {}, &grey, &error)) << error;
+  EXPECT_EQ(grey.type(), CV_8UC1);
+  EXPECT_EQ(cv::norm(grey, ramp_, cv::NORM_INF), 0.0);
+}
+
+TEST_F(ImageIoTest, ConvertsColourRgbaAndSixteenBit) {
+  cv::Mat bgr, bgra, deep;
+  cv::cvtColor(ramp_, bgr, cv::COLOR_GRAY2BGR);
+  cv::cvtColor(ramp_, bgra, cv::COLOR_GRAY2BGRA);
+  ramp_.convertTo(deep, CV_16U, 16.0);  // a 12-bit camera in 16-bit words
+  cv::imwrite(Path("bgr.png"), bgr);
+  cv::imwrite(Path("bgra.png"), bgra);
+  cv::imwrite(Path("deep.png"), deep);
+  cv::imwrite(Path("deep.tif"), deep);
+  for (const char* name : {"bgr.png", "bgra.png", "deep.png", "deep.tif"}) {
+    cv::Mat grey;
+    std::string error;
+    ASSERT_TRUE(LoadGreyImage(Path(name), {}, &grey, &error)) << error;
+    EXPECT_EQ(grey.type(), CV_8UC1) << name;
+    EXPECT_EQ(grey.size(), ramp_.size()) << name;
+    // Grey values keep their order: the brightest pixel stays brightest.
+    cv::Point max_at_loaded, max_at_truth;
+    cv::minMaxLoc(grey, nullptr, nullptr, nullptr, &max_at_loaded);
+    cv::minMaxLoc(ramp_, nullptr, nullptr, nullptr, &max_at_truth);
+    EXPECT_EQ(max_at_loaded, max_at_truth) << name;
+  }
+}
+
+TEST_F(ImageIoTest, RefusesBadFilesWithTheReason) {
+  cv::imwrite(Path("good.png"), ramp_);
+  cv::imwrite(Path("good.jpg"), ramp_);
+  const std::string png = ReadBytes("good.png");
+  const std::string jpg = ReadBytes("good.jpg");
+  WriteBytes("truncated.png", png.substr(0, png.size() / 2));
+  WriteBytes("truncated.jpg", jpg.substr(0, jpg.size() / 2));
+  WriteBytes("zero.png", "");
+  WriteBytes("text.png", "this is not an image at all");
+  struct Case {
+    const char* file;
+    const char* reason;
+  };
+  for (const Case& c : {Case{"truncated.png", "truncated PNG"},
+                        Case{"truncated.jpg", "truncated JPEG"},
+                        Case{"zero.png", "empty file"},
+                        Case{"text.png", "not a readable image"},
+                        Case{"absent.png", "cannot open"}}) {
+    cv::Mat grey;
+    std::string error;
+    EXPECT_FALSE(LoadGreyImage(Path(c.file), {}, &grey, &error)) << c.file;
+    EXPECT_NE(error.find(c.file), std::string::npos) << error;
+    EXPECT_NE(error.find(c.reason), std::string::npos) << error;
+    EXPECT_TRUE(grey.empty());
+  }
+}
+
+TEST_F(ImageIoTest, RefusesImagesAboveThePixelLimit) {
+  cv::imwrite(Path("ramp.png"), ramp_);
+  ImageLoadOptions options;
+  options.max_pixels = 1000;  // the ramp has 2400
+  cv::Mat grey;
+  std::string error;
+  EXPECT_FALSE(LoadGreyImage(Path("ramp.png"), options, &grey, &error));
+  EXPECT_NE(error.find("exceeds"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace puzzlecal
