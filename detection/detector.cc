@@ -1,0 +1,410 @@
+#include "detection/detector.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <unordered_map>
+
+#include <opencv2/imgproc.hpp>
+
+#include "detection/corner_filters.h"
+#include "detection/hessian_response.h"
+#include "detection/subpixel.h"
+
+namespace puzzlecal {
+
+bool DetectorOptions::Check(std::string* why) const {
+  auto fail = [why](const char* text) {
+    if (why != nullptr) *why = text;
+    return false;
+  };
+  if (!(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0)) {
+    return fail("blur_sigma_px must be in [0, 20]");
+  }
+  if (num_levels < 1 || num_levels > 6) return fail("num_levels must be 1..6");
+  if (first_level < 0 || first_level >= num_levels) {
+    return fail("first_level must be in [0, num_levels)");
+  }
+  if (!(trace_weight_k >= 0.0 && std::isfinite(trace_weight_k))) {
+    return fail("trace_weight_k must be >= 0");
+  }
+  if (!(min_response > 0.0 && std::isfinite(min_response))) {
+    return fail("min_response must be > 0");
+  }
+  if (!(noise_response_factor >= 0.0 && std::isfinite(noise_response_factor))) {
+    return fail("noise_response_factor must be >= 0");
+  }
+  if (nms_radius_px < 1 || nms_radius_px > 50) {
+    return fail("nms_radius_px must be in [1, 50]");
+  }
+  if (!(ring_radius_px >= 1.5 && ring_radius_px <= 20.0)) {
+    return fail("ring_radius_px must be in [1.5, 20]");
+  }
+  if (ring_samples < 8 || ring_samples > 64 || ring_samples % 4 != 0) {
+    return fail("ring_samples must be a multiple of 4 in [8, 64]");
+  }
+  if (!(min_ring_contrast >= 0.0)) return fail("min_ring_contrast must be >= 0");
+  if (!(max_ring_asymmetry > 0.0)) return fail("max_ring_asymmetry must be > 0");
+  if (!(min_ring_second_harmonic >= 0.0 && min_ring_second_harmonic <= 1.0)) {
+    return fail("min_ring_second_harmonic must be in [0, 1]");
+  }
+  if (!(window_fraction_of_neighbor > 0.0 && window_fraction_of_neighbor < 1.0)) {
+    return fail("window_fraction_of_neighbor must be in (0, 1)");
+  }
+  if (min_window_px < 2 || max_window_px > 64 || min_window_px > max_window_px) {
+    return fail("need 2 <= min_window_px <= max_window_px <= 64");
+  }
+  if (max_iterations < 1 || max_iterations > 100) {
+    return fail("max_iterations must be in [1, 100]");
+  }
+  if (!(convergence_px > 0.0)) return fail("convergence_px must be > 0");
+  if (!(max_shift_fraction > 0.0)) return fail("max_shift_fraction must be > 0");
+  if (!(merge_distance_px >= 0.0)) return fail("merge_distance_px must be >= 0");
+  if (!(orientation_spacing_fraction > 0.0)) {
+    return fail("orientation_spacing_fraction must be > 0");
+  }
+  return true;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start)
+      .count();
+}
+
+// Converts the input to a CV_32FC1 image in [0, 1] (for finite inputs).
+// Returns false with a reason for unsupported types.
+bool ToNormalizedFloat(const cv::Mat& image, bool normalize_by_max,
+                       cv::Mat* grey, double* normalizer, std::string* why) {
+  cv::Mat single;
+  if (image.channels() == 1) {
+    single = image;
+  } else if ((image.channels() == 3 || image.channels() == 4) &&
+             (image.depth() == CV_8U || image.depth() == CV_16U ||
+              image.depth() == CV_32F)) {
+    cv::cvtColor(image, single,
+                 image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+  } else {
+    *why = "unsupported number of channels";
+    return false;
+  }
+  double full_scale = 1.0;
+  switch (single.depth()) {
+    case CV_8U:
+      full_scale = 255.0;
+      break;
+    case CV_16U:
+      full_scale = 65535.0;
+      break;
+    case CV_32F:
+      full_scale = 1.0;
+      break;
+    default:
+      *why = "unsupported pixel type (need 8-bit, 16-bit or 32-bit float)";
+      return false;
+  }
+  if (single.depth() == CV_32F) {
+    single.copyTo(*grey);
+    // Non-finite pixels become 0 (NaN fails every comparison).
+    for (int y = 0; y < grey->rows; ++y) {
+      float* row = grey->ptr<float>(y);
+      for (int x = 0; x < grey->cols; ++x) {
+        if (!std::isfinite(row[x])) row[x] = 0.0f;
+      }
+    }
+  }
+  double scale = full_scale;
+  if (normalize_by_max) {
+    double max_value = 0.0;
+    cv::minMaxLoc(single.depth() == CV_32F ? *grey : single, nullptr,
+                  &max_value);
+    scale = max_value > 0.0 ? max_value : full_scale;
+  }
+  *normalizer = scale;
+  if (single.depth() == CV_32F) {
+    if (scale != 1.0) *grey *= 1.0 / scale;
+  } else {
+    single.convertTo(*grey, CV_32F, 1.0 / scale);
+  }
+  return true;
+}
+
+// A verified candidate in full-resolution pixels.
+struct Candidate {
+  Eigen::Vector2d xy;  // full-resolution position (before refinement)
+  int level = 0;
+  float response = 0.0f;  // sqrt of the product response at its level
+  int peak_x = 0;         // integer peak at its level
+  int peak_y = 0;
+};
+
+// Buckets of point indices on a square grid, for radius queries.
+class PointGrid {
+ public:
+  PointGrid(double cell, int width, int height)
+      : cell_(std::max(cell, 1.0)),
+        cols_(static_cast<int>(width / cell_) + 1),
+        rows_(static_cast<int>(height / cell_) + 1) {}
+
+  void Add(const Eigen::Vector2d& p, int index) {
+    cells_[Key(p)].push_back(index);
+  }
+
+  // Calls f(index) for every stored point in cells within `radius` of p.
+  template <typename F>
+  void ForNear(const Eigen::Vector2d& p, double radius, F f) const {
+    const int cx0 = CellOf(p.x() - radius), cx1 = CellOf(p.x() + radius);
+    const int cy0 = CellOf(p.y() - radius), cy1 = CellOf(p.y() + radius);
+    for (int cy = cy0; cy <= cy1; ++cy) {
+      for (int cx = cx0; cx <= cx1; ++cx) {
+        auto it = cells_.find(static_cast<int64_t>(cy) * (cols_ + 2) + cx);
+        if (it == cells_.end()) continue;
+        for (int index : it->second) f(index);
+      }
+    }
+  }
+
+ private:
+  int CellOf(double v) const {
+    return static_cast<int>(std::floor(v / cell_));
+  }
+  int64_t Key(const Eigen::Vector2d& p) const {
+    return static_cast<int64_t>(CellOf(p.y())) * (cols_ + 2) + CellOf(p.x());
+  }
+  double cell_;
+  int cols_;
+  int rows_;
+  std::unordered_map<int64_t, std::vector<int>> cells_;
+};
+
+}  // namespace
+
+std::vector<Corner> DetectCorners(const cv::Mat& image,
+                                  const DetectorOptions& options,
+                                  DetectorSummary* summary) {
+  DetectorSummary local_summary;
+  DetectorSummary& s = summary != nullptr ? *summary : local_summary;
+  s = DetectorSummary();
+  const Clock::time_point t_start = Clock::now();
+  std::vector<Corner> corners;
+  std::string why;
+  if (!options.Check(&why)) {
+    s.message = "invalid detector options: " + why;
+    return corners;
+  }
+  if (image.empty()) {
+    s.message = "empty image";
+    return corners;
+  }
+  if (image.dims != 2) {
+    s.message = "image is not two-dimensional";
+    return corners;
+  }
+  s.width = image.cols;
+  s.height = image.rows;
+  constexpr int kMinSide = 8;
+  if (image.cols < kMinSide || image.rows < kMinSide) {
+    s.ok = true;
+    s.message = "image smaller than 8x8 pixels: no corners";
+    return corners;
+  }
+
+  // --- preprocessing ---
+  Clock::time_point t = Clock::now();
+  cv::Mat grey;
+  if (!ToNormalizedFloat(image, options.normalize_by_max, &grey,
+                         &s.normalizer, &why)) {
+    s.message = why;
+    return corners;
+  }
+  std::vector<cv::Mat> blurred(options.num_levels);
+  if (options.blur_sigma_px > 0.0) {
+    const int ksize =
+        2 * static_cast<int>(std::ceil(2.0 * options.blur_sigma_px)) + 1;
+    cv::GaussianBlur(grey, blurred[0], cv::Size(ksize, ksize),
+                     options.blur_sigma_px, options.blur_sigma_px,
+                     cv::BORDER_REPLICATE);
+  } else {
+    blurred[0] = grey;
+  }
+  int levels = 1;
+  for (int l = 1; l < options.num_levels; ++l) {
+    if (blurred[l - 1].cols < 2 * kMinSide || blurred[l - 1].rows < 2 * kMinSide) {
+      break;
+    }
+    cv::pyrDown(blurred[l - 1], blurred[l], cv::Size(), cv::BORDER_REPLICATE);
+    levels = l + 1;
+  }
+  s.levels_used = std::max(0, levels - options.first_level);
+  s.ms_preprocess = MsSince(t);
+
+  // --- per level: response, threshold, NMS, filters ---
+  std::vector<Candidate> candidates;
+  cv::Mat response;
+  std::vector<float> scratch;
+  std::vector<ResponsePeak> peaks;
+  cv::Mat level0_response;  // kept for the thesis's centroid refinement
+  for (int l = options.first_level; l < levels; ++l) {
+    t = Clock::now();
+    ComputeSaddleResponse(blurred[l], static_cast<float>(options.trace_weight_k),
+                          &response);
+    s.ms_response += MsSince(t);
+
+    t = Clock::now();
+    double threshold = options.min_response;
+    if (options.noise_response_factor > 0.0) {
+      const double median = SampledMedian(response, 5, &scratch);
+      threshold = std::max(threshold,
+                           options.noise_response_factor * std::sqrt(median));
+    }
+    if (l == options.first_level) s.threshold = threshold;
+    peaks.clear();
+    s.candidates += FindResponsePeaks(response,
+                                      static_cast<float>(threshold * threshold),
+                                      options.nms_radius_px, &peaks);
+    s.after_nms += static_cast<int>(peaks.size());
+    s.ms_nms += MsSince(t);
+
+    t = Clock::now();
+    const double scale = std::ldexp(1.0, l);
+    for (const ResponsePeak& peak : peaks) {
+      if (options.use_corner_mask &&
+          !PassesCornerMask(blurred[l], peak.x, peak.y)) {
+        continue;
+      }
+      ++s.after_mask;
+      if (options.use_ring_test) {
+        const RingMeasure ring =
+            MeasureRing(blurred[l], peak.x, peak.y, options.ring_radius_px,
+                        options.ring_samples);
+        if (!ring.inside || ring.contrast < options.min_ring_contrast ||
+            ring.asymmetry > options.max_ring_asymmetry ||
+            ring.second_harmonic_share < options.min_ring_second_harmonic) {
+          continue;
+        }
+      }
+      ++s.after_ring;
+      Candidate c;
+      c.level = l;
+      c.peak_x = peak.x;
+      c.peak_y = peak.y;
+      c.response = std::sqrt(peak.value);
+      c.xy = Eigen::Vector2d(peak.x * scale, peak.y * scale);
+      if (options.subpixel == SubpixelMethod::kCentroid) {
+        c.xy = CentroidOfSquaredResponse(response, peak.x, peak.y) * scale;
+      }
+      candidates.push_back(c);
+    }
+    s.ms_filter += MsSince(t);
+  }
+
+  // --- merge levels (finer levels first), refine at full resolution ---
+  t = Clock::now();
+  std::vector<Candidate> merged;
+  {
+    PointGrid grid(8.0 * options.nms_radius_px, image.cols, image.rows);
+    for (const Candidate& c : candidates) {  // already ordered by level
+      const double radius =
+          std::ldexp(1.0, c.level) * options.nms_radius_px;
+      bool taken = false;
+      grid.ForNear(c.xy, radius, [&](int index) {
+        if ((merged[index].xy - c.xy).norm() <= radius) taken = true;
+      });
+      if (taken) continue;
+      grid.Add(c.xy, static_cast<int>(merged.size()));
+      merged.push_back(c);
+    }
+  }
+  s.after_merge_levels = static_cast<int>(merged.size());
+
+  // Window half-size from the distance to the nearest other candidate.
+  const double reach =
+      options.max_window_px / options.window_fraction_of_neighbor;
+  PointGrid neighbours(reach, image.cols, image.rows);
+  for (size_t i = 0; i < merged.size(); ++i) {
+    neighbours.Add(merged[i].xy, static_cast<int>(i));
+  }
+  std::vector<Corner> refined;
+  std::vector<int> refined_window;
+  refined.reserve(merged.size());
+  for (size_t i = 0; i < merged.size(); ++i) {
+    const Candidate& c = merged[i];
+    double nearest = std::numeric_limits<double>::infinity();
+    neighbours.ForNear(c.xy, reach, [&](int index) {
+      if (index == static_cast<int>(i)) return;
+      nearest = std::min(nearest, (merged[index].xy - c.xy).norm());
+    });
+    int window = options.max_window_px;
+    if (std::isfinite(nearest)) {
+      window = static_cast<int>(
+          std::floor(options.window_fraction_of_neighbor * nearest));
+    }
+    window = std::clamp(window, options.min_window_px, options.max_window_px);
+    Corner corner;
+    corner.xy = c.xy;
+    corner.response = c.response;
+    if (options.subpixel == SubpixelMethod::kGradientOrthogonality) {
+      const GradientRefineResult r = RefineByGradientOrthogonality(
+          blurred[0], c.xy, window, options.max_iterations,
+          options.convergence_px);
+      if (!r.ok || (r.xy - c.xy).norm() >
+                       options.max_shift_fraction * window +
+                           std::ldexp(0.5, c.level)) {
+        ++s.refine_failed;
+        continue;
+      }
+      corner.xy = r.xy;
+    }
+    refined.push_back(corner);
+    refined_window.push_back(window);
+  }
+
+  // Merge duplicates (strongest first), then orientation and order.
+  std::vector<int> order(refined.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return refined[a].response > refined[b].response;
+  });
+  {
+    PointGrid kept_grid(std::max(options.merge_distance_px, 1.0) * 4.0,
+                        image.cols, image.rows);
+    std::vector<Corner> kept_corners;
+    for (int index : order) {
+      const Corner& c = refined[index];
+      bool duplicate = false;
+      kept_grid.ForNear(c.xy, options.merge_distance_px, [&](int k) {
+        if ((kept_corners[k].xy - c.xy).norm() < options.merge_distance_px) {
+          duplicate = true;
+        }
+      });
+      if (duplicate) {
+        ++s.merged_duplicates;
+        continue;
+      }
+      kept_grid.Add(c.xy, static_cast<int>(kept_corners.size()));
+      Corner out = c;
+      out.orientation = HessianOrientation(
+          blurred[0], c.xy,
+          options.orientation_spacing_fraction * refined_window[index]);
+      kept_corners.push_back(out);
+    }
+    corners = std::move(kept_corners);
+  }
+  std::sort(corners.begin(), corners.end(),
+            [](const Corner& a, const Corner& b) {
+              if (a.xy.y() != b.xy.y()) return a.xy.y() < b.xy.y();
+              return a.xy.x() < b.xy.x();
+            });
+  s.ms_refine = MsSince(t);
+  s.corners = static_cast<int>(corners.size());
+  s.ok = true;
+  s.ms_total = MsSince(t_start);
+  return corners;
+}
+
+}  // namespace puzzlecal

@@ -1,0 +1,158 @@
+#ifndef PUZZLECAL_DETECTION_DETECTOR_H_
+#define PUZZLECAL_DETECTION_DETECTOR_H_
+
+// Checkerboard saddle-point detector.
+//
+// Pipeline (the thesis's Hessian detector, extended):
+//  1. grey normalisation (divide by the image maximum) and Gaussian blur;
+//  2. per pyramid level, the response S = det(H) + k trace(H)^2 on the
+//     axis-aligned and on the diagonal second derivatives (k = 0.5); the
+//     corner response is the product of -S and -S_d where both are positive;
+//  3. non-maximum suppression with a radius in level pixels (so it scales with
+//     the level), above an absolute and a noise-adaptive threshold;
+//  4. the thesis's corner mask (junction kernels beat edge kernels) and a
+//     ring test (the grey values on a circle around the candidate must be
+//     centrally symmetric and dominated by the second angular harmonic);
+//  5. sub-pixel refinement at full resolution (gradient orthogonality with a
+//     window sized from the distance to the nearest neighbour corner, or the
+//     thesis's squared-grey centroid);
+//  6. orientation = angle of the first Hessian eigenvector.
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "detection/corner.h"
+
+namespace puzzlecal {
+
+enum class SubpixelMethod {
+  kNone,      // integer peak positions (at the detection level, scaled)
+  kCentroid,  // the thesis: squared-response centroid over the 3x3 peak
+  kGradientOrthogonality,  // edge-gradient least squares, iterated (default)
+};
+
+struct DetectorOptions {
+  // --- preprocessing ---
+  // Divide the grey image by its maximum (the thesis). When false, 8-bit and
+  // 16-bit images are divided by 255 / 65535 and float images are used as-is.
+  bool normalize_by_max = true;
+  // Standard deviation (pixels) of the Gaussian blur applied before the
+  // derivatives; the thesis uses 1 with a 5x5 kernel. >= 0.
+  double blur_sigma_px = 1.0;
+  // Number of pyramid levels searched (level l has 2^-l of the resolution,
+  // made by cv::pyrDown); coarser levels catch large, blurry corners. 1..6.
+  int num_levels = 2;
+  // Levels finer than this are skipped for detection (but sub-pixel
+  // refinement still runs at full resolution); 0 = detect from full
+  // resolution. Raising it trades small-tile recall for speed.
+  int first_level = 0;
+
+  // --- Hessian response ---
+  // Weight of the trace term in S = det(H) + k trace(H)^2 (thesis: 0.5).
+  // Edges (one non-zero eigenvalue) get a negative -S with k > 0. >= 0.
+  double trace_weight_k = 0.5;
+  // Absolute threshold on the corner response sqrt(max(-S,0) max(-S_d,0))
+  // (grey normalised to [0,1]; a sharp corner of contrast c blurred with
+  // sigma s gives about 32 (c / (pi s^2))^2). > 0.
+  double min_response = 5e-4;
+  // Noise-adaptive threshold: the response must also exceed this multiple of
+  // the median response of the level (sampled on a sparse grid). >= 0; 0 off.
+  double noise_response_factor = 8.0;
+
+  // --- non-maximum suppression ---
+  // Radius (level pixels) of the square window in which a candidate must be
+  // the maximum. The thesis uses 10 px at one scale; 3 keeps 5 px tiles. >= 1.
+  int nms_radius_px = 3;
+
+  // --- candidate filters ---
+  // The thesis's corner mask: at a candidate, the strongest junction kernel
+  // (5x5 ring of radius 2) must beat the strongest edge kernel.
+  bool use_corner_mask = true;
+  // Ring test: grey values are sampled on a circle around the candidate; a
+  // checkerboard corner gives a centrally symmetric ring signal whose energy
+  // is mostly in the second angular harmonic.
+  bool use_ring_test = true;
+  // Ring radius in level pixels. >= 1.5.
+  double ring_radius_px = 2.5;
+  // Samples on the ring (multiple of 4, 8..64).
+  int ring_samples = 16;
+  // Minimum grey contrast of the ring (peak-to-peak amplitude of its second
+  // harmonic, grey normalised to [0,1]). >= 0.
+  double min_ring_contrast = 0.02;
+  // Maximum ratio rms(antisymmetric part) / rms(symmetric part) of the ring
+  // signal (0 for an ideal corner, about 1 for an edge or a T-junction). > 0.
+  double max_ring_asymmetry = 0.5;
+  // Minimum share of the symmetric ring energy in the second harmonic (0.81
+  // for an ideal square-wave corner, lower for blobs and lines). In [0, 1].
+  double min_ring_second_harmonic = 0.5;
+
+  // --- sub-pixel refinement (always at full resolution) ---
+  SubpixelMethod subpixel = SubpixelMethod::kGradientOrthogonality;
+  // Half-size of the refinement window as a fraction of the distance to the
+  // nearest other corner (a tile edge); clamped to the two bounds below. > 0.
+  double window_fraction_of_neighbor = 0.4;
+  // Bounds of the window half-size in full-resolution pixels; the upper one is
+  // also used for a corner without neighbours. 2 <= min <= max <= 64.
+  int min_window_px = 2;
+  int max_window_px = 10;
+  // Iterations of the gradient-orthogonality solve (window re-centred). >= 1.
+  int max_iterations = 6;
+  // Stop when the update is shorter than this (pixels). > 0.
+  double convergence_px = 0.005;
+  // Drop a corner whose refined position moved more than this fraction of the
+  // window half-size from its start (a failed refinement). > 0.
+  double max_shift_fraction = 0.75;
+  // Corners closer than this (pixels) after refinement are merged (the
+  // stronger one stays). >= 0.
+  double merge_distance_px = 1.5;
+
+  // --- orientation ---
+  // Spacing (full-resolution pixels) of the finite differences giving the
+  // Hessian for the orientation, as a fraction of the refinement window
+  // half-size; at least 1 px. > 0.
+  double orientation_spacing_fraction = 0.5;
+
+  // False with a reason when a field is out of range.
+  bool Check(std::string* why = nullptr) const;
+};
+
+// What happened inside one DetectCorners call.
+struct DetectorSummary {
+  bool ok = false;      // the image could be processed
+  std::string message;  // why not, when !ok
+  int width = 0;
+  int height = 0;
+  int levels_used = 0;        // pyramid levels searched
+  double normalizer = 0.0;    // grey value mapped to 1.0
+  double threshold = 0.0;     // response threshold of level `first_level`
+  int candidates = 0;         // pixels above threshold, all levels
+  int after_nms = 0;          // local maxima
+  int after_mask = 0;         // passed the thesis corner mask
+  int after_ring = 0;         // passed the ring test
+  int after_merge_levels = 0; // after merging detections of several levels
+  int refine_failed = 0;      // dropped because refinement diverged
+  int merged_duplicates = 0;  // dropped as duplicates after refinement
+  int corners = 0;            // returned
+  // Wall time per stage, milliseconds.
+  double ms_preprocess = 0.0;  // conversion, normalisation, blur, pyramid
+  double ms_response = 0.0;    // Hessian responses
+  double ms_nms = 0.0;         // thresholds and non-maximum suppression
+  double ms_filter = 0.0;      // corner mask and ring test
+  double ms_refine = 0.0;      // sub-pixel, orientation, merging, sorting
+  double ms_total = 0.0;
+};
+
+// Detects checkerboard corners in a grey image (CV_8UC1, CV_16UC1 or
+// CV_32FC1; a 3- or 4-channel 8-bit image is converted to grey). Returns the
+// corners sorted by y, then x. Empty, tiny, constant or unsupported images
+// give no corners and a reason in `summary`; non-finite float pixels are
+// treated as 0. Invalid options give no corners (summary->message says why).
+std::vector<Corner> DetectCorners(const cv::Mat& image,
+                                  const DetectorOptions& options = {},
+                                  DetectorSummary* summary = nullptr);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_DETECTION_DETECTOR_H_

@@ -1,0 +1,42 @@
+#ifndef PUZZLECAL_DETECTION_HESSIAN_RESPONSE_H_
+#define PUZZLECAL_DETECTION_HESSIAN_RESPONSE_H_
+
+// The thesis's Hessian saddle response on one (blurred) image level.
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace puzzlecal {
+
+// For every pixel of `blurred` (CV_32FC1), with second differences of
+// spacing 2 (the thesis's [-1 0 1] kernel applied twice):
+//   S   = rxx ryy - rxy^2 + k (rxx + ryy)^2            (axis-aligned)
+//   S_d = rll rrr - rlr^2 + k (rll + rrr)^2            (diagonals)
+// and writes max(-S, 0) * max(-S_d, 0) into `response` (CV_32FC1, same size;
+// 0 on the 2-pixel border). Positive only where both Hessians see a saddle.
+void ComputeSaddleResponse(const cv::Mat& blurred, float trace_weight_k,
+                           cv::Mat* response);
+
+// Median of `response` sampled every `step` pixels in x and y (step >= 1).
+// `scratch` is reused between calls.
+float SampledMedian(const cv::Mat& response, int step,
+                    std::vector<float>* scratch);
+
+// An integer local maximum of the response.
+struct ResponsePeak {
+  int x = 0;
+  int y = 0;
+  float value = 0.0f;  // the response (product form) at the peak
+};
+
+// Pixels whose response exceeds `threshold` (product form) and is the
+// maximum of the (2 radius + 1)^2 window around it. Ties are broken by scan
+// order (the first pixel wins), so plateaus yield one peak. Appends in scan
+// order. Returns the number of pixels above the threshold.
+int FindResponsePeaks(const cv::Mat& response, float threshold, int radius,
+                      std::vector<ResponsePeak>* peaks);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_DETECTION_HESSIAN_RESPONSE_H_
