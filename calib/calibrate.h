@@ -1,0 +1,138 @@
+#ifndef PUZZLECAL_CALIB_CALIBRATE_H_
+#define PUZZLECAL_CALIB_CALIBRATE_H_
+
+// Calibration of one camera from views of a planar board: automatic
+// initialisation (calib/initialization.h), then a Ceres bundle adjustment over
+// the intrinsics and one cam_from_board pose per view (poses eliminated by
+// the Schur complement), a robust loss, iterative k-sigma outlier rejection
+// and parameter standard deviations from ceres::Covariance.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "calib/calibration_view.h"
+#include "calib/camera_models.h"
+#include "calib/initialization.h"
+
+namespace puzzlecal {
+
+enum class RobustLoss { kNone, kHuber, kCauchy };
+
+// "none", "huber", "cauchy".
+const char* RobustLossName(RobustLoss loss);
+bool RobustLossFromName(const std::string& name, RobustLoss* loss);
+
+struct CalibrationOptions {
+  // Hold fx and fy at their initial values. Default false.
+  bool fix_focal_length = false;
+  // Hold cx and cy at their initial values. Default false.
+  bool fix_principal_point = false;
+  // Hold every distortion coefficient at its initial value (0 unless
+  // initial_params says otherwise). Default false.
+  bool fix_distortion = false;
+  // Individual parameters held at their initial values, by name ("k3",
+  // "p1", ...; see CameraModelParamNames). Default empty.
+  std::vector<std::string> fixed_params;
+  // Starting intrinsics in the model's order; empty (the default) means
+  // automatic initialisation.
+  std::vector<double> initial_params;
+
+  // Robust loss on each corner's pixel error. Default Huber.
+  RobustLoss loss = RobustLoss::kHuber;
+  // Scale of the robust loss in pixels: errors below it count quadratically.
+  // Default 1 px.
+  double loss_scale_px = 1.0;
+
+  // Outlier rejection: after a solve, a corner whose pixel error exceeds
+  // outlier_k * sigma (sigma = 1.4826 * median absolute residual coordinate)
+  // is dropped and the problem solved again. Default 4 (for Gaussian noise
+  // this drops 0.03 % of good corners). 0 turns rejection off.
+  double outlier_k = 4.0;
+  // At most this many rejection rounds. Default 3.
+  int outlier_iterations = 3;
+
+  // Levenberg-Marquardt iterations per solve. Default 100.
+  int max_iterations = 100;
+  // Relative cost change that ends a solve. Default 1e-12.
+  double function_tolerance = 1e-12;
+  // Threads for the Ceres solve. Default 1. Results do not depend on it
+  // beyond the last bits of floating point (see the report's figures).
+  int num_threads = 1;
+
+  // A view needs at least this many corners to be used. Default 6.
+  int min_corners_per_view = 6;
+  // Fewer usable views than this is a failure. Default 3.
+  int min_views = 3;
+  // The board normals of the posed views must span at least this angle
+  // (degrees), otherwise the focal length is undetermined. Default 5.
+  double min_orientation_spread_deg = 5.0;
+  // The corners must touch at least this fraction of the cells of a
+  // coverage_grid x coverage_grid grid over the image. Default 0.1.
+  double min_coverage = 0.1;
+  // Cells per image side for the coverage figure. Default 8.
+  int coverage_grid = 8;
+  // A final RMS above this (pixels, per coordinate) is a failure: the
+  // correspondences or the model do not fit. Default 3 px.
+  double max_rms_px = 3.0;
+
+  // Fit fx, fy, cx, cy first with the distortion held at zero, then all.
+  // Makes the start from the undistorted initialisation safer. Default true.
+  bool staged_distortion = true;
+  // Compute the parameter covariance and standard deviations. Default true.
+  bool compute_covariance = true;
+
+  InitializationOptions initialization;
+
+  bool Check(std::string* why) const;
+};
+
+struct CalibrationResult {
+  Camera camera;  // model, estimated parameters, image size
+  // Per input view: whether it took part, and why not.
+  std::vector<bool> view_used;
+  std::vector<std::string> view_reason;
+  std::vector<Eigen::Isometry3d> cam_from_board;  // identity when not used
+  // RMS of the inlier residual coordinates (sqrt(sum(dx^2 + dy^2) / 2N)):
+  // for Gaussian corner noise sigma per axis it tends to
+  // sigma * sqrt(1 - P / 2N).
+  double rms_px = 0;
+  // OpenCV's figure (sqrt(sum(dx^2 + dy^2) / N)), for comparisons.
+  double rms_point_px = 0;
+  std::vector<double> view_rms_px;  // per view, per coordinate, inliers
+  // Per view and corner: projected minus observed pixel (empty for views
+  // not used), and whether the corner was kept.
+  std::vector<std::vector<Eigen::Vector2d>> residuals;
+  std::vector<std::vector<bool>> inlier;
+  // Standard deviation of every parameter (0 for fixed ones) and the
+  // covariance of the intrinsics, scaled by the residual variance.
+  std::vector<double> param_stddev;
+  Eigen::MatrixXd covariance;
+  bool covariance_ok = false;
+  std::vector<bool> param_fixed;
+  int num_views_used = 0;
+  int num_corners_used = 0;  // inlier corners of the used views
+  int num_outliers = 0;
+  int outlier_rounds = 0;  // solves after the first one
+  int iterations = 0;      // Levenberg-Marquardt iterations, all solves
+  double solve_seconds = 0;
+  double initialization_seconds = 0;
+  std::string initialization_method;
+  double orientation_spread_deg = 0;
+  double coverage = 0;  // fraction of coverage-grid cells with corners
+  std::string termination;  // Ceres' message of the last solve
+  std::string report;       // readable summary of all of the above
+};
+
+// Calibrates `model` for images of width x height pixels. Returns false with
+// a reason (which says what to change) when the views are too few or
+// degenerate or the solve fails; `result` then holds what is known so far.
+bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
+               int width, int height, const CalibrationOptions& options,
+               CalibrationResult* result, std::string* error);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_CALIB_CALIBRATE_H_

@@ -1,0 +1,624 @@
+#include "calib/initialization.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+
+#include "calib/reprojection_error.h"
+
+namespace puzzlecal {
+namespace {
+
+bool Fail(const std::string& message, std::string* why) {
+  if (why != nullptr) *why = message;
+  return false;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
+// Angle between a unit ray and a direction (any length), radians.
+double AngleBetween(const Eigen::Vector3d& ray, const Eigen::Vector3d& v) {
+  return std::atan2(ray.cross(v).norm(), ray.dot(v));
+}
+
+// True when the board points span a plane region (not all on one line).
+bool PointsSpanPlane(const std::vector<Eigen::Vector2d>& points,
+                     const std::vector<bool>& use) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  int n = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (use[i]) {
+      mean += points[i];
+      ++n;
+    }
+  }
+  if (n < 4) return false;
+  mean /= n;
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (use[i]) cov += (points[i] - mean) * (points[i] - mean).transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+  const double small = eig.eigenvalues()(0), large = eig.eigenvalues()(1);
+  return large > 0 && small > 1e-6 * large;
+}
+
+// One weighted DLT solve of ray x (H_norm * X_norm) = 0.
+bool SolveDlt(const std::vector<Eigen::Vector3d>& board_norm,
+              const std::vector<Eigen::Vector3d>& rays,
+              const std::vector<bool>& use, Eigen::Matrix3d* h) {
+  Eigen::Matrix<double, 9, 9> ata = Eigen::Matrix<double, 9, 9>::Zero();
+  Eigen::Matrix<double, 3, 9> rows;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (!use[i]) continue;
+    const Eigen::Vector3d& x = board_norm[i];
+    const Eigen::Vector3d& d = rays[i];
+    rows.setZero();
+    // d x (H x): three rows, rank two.
+    rows.block<1, 3>(0, 3) = -d.z() * x.transpose();
+    rows.block<1, 3>(0, 6) = d.y() * x.transpose();
+    rows.block<1, 3>(1, 0) = d.z() * x.transpose();
+    rows.block<1, 3>(1, 6) = -d.x() * x.transpose();
+    rows.block<1, 3>(2, 0) = -d.y() * x.transpose();
+    rows.block<1, 3>(2, 3) = d.x() * x.transpose();
+    ata.noalias() += rows.transpose() * rows;
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eig(ata);
+  if (eig.info() != Eigen::Success) return false;
+  const Eigen::Matrix<double, 9, 1> v = eig.eigenvectors().col(0);
+  if (!v.allFinite()) return false;
+  *h << v(0), v(1), v(2), v(3), v(4), v(5), v(6), v(7), v(8);
+  return true;
+}
+
+// The camera a focal-length candidate stands for: fx = fy = f, principal
+// point at the image centre, no distortion.
+Camera CandidateCamera(CameraModelId model, int width, int height, double f) {
+  Camera camera;
+  camera.model = model;
+  camera.width = width;
+  camera.height = height;
+  camera.params.assign(CameraModelNumParams(model), 0.0);
+  camera.params[0] = camera.params[1] = f;
+  camera.params[2] = 0.5 * (width - 1);
+  camera.params[3] = 0.5 * (height - 1);
+  return camera;
+}
+
+std::vector<Eigen::Vector2d> BoardXy(const CalibrationView& view) {
+  std::vector<Eigen::Vector2d> xy(view.board_points.size());
+  for (size_t i = 0; i < xy.size(); ++i) xy[i] = view.board_points[i].head<2>();
+  return xy;
+}
+
+// Unprojects every image point; `ok[i]` false where the model gives no ray.
+void UnprojectAll(const Camera& camera, const CalibrationView& view,
+                  std::vector<Eigen::Vector3d>* rays, std::vector<bool>* ok) {
+  rays->resize(view.image_points.size());
+  ok->assign(view.image_points.size(), false);
+  for (size_t i = 0; i < rays->size(); ++i) {
+    (*ok)[i] = camera.Unproject(view.image_points[i], &(*rays)[i]).converged;
+  }
+}
+
+// Pose of one view from rays only (no refinement); false if none.
+bool PoseFromRays(const Camera& camera, const CalibrationView& view,
+                  const InitializationOptions& options,
+                  Eigen::Isometry3d* cam_from_board, std::string* why) {
+  std::vector<Eigen::Vector3d> rays;
+  std::vector<bool> ok;
+  UnprojectAll(camera, view, &rays, &ok);
+  std::vector<Eigen::Vector2d> xy_ok;
+  std::vector<Eigen::Vector3d> rays_ok;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (ok[i]) {
+      xy_ok.push_back(view.board_points[i].head<2>());
+      rays_ok.push_back(rays[i]);
+    }
+  }
+  if (xy_ok.size() < 4) {
+    return Fail("fewer than 4 corners unproject with the current intrinsics",
+                why);
+  }
+  Eigen::Matrix3d h;
+  if (!EstimateBoardToRayHomography(xy_ok, rays_ok, options, &h, nullptr)) {
+    return Fail("no board-to-ray homography (corners on a line?)", why);
+  }
+  if (!PoseFromBoardToRayHomography(h, xy_ok, rays_ok, cam_from_board)) {
+    return Fail("the homography gives no pose", why);
+  }
+  return true;
+}
+
+// Sum over views of truncated squared pixel errors when every view gets its
+// pose from rays through `camera`: how well `camera` explains the views.
+double ViewFitCost(const Camera& camera,
+                   const std::vector<const CalibrationView*>& views,
+                   const InitializationOptions& options) {
+  const double truncation2 =
+      options.focal_search_truncation_px * options.focal_search_truncation_px;
+  double cost = 0;
+  for (const CalibrationView* view : views) {
+    Eigen::Isometry3d pose;
+    if (!PoseFromRays(camera, *view, options, &pose, nullptr)) {
+      cost += truncation2 * view->board_points.size();
+      continue;
+    }
+    for (size_t i = 0; i < view->board_points.size(); ++i) {
+      Eigen::Vector2d pixel;
+      double e2 = truncation2;
+      if (camera.Project(pose * view->board_points[i], &pixel)) {
+        e2 = std::min(e2, (pixel - view->image_points[i]).squaredNorm());
+      }
+      if (!std::isfinite(e2)) e2 = truncation2;
+      cost += e2;
+    }
+  }
+  return cost;
+}
+
+// 1D search for f (fx = fy = f, centred principal point, no distortion):
+// log-spaced scan, then golden section around the best candidate.
+double SearchFocalLength(CameraModelId model, int width, int height,
+                         const std::vector<const CalibrationView*>& views,
+                         const InitializationOptions& options,
+                         double* best_cost) {
+  const double diagonal = std::hypot(width, height);
+  const double log_min = std::log(options.focal_search_min_ratio * diagonal);
+  const double log_max = std::log(options.focal_search_max_ratio * diagonal);
+  const int steps = options.focal_search_steps;
+  auto cost_at = [&](double log_f) {
+    return ViewFitCost(CandidateCamera(model, width, height, std::exp(log_f)),
+                       views, options);
+  };
+  int best = 0;
+  double best_value = std::numeric_limits<double>::infinity();
+  const double step = (log_max - log_min) / (steps - 1);
+  for (int k = 0; k < steps; ++k) {
+    const double value = cost_at(log_min + k * step);
+    if (value < best_value) {
+      best_value = value;
+      best = k;
+    }
+  }
+  double a = log_min + std::max(0, best - 1) * step;
+  double b = log_min + std::min(steps - 1, best + 1) * step;
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  double c = b - ratio * (b - a), d = a + ratio * (b - a);
+  double fc = cost_at(c), fd = cost_at(d);
+  for (int it = 0; it < 30; ++it) {
+    if (fc < fd) {
+      b = d;
+      d = c;
+      fd = fc;
+      c = b - ratio * (b - a);
+      fc = cost_at(c);
+    } else {
+      a = c;
+      c = d;
+      fc = fd;
+      d = a + ratio * (b - a);
+      fd = cost_at(d);
+    }
+  }
+  double log_f = fc < fd ? c : d;
+  double value = std::min(fc, fd);
+  if (best_value < value) {  // the scan point itself was better
+    log_f = log_min + best * step;
+    value = best_value;
+  }
+  *best_cost = value;
+  return std::exp(log_f);
+}
+
+// Zhang's v_ij vector for columns i, j of a homography.
+Eigen::Matrix<double, 6, 1> ZhangV(const Eigen::Matrix3d& h, int i, int j) {
+  Eigen::Matrix<double, 6, 1> v;
+  v << h(0, i) * h(0, j), h(0, i) * h(1, j) + h(1, i) * h(0, j),
+      h(1, i) * h(1, j), h(2, i) * h(0, j) + h(0, i) * h(2, j),
+      h(2, i) * h(1, j) + h(1, i) * h(2, j), h(2, i) * h(2, j);
+  return v;
+}
+
+// Homographies from the board plane to normalised pixel coordinates
+// ((u - centre) / scale), one per view that gives one.
+std::vector<Eigen::Matrix3d> NormalisedHomographies(
+    const std::vector<const CalibrationView*>& views, double cx0, double cy0,
+    double scale, const InitializationOptions& options) {
+  std::vector<Eigen::Matrix3d> result;
+  for (const CalibrationView* view : views) {
+    std::vector<Eigen::Vector3d> rays(view->image_points.size());
+    for (size_t i = 0; i < rays.size(); ++i) {
+      rays[i] = Eigen::Vector3d((view->image_points[i].x() - cx0) / scale,
+                                (view->image_points[i].y() - cy0) / scale, 1.0)
+                    .normalized();
+    }
+    Eigen::Matrix3d h;
+    if (EstimateBoardToRayHomography(BoardXy(*view), rays, options, &h,
+                                     nullptr)) {
+      result.push_back(h / h.norm());
+    }
+  }
+  return result;
+}
+
+// Zhang's closed form, all five parameters (skew dropped). Normalised units.
+bool ZhangFull(const std::vector<Eigen::Matrix3d>& homographies, double* fx,
+               double* fy, double* u0, double* v0) {
+  if (homographies.size() < 3) return false;
+  Eigen::MatrixXd v(2 * homographies.size(), 6);
+  for (size_t k = 0; k < homographies.size(); ++k) {
+    v.row(2 * k) = ZhangV(homographies[k], 0, 1).transpose();
+    v.row(2 * k + 1) =
+        (ZhangV(homographies[k], 0, 0) - ZhangV(homographies[k], 1, 1))
+            .transpose();
+  }
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(v, Eigen::ComputeFullV);
+  Eigen::VectorXd b = svd.matrixV().col(5);
+  if (b(0) < 0) b = -b;
+  const double b11 = b(0), b12 = b(1), b22 = b(2), b13 = b(3), b23 = b(4),
+               b33 = b(5);
+  const double den = b11 * b22 - b12 * b12;
+  if (!(b11 > 0) || !(den > 0)) return false;
+  *v0 = (b12 * b13 - b11 * b23) / den;
+  const double lambda = b33 - (b13 * b13 + *v0 * (b12 * b13 - b11 * b23)) / b11;
+  if (!(lambda / b11 > 0)) return false;
+  *fx = std::sqrt(lambda / b11);
+  *fy = std::sqrt(lambda * b11 / den);
+  const double gamma = -b12 * (*fx) * (*fx) * (*fy) / lambda;
+  *u0 = gamma * (*v0) / (*fy) - b13 * (*fx) * (*fx) / lambda;
+  return std::isfinite(*fx) && std::isfinite(*fy) && std::isfinite(*u0) &&
+         std::isfinite(*v0);
+}
+
+// Zhang's closed form with the principal point at the centre and square
+// pixels: one unknown f^2, linear least squares. Normalised units.
+bool ZhangCentred(const std::vector<Eigen::Matrix3d>& homographies,
+                  double* f) {
+  double pq = 0, qq = 0;
+  for (const Eigen::Matrix3d& h : homographies) {
+    // h1' w h2 = 0 and h1' w h1 = h2' w h2 with w = diag(1, 1, f^2).
+    const double p1 = h(0, 0) * h(0, 1) + h(1, 0) * h(1, 1);
+    const double q1 = h(2, 0) * h(2, 1);
+    const double p2 = h(0, 0) * h(0, 0) + h(1, 0) * h(1, 0) -
+                      h(0, 1) * h(0, 1) - h(1, 1) * h(1, 1);
+    const double q2 = h(2, 0) * h(2, 0) - h(2, 1) * h(2, 1);
+    pq += p1 * q1 + p2 * q2;
+    qq += q1 * q1 + q2 * q2;
+  }
+  if (!(qq > 0)) return false;
+  const double f2 = -pq / qq;
+  if (!(f2 > 0)) return false;
+  *f = std::sqrt(f2);
+  return std::isfinite(*f);
+}
+
+// Pose refinement with fixed intrinsics: robust reprojection error.
+template <typename Model>
+bool RefinePose(const Camera& camera, const CalibrationView& view,
+                const InitializationOptions& options,
+                Eigen::Isometry3d* cam_from_board) {
+  double pose[kPoseBlockSize];
+  const Eigen::Matrix3d rotation = cam_from_board->linear();
+  ceres::RotationMatrixToAngleAxis(
+      ceres::ColumnMajorAdapter3x3(rotation.data()), pose);
+  for (int k = 0; k < 3; ++k) pose[3 + k] = cam_from_board->translation()(k);
+  std::vector<double> intrinsics = camera.params;
+  ceres::Problem problem;
+  for (size_t i = 0; i < view.board_points.size(); ++i) {
+    problem.AddResidualBlock(
+        ReprojectionError<Model>::Create(view.board_points[i],
+                                         view.image_points[i]),
+        new ceres::HuberLoss(options.pose_refine_loss_px), intrinsics.data(),
+        pose);
+  }
+  problem.SetParameterBlockConstant(intrinsics.data());
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.pose_refine_iterations;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  if (!summary.IsSolutionUsable() ||
+      !(summary.final_cost <= summary.initial_cost)) {
+    return false;
+  }
+  Eigen::Matrix3d refined;
+  ceres::AngleAxisToRotationMatrix(pose,
+                                   ceres::ColumnMajorAdapter3x3(refined.data()));
+  cam_from_board->linear() = refined;
+  cam_from_board->translation() = Eigen::Vector3d(pose[3], pose[4], pose[5]);
+  return true;
+}
+
+}  // namespace
+
+bool InitializationOptions::Check(std::string* why) const {
+  if (reweight_iterations < 0) {
+    return Fail("initialization.reweight_iterations must be >= 0", why);
+  }
+  if (!(reweight_k > 0)) return Fail("initialization.reweight_k must be > 0", why);
+  if (!(focal_search_min_ratio > 0) ||
+      !(focal_search_max_ratio > focal_search_min_ratio)) {
+    return Fail("initialization.focal_search_min_ratio must be > 0 and below "
+                "focal_search_max_ratio", why);
+  }
+  if (focal_search_steps < 3) {
+    return Fail("initialization.focal_search_steps must be >= 3", why);
+  }
+  if (!(focal_search_truncation_px > 0)) {
+    return Fail("initialization.focal_search_truncation_px must be > 0", why);
+  }
+  if (focal_search_max_views < 1) {
+    return Fail("initialization.focal_search_max_views must be >= 1", why);
+  }
+  if (pose_refine_iterations < 0) {
+    return Fail("initialization.pose_refine_iterations must be >= 0", why);
+  }
+  if (!(pose_refine_loss_px > 0)) {
+    return Fail("initialization.pose_refine_loss_px must be > 0", why);
+  }
+  return true;
+}
+
+bool EstimateBoardToRayHomography(const std::vector<Eigen::Vector2d>& board_xy,
+                                  const std::vector<Eigen::Vector3d>& rays,
+                                  const InitializationOptions& options,
+                                  Eigen::Matrix3d* homography,
+                                  std::vector<bool>* inlier) {
+  const size_t n = board_xy.size();
+  if (n < 4 || rays.size() != n) return false;
+  std::vector<bool> use(n, false);
+  for (size_t i = 0; i < n; ++i) {
+    use[i] = board_xy[i].allFinite() && rays[i].allFinite() &&
+             rays[i].norm() > 0.5;
+  }
+  if (!PointsSpanPlane(board_xy, use)) return false;
+  // Normalise the board coordinates (centroid, mean distance sqrt 2).
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  int count = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (use[i]) {
+      mean += board_xy[i];
+      ++count;
+    }
+  }
+  mean /= count;
+  double spread = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (use[i]) spread += (board_xy[i] - mean).norm();
+  }
+  spread /= count;
+  const double s = std::sqrt(2.0) / spread;
+  Eigen::Matrix3d normalise;
+  normalise << s, 0, -s * mean.x(), 0, s, -s * mean.y(), 0, 0, 1;
+  std::vector<Eigen::Vector3d> board_norm(n);
+  for (size_t i = 0; i < n; ++i) {
+    board_norm[i] = normalise * board_xy[i].homogeneous();
+  }
+  Eigen::Matrix3d h_norm;
+  if (!SolveDlt(board_norm, rays, use, &h_norm)) return false;
+  std::vector<double> error(n, 0.0);
+  for (int round = 0; round < options.reweight_iterations; ++round) {
+    double sign_sum = 0;
+    for (size_t i = 0; i < n; ++i) {
+      if (use[i]) sign_sum += rays[i].dot(h_norm * board_norm[i]);
+    }
+    if (sign_sum < 0) h_norm = -h_norm;
+    std::vector<double> kept_errors;
+    for (size_t i = 0; i < n; ++i) {
+      error[i] = rays[i].allFinite() && board_xy[i].allFinite()
+                     ? AngleBetween(rays[i], h_norm * board_norm[i])
+                     : std::numeric_limits<double>::infinity();
+      if (use[i]) kept_errors.push_back(error[i]);
+    }
+    // Floor: exact data must not lose points to rounding.
+    const double threshold =
+        std::max(options.reweight_k * 1.4826 * Median(kept_errors), 1e-9);
+    std::vector<bool> next(n, false);
+    for (size_t i = 0; i < n; ++i) next[i] = error[i] <= threshold;
+    if (next == use) break;
+    if (!PointsSpanPlane(board_xy, next)) break;
+    Eigen::Matrix3d h_next;
+    if (!SolveDlt(board_norm, rays, next, &h_next)) break;
+    use = next;
+    h_norm = h_next;
+  }
+  double sign_sum = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (use[i]) sign_sum += rays[i].dot(h_norm * board_norm[i]);
+  }
+  if (sign_sum < 0) h_norm = -h_norm;
+  *homography = h_norm * normalise;
+  if (!homography->allFinite()) return false;
+  if (inlier != nullptr) *inlier = use;
+  return true;
+}
+
+bool PoseFromBoardToRayHomography(const Eigen::Matrix3d& homography,
+                                  const std::vector<Eigen::Vector2d>& board_xy,
+                                  const std::vector<Eigen::Vector3d>& rays,
+                                  Eigen::Isometry3d* cam_from_board) {
+  Eigen::Matrix3d h = homography;
+  double sign_sum = 0;
+  for (size_t i = 0; i < board_xy.size(); ++i) {
+    if (board_xy[i].allFinite() && rays[i].allFinite()) {
+      sign_sum += rays[i].dot(h * board_xy[i].homogeneous());
+    }
+  }
+  if (sign_sum < 0) h = -h;
+  const double norm1 = h.col(0).norm(), norm2 = h.col(1).norm();
+  if (!(norm1 > 0) || !(norm2 > 0)) return false;
+  const double scale = 2.0 / (norm1 + norm2);
+  Eigen::Matrix3d r;
+  r.col(0) = h.col(0) * scale;
+  r.col(1) = h.col(1) * scale;
+  r.col(2) = r.col(0).cross(r.col(1));
+  // The nearest rotation (polar decomposition).
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(r, Eigen::ComputeFullU |
+                                               Eigen::ComputeFullV);
+  Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
+  if (rotation.determinant() < 0) {
+    Eigen::Matrix3d u = svd.matrixU();
+    u.col(2) = -u.col(2);
+    rotation = u * svd.matrixV().transpose();
+  }
+  if (!rotation.allFinite()) return false;
+  cam_from_board->setIdentity();
+  cam_from_board->linear() = rotation;
+  cam_from_board->translation() = h.col(2) * scale;
+  return cam_from_board->matrix().allFinite();
+}
+
+bool EstimateViewPose(const Camera& camera, const CalibrationView& view,
+                      const InitializationOptions& options,
+                      Eigen::Isometry3d* cam_from_board, std::string* why) {
+  if (!PoseFromRays(camera, view, options, cam_from_board, why)) return false;
+  if (options.pose_refine_iterations > 0) {
+    // A failed refinement keeps the homography pose: it is still a start.
+    DispatchCameraModel(camera.model, [&](auto model) {
+      return RefinePose<decltype(model)>(camera, view, options,
+                                         cam_from_board);
+    });
+  }
+  return true;
+}
+
+bool InitializeCalibration(const std::vector<CalibrationView>& views,
+                           const std::vector<bool>& use_view,
+                           CameraModelId model, int width, int height,
+                           const std::vector<double>& initial_params,
+                           const InitializationOptions& options,
+                           InitializationResult* result, std::string* error) {
+  std::string why;
+  if (!options.Check(&why)) return Fail(why, error);
+  if (width <= 0 || height <= 0) {
+    return Fail("image size must be positive", error);
+  }
+  if (use_view.size() != views.size()) {
+    return Fail("use_view must have one entry per view", error);
+  }
+  *result = InitializationResult();
+  std::vector<const CalibrationView*> used;
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (use_view[i]) used.push_back(&views[i]);
+  }
+  if (used.empty()) return Fail("no views to initialise from", error);
+  // Evenly spread subset for the intrinsics search.
+  std::vector<const CalibrationView*> search_views;
+  const int max_views = options.focal_search_max_views;
+  if (static_cast<int>(used.size()) <= max_views) {
+    search_views = used;
+  } else {
+    for (int k = 0; k < max_views; ++k) {
+      search_views.push_back(used[static_cast<size_t>(k) * used.size() /
+                                  max_views]);
+    }
+  }
+
+  Camera camera;
+  if (!initial_params.empty()) {
+    if (static_cast<int>(initial_params.size()) != CameraModelNumParams(model)) {
+      return Fail("initial parameters: " + std::to_string(initial_params.size()) +
+                      " values given, model " + CameraModelName(model) +
+                      " has " + std::to_string(CameraModelNumParams(model)),
+                  error);
+    }
+    camera.model = model;
+    camera.width = width;
+    camera.height = height;
+    camera.params = initial_params;
+    result->method = "given by the caller";
+  } else {
+    double search_cost = 0;
+    const double f_search = SearchFocalLength(model, width, height,
+                                              search_views, options,
+                                              &search_cost);
+    camera = CandidateCamera(model, width, height, f_search);
+    result->method = "focal-length search (f = " + std::to_string(f_search) +
+                     " px, centred principal point)";
+    if (CameraModelIsPinhole(model)) {
+      // Zhang's closed forms compete with the search; the best fit wins.
+      const double cx0 = 0.5 * (width - 1), cy0 = 0.5 * (height - 1);
+      const double scale = 0.5 * std::max(width, height);
+      const std::vector<Eigen::Matrix3d> homographies =
+          NormalisedHomographies(search_views, cx0, cy0, scale, options);
+      double best_cost = search_cost;
+      double fx, fy, u0, v0;
+      if (ZhangFull(homographies, &fx, &fy, &u0, &v0)) {
+        Camera full = CandidateCamera(model, width, height, fx * scale);
+        full.params[1] = fy * scale;
+        full.params[2] = cx0 + u0 * scale;
+        full.params[3] = cy0 + v0 * scale;
+        const bool plausible = fx / fy > 0.5 && fx / fy < 2.0 &&
+                               full.params[2] > 0 && full.params[2] < width &&
+                               full.params[3] > 0 && full.params[3] < height;
+        const double cost =
+            plausible ? ViewFitCost(full, search_views, options)
+                      : std::numeric_limits<double>::infinity();
+        if (cost < best_cost) {
+          best_cost = cost;
+          camera = full;
+          result->method = "Zhang closed form";
+        }
+      }
+      double f;
+      if (ZhangCentred(homographies, &f)) {
+        const Camera centred = CandidateCamera(model, width, height, f * scale);
+        const double cost = ViewFitCost(centred, search_views, options);
+        if (cost < best_cost) {
+          best_cost = cost;
+          camera = centred;
+          result->method = "Zhang closed form, centred principal point";
+        }
+      }
+    }
+  }
+
+  result->camera = camera;
+  result->view_ok.assign(views.size(), false);
+  result->cam_from_board.assign(views.size(), Eigen::Isometry3d::Identity());
+  result->view_reason.assign(views.size(), "");
+  std::vector<Eigen::Vector3d> normals;
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (!use_view[i]) {
+      result->view_reason[i] = "not used";
+      continue;
+    }
+    std::string view_why;
+    if (EstimateViewPose(camera, views[i], options,
+                         &result->cam_from_board[i], &view_why)) {
+      result->view_ok[i] = true;
+      normals.push_back(result->cam_from_board[i].linear().col(2));
+    } else {
+      result->view_reason[i] = view_why;
+    }
+  }
+  if (normals.empty()) {
+    return Fail("no view gives a pose with the initial intrinsics (" +
+                    result->method + ")", error);
+  }
+  double spread = 0;
+  for (size_t i = 0; i < normals.size(); ++i) {
+    for (size_t j = i + 1; j < normals.size(); ++j) {
+      spread = std::max(spread, AngleBetween(normals[i], normals[j]));
+    }
+  }
+  result->orientation_spread_deg = spread * 180.0 / M_PI;
+  return true;
+}
+
+}  // namespace puzzlecal

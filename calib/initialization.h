@@ -1,0 +1,104 @@
+#ifndef PUZZLECAL_CALIB_INITIALIZATION_H_
+#define PUZZLECAL_CALIB_INITIALIZATION_H_
+
+// Starting values for the bundle adjustment without any guess from the user:
+// - pinhole models: Zhang's closed form on board-to-image homographies (the
+//   full five-parameter form when it is plausible, otherwise the form with
+//   the principal point at the image centre and square pixels);
+// - kannala-brandt: the equidistant model r = f * theta with the principal
+//   point at the image centre; f by a 1D search that fits, for every view, a
+//   board-to-ray homography to the rays the candidate f gives (works for rays
+//   beyond 90 degrees, so for 190 degree lenses and partial views);
+// - per view: a pose "PnP through the model": pixels are unprojected to rays
+//   with the current intrinsics, a board-to-ray homography gives the pose,
+//   and a small robust Ceres refinement polishes it.
+// Every estimate is robust to a few gross outliers (iteratively reweighted).
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "calib/calibration_view.h"
+#include "calib/camera_models.h"
+
+namespace puzzlecal {
+
+struct InitializationOptions {
+  // Rounds of outlier down-weighting in every homography fit. Default 4.
+  int reweight_iterations = 4;
+  // A correspondence is dropped from a homography fit when its angular error
+  // exceeds this many robust standard deviations (1.4826 * median). Default 3.
+  double reweight_k = 3.0;
+  // Fisheye focal search: candidate f from focal_search_min_ratio to
+  // focal_search_max_ratio times the image diagonal, log-spaced. Defaults
+  // 0.05 and 3.
+  double focal_search_min_ratio = 0.05;
+  double focal_search_max_ratio = 3.0;
+  // Number of log-spaced candidates before the golden-section refinement.
+  // Default 64.
+  int focal_search_steps = 64;
+  // Pixel errors above this are truncated in the focal-search cost, so that
+  // outliers and badly fitting views cannot dominate it. Default 8 px.
+  double focal_search_truncation_px = 8.0;
+  // At most this many views (evenly spread over the input) take part in the
+  // focal search; all views get a pose afterwards. Default 60.
+  int focal_search_max_views = 60;
+  // Iterations of the per-view pose refinement (Ceres, Huber loss). Default 20.
+  int pose_refine_iterations = 20;
+  // Huber scale of the pose refinement, pixels. Default 2.
+  double pose_refine_loss_px = 2.0;
+
+  bool Check(std::string* why) const;
+};
+
+// What the initialisation produced and how.
+struct InitializationResult {
+  Camera camera;                                // starting intrinsics
+  std::vector<bool> view_ok;                    // pose found for the view
+  std::vector<Eigen::Isometry3d> cam_from_board;  // per view (identity if !ok)
+  std::vector<std::string> view_reason;         // why a view has no pose
+  std::string method;                           // how the intrinsics were made
+  // Largest angle between the board normals of two posed views, degrees: a
+  // small value means the focal length is poorly determined.
+  double orientation_spread_deg = 0;
+};
+
+// Board-to-ray homography (ray ~ H * (X, Y, 1)) from board-plane points and
+// unit rays (any direction, also beyond 90 degrees from the optical axis),
+// with iterative outlier down-weighting. `inlier` (optional) returns the
+// correspondences kept in the last round. False when fewer than 4 usable
+// points remain or the points are degenerate (collinear).
+bool EstimateBoardToRayHomography(const std::vector<Eigen::Vector2d>& board_xy,
+                                  const std::vector<Eigen::Vector3d>& rays,
+                                  const InitializationOptions& options,
+                                  Eigen::Matrix3d* homography,
+                                  std::vector<bool>* inlier);
+
+// cam_from_board from a board-to-ray homography (H = s * [r1 r2 t]).
+bool PoseFromBoardToRayHomography(const Eigen::Matrix3d& homography,
+                                  const std::vector<Eigen::Vector2d>& board_xy,
+                                  const std::vector<Eigen::Vector3d>& rays,
+                                  Eigen::Isometry3d* cam_from_board);
+
+// PnP through the model: the pose of one view for a known camera. Returns
+// false with a reason when the view gives no pose.
+bool EstimateViewPose(const Camera& camera, const CalibrationView& view,
+                      const InitializationOptions& options,
+                      Eigen::Isometry3d* cam_from_board, std::string* why);
+
+// Starting intrinsics (see the file comment) and one pose per usable view.
+// `use_view[i]` false skips view i. If `initial_params` is not empty it is
+// used as the intrinsics and only the poses are estimated. False with a
+// reason when no intrinsics can be found.
+bool InitializeCalibration(const std::vector<CalibrationView>& views,
+                           const std::vector<bool>& use_view,
+                           CameraModelId model, int width, int height,
+                           const std::vector<double>& initial_params,
+                           const InitializationOptions& options,
+                           InitializationResult* result, std::string* error);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_CALIB_INITIALIZATION_H_
