@@ -1,0 +1,407 @@
+#include "decode/decoder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+
+#include "decode/position_search.h"
+
+namespace puzzlecal {
+namespace {
+
+std::string Format(const char* format, double a, double b = 0.0, double c = 0.0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), format, a, b, c);
+  return buffer;
+}
+
+// Relative labels of a component: right-handed, smallest label at (0, 0).
+void AppendRelativeLabels(const LabelLattice& lattice, int handedness,
+                          int component, DecodeResult* result) {
+  Eigen::Matrix2i flip = Eigen::Matrix2i::Identity();
+  if (handedness < 0) flip(1, 1) = -1;
+  Eigen::Vector2i lo = (flip * lattice.label.front());
+  for (const Eigen::Vector2i& ij : lattice.label) lo = lo.cwiseMin(flip * ij);
+  for (size_t k = 0; k < lattice.label.size(); ++k) {
+    result->observation.id.push_back(flip * lattice.label[k] - lo);
+    result->observation.xy.push_back(lattice.xy[k]);
+    result->corner_index.push_back(lattice.corner_index[k]);
+    result->component.push_back(component);
+  }
+}
+
+// Image direction of the label step `step`, averaged over the lattice.
+Eigen::Vector2d ImageDirection(const LabelLattice& lattice,
+                               const Eigen::Vector2i& step) {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (size_t k = 0; k < lattice.label.size(); ++k) {
+    const int next = lattice.At(lattice.label[k] + step);
+    if (next >= 0) sum += (lattice.xy[next] - lattice.xy[k]).normalized();
+  }
+  return sum;
+}
+
+// A checkerboard component whose label extent is the whole board: the map to
+// board ids, or false.
+bool FullCheckerboardMap(const LabelLattice& lattice, int handedness,
+                         const Board& board, LabelToBoard* map) {
+  const Eigen::Vector2i span(lattice.width - 1, lattice.height - 1);
+  double best_x = -1e300;
+  bool found = false;
+  for (const Eigen::Matrix2i& m : LabelRotations(handedness >= 0 ? 1 : -1)) {
+    const Eigen::Vector2i a = m * lattice.min_label;
+    const Eigen::Vector2i b = m * (lattice.min_label + span);
+    const Eigen::Vector2i lo = a.cwiseMin(b), hi = a.cwiseMax(b);
+    if (hi.x() - lo.x() != board.cols - 1 || hi.y() - lo.y() != board.rows - 1) {
+      continue;
+    }
+    // Board +col axis in label steps: m^T (1, 0).
+    const Eigen::Vector2i step = m.transpose() * Eigen::Vector2i(1, 0);
+    const double x = ImageDirection(lattice, step).x();
+    if (!found || x > best_x) {
+      found = true;
+      best_x = x;
+      map->rotation = m;
+      map->offset = board.origin - lo;
+    }
+  }
+  return found;
+}
+
+struct AcceptedComponent {
+  int component = -1;
+  const LabelLattice* lattice = nullptr;
+  LabelToBoard map;
+  std::vector<char> keep;  // per lattice point
+};
+
+// Decodes one PuzzleBoard component; fills `decoding` and, when accepted,
+// `accepted`.
+bool DecodePuzzleComponent(const LabelLattice& lattice, const cv::Mat& grey,
+                           const Board& board, const DecodeOptions& options,
+                           ComponentDecoding* decoding,
+                           AcceptedComponent* accepted) {
+  const int handedness = decoding->handedness;
+  if (handedness == 0) {
+    decoding->reason = "labels do not span two lattice directions";
+    return false;
+  }
+  const EdgeBitReading reading = ReadEdgeBits(lattice, grey, options.bits);
+  decoding->edges = static_cast<int>(reading.edges.size());
+  decoding->bits_read = reading.num_read;
+  if (reading.num_read < options.min_bits_read) {
+    decoding->reason =
+        Format("only %.0f of %.0f edge bits readable (need %.0f): no discs "
+               "(plain checkerboard?), blur or tiles too small",
+               reading.num_read, decoding->edges, options.min_bits_read);
+    return false;
+  }
+  std::vector<LabelEdgeVote> votes;
+  votes.reserve(reading.num_read);
+  for (const EdgeBit& edge : reading.edges) {
+    if (!edge.read) continue;
+    votes.push_back({edge.from - lattice.min_label, edge.axis,
+                     edge.confidence > 0 ? 1 : 0});
+  }
+  // Dark-tile parity relative to the shifted labels.
+  int parity = reading.dark_tile_parity;
+  if (parity >= 0) {
+    parity = (parity + lattice.min_label.x() + lattice.min_label.y()) & 1;
+  }
+  const Eigen::Vector2i label_max(lattice.width - 1, lattice.height - 1);
+  const PositionSearchResult search = SearchPuzzleBoardPosition(
+      votes, Eigen::Vector2i::Zero(), label_max, handedness, parity, board);
+  if (!search.found) {
+    decoding->reason = Format(
+        "labels spanning %.0f x %.0f corners fit on the %.0f-column board in "
+        "no rotation",
+        lattice.width, lattice.height, board.cols);
+    return false;
+  }
+  decoding->bits_agreeing = search.edges_agreeing;
+  decoding->agreement =
+      static_cast<double>(search.edges_agreeing) / std::max(1, search.num_edges);
+  decoding->bins_read = search.bins_read;
+  decoding->bins_agreeing = search.bins_agreeing;
+  decoding->margin = (search.best_score - search.second_score) / 2;
+  decoding->hypotheses = search.hypotheses;
+  decoding->log10_nfa = std::log10(static_cast<double>(search.hypotheses)) +
+                        Log10BinomialTailHalf(search.bins_read, search.bins_agreeing);
+
+  std::string why;
+  if (decoding->agreement < options.min_agreement) {
+    why = Format("best position agrees with %.1f %% of %.0f bits (need %.1f %%)",
+                 100.0 * decoding->agreement, decoding->bits_read,
+                 100.0 * options.min_agreement);
+  } else if (decoding->margin < options.min_margin) {
+    why = Format("ambiguous: best position leads the second by %.0f bits "
+                 "(need %.0f)",
+                 decoding->margin, options.min_margin);
+  } else if (decoding->log10_nfa > options.max_log10_nfa) {
+    why = Format("too little evidence: a random pattern would match this well "
+                 "10^%.1f times (allowed 10^%.1f)",
+                 decoding->log10_nfa, options.max_log10_nfa);
+  } else if (options.refuse_better_off_board &&
+             search.torus_best_score > search.best_score) {
+    why = Format("a position outside the printed board matches better (%.0f vs "
+                 "%.0f agreeing bits): wrong board file or print?",
+                 (search.torus_best_score + search.num_edges) / 2,
+                 search.edges_agreeing);
+  }
+  if (!why.empty()) {
+    // Name mirrored or inverted prints when they explain the bits better.
+    const PositionSearchResult mirrored = SearchPuzzleBoardPosition(
+        votes, Eigen::Vector2i::Zero(), label_max, -handedness,
+        parity < 0 ? -1 : parity, board);
+    const PositionSearchResult inverted = SearchPuzzleBoardPosition(
+        votes, Eigen::Vector2i::Zero(), label_max, handedness, parity, board,
+        /*inverted=*/true);
+    const auto agreement = [](const PositionSearchResult& r) {
+      return r.found ? static_cast<double>(r.edges_agreeing) / std::max(1, r.num_edges)
+                     : 0.0;
+    };
+    decoding->mirrored_agreement = agreement(mirrored);
+    decoding->inverted_agreement = agreement(inverted);
+    if (decoding->mirrored_agreement >= options.min_agreement &&
+        mirrored.edges_agreeing > search.edges_agreeing) {
+      why += Format("; the bits match a mirrored PuzzleBoard (%.1f %%): mirrored "
+                    "image or print",
+                    100.0 * decoding->mirrored_agreement);
+    } else if (decoding->inverted_agreement >= options.min_agreement &&
+               inverted.edges_agreeing > search.edges_agreeing) {
+      why += Format("; the bits match a contrast-inverted PuzzleBoard (%.1f %%)",
+                    100.0 * decoding->inverted_agreement);
+    }
+    decoding->reason = why;
+    return false;
+  }
+
+  // Accepted: label -> board map for the original labels.
+  accepted->lattice = &lattice;
+  accepted->map.rotation = search.best.rotation;
+  accepted->map.offset =
+      search.best.offset - search.best.rotation * lattice.min_label;
+  decoding->rotation = accepted->map.rotation;
+  decoding->offset = accepted->map.offset;
+  decoding->decoded = true;
+  // Corners whose own edges mostly contradict the code are mislabelled.
+  std::vector<int> disagreeing(lattice.xy.size(), 0);
+  for (const EdgeBit& edge : reading.edges) {
+    if (!edge.read) continue;
+    const int bit = edge.confidence > 0 ? 1 : 0;
+    if (bit == BoardBitOfLabelEdge(accepted->map, edge.from, edge.axis)) continue;
+    const Eigen::Vector2i to =
+        edge.from + (edge.axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1));
+    ++disagreeing[lattice.At(edge.from)];
+    ++disagreeing[lattice.At(to)];
+  }
+  accepted->keep.assign(lattice.xy.size(), 1);
+  for (size_t k = 0; k < lattice.xy.size(); ++k) {
+    if (disagreeing[k] >= options.drop_corner_min_disagreeing_edges) {
+      accepted->keep[k] = 0;
+      ++decoding->corners_dropped;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool DecodeOptions::Check(std::string* why) const {
+  auto fail = [why](const char* message) {
+    if (why != nullptr) *why = message;
+    return false;
+  };
+  if (!bits.Check(why)) return false;
+  if (min_corners < 1) return fail("min_corners must be >= 1");
+  if (max_label_extent < 2) return fail("max_label_extent must be >= 2");
+  if (min_bits_read < 1) return fail("min_bits_read must be >= 1");
+  if (!(min_agreement >= 0.5 && min_agreement <= 1.0)) {
+    return fail("min_agreement must be in [0.5, 1]");
+  }
+  if (min_margin < 1) return fail("min_margin must be >= 1");
+  if (!(max_log10_nfa <= 0.0)) return fail("max_log10_nfa must be <= 0");
+  if (drop_corner_min_disagreeing_edges < 1) {
+    return fail("drop_corner_min_disagreeing_edges must be >= 1");
+  }
+  return true;
+}
+
+DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
+                         const std::vector<GridComponent>& components,
+                         const cv::Mat& image, const DecodeOptions& options) {
+  DecodeResult result;
+  result.components.resize(components.size());
+  for (size_t c = 0; c < components.size(); ++c) {
+    result.components[c].component = static_cast<int>(c);
+  }
+  std::string why;
+  if (!board.Check(&why)) {
+    result.reason = "invalid board: " + why;
+    return result;
+  }
+  if (!options.Check(&why)) {
+    result.reason = "invalid decode options: " + why;
+    return result;
+  }
+  if (components.empty()) {
+    result.reason = "no grid components";
+    return result;
+  }
+  const bool puzzle = board.type == BoardType::kPuzzleBoard;
+  cv::Mat grey;
+  if (puzzle) {
+    if (image.empty()) {
+      result.reason = "empty image: edge bits cannot be read";
+    } else if (image.channels() == 1) {
+      grey = image;
+    } else if (image.channels() == 3 || image.channels() == 4) {
+      cv::cvtColor(image, grey, image.channels() == 3 ? cv::COLOR_BGR2GRAY
+                                                      : cv::COLOR_BGRA2GRAY);
+    } else {
+      result.reason = "image has an unsupported number of channels";
+    }
+    if (!grey.empty() && grey.depth() != CV_8U && grey.depth() != CV_16U &&
+        grey.depth() != CV_32F && grey.depth() != CV_64F) {
+      grey = cv::Mat();
+      result.reason = "image depth not supported (8-bit, 16-bit or float)";
+    }
+  }
+
+  std::vector<LabelLattice> lattices(components.size());
+  std::vector<char> usable(components.size(), 0);
+  std::vector<AcceptedComponent> accepted;
+  for (size_t c = 0; c < components.size(); ++c) {
+    ComponentDecoding& decoding = result.components[c];
+    LabelLattice& lattice = lattices[c];
+    if (!BuildLabelLattice(corners, components[c], options.max_label_extent,
+                           &lattice, &why)) {
+      decoding.reason = why;
+      continue;
+    }
+    decoding.num_corners = static_cast<int>(lattice.xy.size());
+    decoding.corners_dropped = lattice.dropped_duplicates + lattice.dropped_invalid;
+    decoding.handedness = LabelHandedness(lattice);
+    if (decoding.num_corners < options.min_corners) {
+      decoding.reason = Format("only %.0f usable corners (need %.0f)",
+                               decoding.num_corners, options.min_corners);
+      continue;
+    }
+    usable[c] = 1;
+    if (!puzzle) continue;
+    if (grey.empty()) {
+      decoding.reason = result.reason;
+      continue;
+    }
+    AcceptedComponent candidate;
+    candidate.component = static_cast<int>(c);
+    if (DecodePuzzleComponent(lattice, grey, board, options, &decoding,
+                              &candidate)) {
+      accepted.push_back(std::move(candidate));
+    }
+  }
+
+  if (!puzzle) {
+    // A component spanning the whole board gets board ids (the largest one).
+    int best = -1;
+    LabelToBoard best_map;
+    for (size_t c = 0; c < components.size(); ++c) {
+      LabelToBoard map;
+      if (!usable[c] ||
+          !FullCheckerboardMap(lattices[c], result.components[c].handedness, board,
+                               &map)) {
+        continue;
+      }
+      if (best < 0 || lattices[c].xy.size() > lattices[best].xy.size()) {
+        best = static_cast<int>(c);
+        best_map = map;
+      }
+    }
+    if (best >= 0) {
+      const LabelLattice& lattice = lattices[best];
+      ComponentDecoding& decoding = result.components[best];
+      decoding.decoded = true;
+      decoding.rotation = best_map.rotation;
+      decoding.offset = best_map.offset;
+      for (size_t k = 0; k < lattice.xy.size(); ++k) {
+        result.observation.id.push_back(best_map.Apply(lattice.label[k]));
+        result.observation.xy.push_back(lattice.xy[k]);
+        result.corner_index.push_back(lattice.corner_index[k]);
+        result.component.push_back(best);
+      }
+      result.decoded = true;
+      result.absolute_ids = true;
+      for (size_t c = 0; c < components.size(); ++c) {
+        if (static_cast<int>(c) != best && result.components[c].reason.empty()) {
+          result.components[c].reason = "another component spans the whole board";
+        }
+      }
+      return result;
+    }
+    for (size_t c = 0; c < components.size(); ++c) {
+      if (!usable[c]) continue;
+      result.components[c].reason =
+          "component does not span the whole checkerboard: relative labels";
+      AppendRelativeLabels(lattices[c], result.components[c].handedness,
+                           static_cast<int>(c), &result);
+    }
+    result.reason =
+        "no component spans the whole checkerboard: labels are relative";
+    return result;
+  }
+
+  if (accepted.empty()) {
+    for (size_t c = 0; c < components.size(); ++c) {
+      if (usable[c]) {
+        AppendRelativeLabels(lattices[c], result.components[c].handedness,
+                             static_cast<int>(c), &result);
+      }
+    }
+    if (result.reason.empty()) {
+      result.reason = "no component decoded";
+      int listed = 0;
+      for (const ComponentDecoding& decoding : result.components) {
+        if (decoding.reason.empty() || listed == 3) continue;
+        result.reason += (listed == 0 ? ": component " : "; component ") +
+                         std::to_string(decoding.component) + ": " + decoding.reason;
+        ++listed;
+      }
+    }
+    return result;
+  }
+
+  // Join the accepted components; ids claimed twice are dropped.
+  std::map<std::pair<int, int>, int> claims;
+  for (const AcceptedComponent& a : accepted) {
+    for (size_t k = 0; k < a.lattice->xy.size(); ++k) {
+      if (!a.keep[k]) continue;
+      const Eigen::Vector2i id = a.map.Apply(a.lattice->label[k]);
+      ++claims[{id.x(), id.y()}];
+    }
+  }
+  for (const AcceptedComponent& a : accepted) {
+    ComponentDecoding& decoding = result.components[a.component];
+    for (size_t k = 0; k < a.lattice->xy.size(); ++k) {
+      if (!a.keep[k]) continue;
+      const Eigen::Vector2i id = a.map.Apply(a.lattice->label[k]);
+      if (claims[{id.x(), id.y()}] > 1) {
+        ++decoding.corners_dropped;
+        continue;
+      }
+      result.observation.id.push_back(id);
+      result.observation.xy.push_back(a.lattice->xy[k]);
+      result.corner_index.push_back(a.lattice->corner_index[k]);
+      result.component.push_back(a.component);
+    }
+  }
+  result.decoded = !result.observation.id.empty();
+  result.absolute_ids = result.decoded;
+  if (!result.decoded) result.reason = "every decoded corner collided with another";
+  return result;
+}
+
+}  // namespace puzzlecal

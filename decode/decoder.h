@@ -1,0 +1,141 @@
+#ifndef PUZZLECAL_DECODE_DECODER_H_
+#define PUZZLECAL_DECODE_DECODER_H_
+
+// From labelled grid components to board ids.
+//
+// PuzzleBoard: every component's edge bits are read (decode/edge_bits.h) and
+// its label -> board map (rotation + offset) is searched over all positions
+// (decode/position_search.h). The handedness of that map is not guessed: a
+// board seen from its printed side keeps its (col, row) axes turning like the
+// image axes, so the sign of the labels' image orientation fixes whether the
+// labels are mirrored. Only the four rotations of that handedness are
+// accepted; the other handedness (a mirrored image or print) and inverted
+// contrast are tried only to name the reason of a refusal.
+//
+// Acceptance rule (per component; all must hold). The thresholds come from
+// the agreement statistics printed by bench/bench_decode (true positions on
+// clean and noisy renders versus best matches of random codes, mirrored and
+// inverted prints and plain checkerboards):
+//  1. bits_read >= min_bits_read (a 3 x 3-tile window has 24 edges);
+//  2. agreement = bits_agreeing / bits_read >= min_agreement;
+//  3. margin = agreeing edges at the best position minus at the second-best
+//     position inside the printed board (any rotation) >= min_margin;
+//  4. the false-alarm figure log10(NFA) <= max_log10_nfa, where NFA = number
+//     of in-board hypotheses x P(Binomial(bins_read, 1/2) >= bins_agreeing):
+//     the expected number of positions a random pattern would match this
+//     well (bins = distinct code bits after voting the period-3 repeats);
+//  5. no position anywhere on the torus scores strictly better than the best
+//     in-board one (else the board file or the print is not the one seen).
+// Accepted components are joined into one observation; corners with at
+// least `drop_corner_min_disagreeing_edges` incident edges that disagree with
+// the code are dropped, and ids claimed by two corners are dropped (all).
+//
+// Plain checkerboard (and PuzzleBoard components that are not decoded):
+// `absolute_ids` is false and each point carries its component's relative
+// label, made right-handed (labels of a mirrored component get j -> -j) and
+// shifted so the component's smallest label is (0, 0); labels of different
+// components are not comparable (see `component`). A checkerboard component
+// whose label extent equals the board's cols x rows (either orientation) gets
+// board ids instead (absolute_ids true), chosen among the board's symmetric
+// equivalents as the one whose +col axis points most to the image's +x.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "decode/board.h"
+#include "decode/edge_bits.h"
+#include "detection/corner.h"
+#include "grid/grid_component.h"
+
+namespace puzzlecal {
+
+struct DecodeOptions {
+  // How edge bits are read (disc sampling, confidence threshold).
+  EdgeBitOptions bits;
+  // Components with fewer labelled corners are not decoded. Default 4; >= 1.
+  int min_corners = 4;
+  // Components whose labels span more than this along an axis are refused
+  // (guards the dense label array). Default 4096; >= 2.
+  int max_label_extent = 4096;
+  // Rule 1: minimum number of read edge bits. Default 20 (a 3 x 3-tile window
+  // holds 24); >= 1.
+  int min_bits_read = 20;
+  // Rule 2: minimum fraction of read bits agreeing with the code at the best
+  // position. Default 0.7 (true positions with 20 % flipped bits measure
+  // 0.8 +- 0.05; random codes on large views 0.5-0.6); in [0.5, 1].
+  double min_agreement = 0.7;
+  // Rule 3: minimum lead of the best position over the second best, in
+  // agreeing edges. Default 2; >= 1.
+  int min_margin = 2;
+  // Rule 4: maximum log10 of the expected number of false matches. Default
+  // -2 (one random pattern in 100 would pass); <= 0.
+  double max_log10_nfa = -2.0;
+  // Rule 5: refuse when a position outside the printed board matches
+  // strictly better. Default true.
+  bool refuse_better_off_board = true;
+  // Corners with at least this many incident read edges that disagree with
+  // the code at the accepted position are dropped (mislabelled corners).
+  // Default 3 (of up to 4); >= 1.
+  int drop_corner_min_disagreeing_edges = 3;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+// What happened to one grid component.
+struct ComponentDecoding {
+  int component = -1;     // index into the components argument
+  bool decoded = false;   // absolute ids assigned
+  std::string reason;     // why not, when not decoded
+  int num_corners = 0;    // usable labelled corners
+  int handedness = 0;     // +1 labels turn like the image, -1 mirrored, 0 ?
+  int edges = 0;          // lattice edges between two labelled corners
+  int bits_read = 0;      // edges whose bit was read
+  int bits_agreeing = 0;  // read bits agreeing with the code at the best position
+  double agreement = 0.0; // bits_agreeing / bits_read
+  int bins_read = 0;      // distinct code bits seen (after period-3 voting)
+  int bins_agreeing = 0;
+  int margin = 0;         // agreeing edges: best minus second-best position
+  int hypotheses = 0;     // in-board positions x rotations scored
+  double log10_nfa = 0.0; // rule 4 figure at the best position
+  // Agreement of the best match under the other handedness and under
+  // inverted contrast (computed only when the component is refused; -1 when
+  // not computed). A value near 1 names a mirrored / inverted print.
+  double mirrored_agreement = -1.0;
+  double inverted_agreement = -1.0;
+  // Label -> board map: id = rotation * ij + offset (ids unwrapped into the
+  // board's printed range). Valid when decoded (PuzzleBoard) or when a
+  // checkerboard component got board ids.
+  Eigen::Matrix2i rotation = Eigen::Matrix2i::Identity();
+  Eigen::Vector2i offset = Eigen::Vector2i::Zero();
+  int corners_dropped = 0;  // corners removed after decoding (bad bits, collisions)
+};
+
+struct DecodeResult {
+  // PuzzleBoard: at least one component got absolute ids. Checkerboard: a
+  // component spans the whole board and got board ids.
+  bool decoded = false;
+  // True when observation.id are board ids; false when they are relative
+  // labels (see the header comment for the convention).
+  bool absolute_ids = false;
+  std::string reason;  // why not decoded, when not
+  // Ids (absolute in [origin, origin + size) for a decoded PuzzleBoard) and
+  // pixel positions.
+  BoardObservation observation;
+  std::vector<int> corner_index;  // per observation point: index into corners
+  std::vector<int> component;     // per observation point: component index
+  std::vector<ComponentDecoding> components;  // one per input component
+};
+
+// Decodes the components of one image. `image`: 8-bit, 16-bit or float grey
+// (colour images are converted); only read for a PuzzleBoard.
+DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
+                         const std::vector<GridComponent>& components,
+                         const cv::Mat& image,
+                         const DecodeOptions& options = DecodeOptions());
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_DECODE_DECODER_H_
