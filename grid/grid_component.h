@@ -1,9 +1,8 @@
 #ifndef PUZZLECAL_GRID_GRID_COMPONENT_H_
 #define PUZZLECAL_GRID_GRID_COMPONENT_H_
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 namespace puzzlecal {
 

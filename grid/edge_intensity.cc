@@ -1,0 +1,65 @@
+#include "grid/edge_intensity.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace puzzlecal {
+namespace {
+
+template <typename T>
+double SampleBilinear(const cv::Mat& image, double x, double y) {
+  x = std::clamp(x, 0.0, image.cols - 1.0);
+  y = std::clamp(y, 0.0, image.rows - 1.0);
+  const int x0 = std::min(static_cast<int>(x), image.cols - 1);
+  const int y0 = std::min(static_cast<int>(y), image.rows - 1);
+  const int x1 = std::min(x0 + 1, image.cols - 1);
+  const int y1 = std::min(y0 + 1, image.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  const T* row0 = image.ptr<T>(y0);
+  const T* row1 = image.ptr<T>(y1);
+  const double top = row0[x0] + fx * (double(row0[x1]) - row0[x0]);
+  const double bottom = row1[x0] + fx * (double(row1[x1]) - row1[x0]);
+  return top + fy * (bottom - top);
+}
+
+template <typename T>
+bool CrossesTile(const cv::Mat& image, const Eigen::Vector2d& a,
+                 const Eigen::Vector2d& b, int n, double fraction) {
+  const int third = std::max(n / 3, 1);
+  double sum = 0, first = 0, last = 0;
+  for (int s = 0; s < n; ++s) {
+    const Eigen::Vector2d p = a + (b - a) * ((s + 0.5) / n);
+    const double v = SampleBilinear<T>(image, p.x(), p.y());
+    sum += v;
+    if (s < third) first += v;
+    if (s >= n - third) last += v;
+  }
+  const double mean = sum / n;
+  return std::abs(first - last) / third > fraction * mean;
+}
+
+}  // namespace
+
+bool IsSupportedGridImage(const cv::Mat& image) {
+  return !image.empty() && image.dims == 2 &&
+         (image.type() == CV_8UC1 || image.type() == CV_16UC1 ||
+          image.type() == CV_32FC1);
+}
+
+bool EdgeCrossesTile(const cv::Mat& image, const Eigen::Vector2d& a,
+                     const Eigen::Vector2d& b, int num_samples,
+                     double fraction) {
+  if (num_samples < 3) return false;
+  switch (image.type()) {
+    case CV_8UC1:
+      return CrossesTile<uint8_t>(image, a, b, num_samples, fraction);
+    case CV_16UC1:
+      return CrossesTile<uint16_t>(image, a, b, num_samples, fraction);
+    case CV_32FC1:
+      return CrossesTile<float>(image, a, b, num_samples, fraction);
+    default:
+      return false;
+  }
+}
+
+}  // namespace puzzlecal

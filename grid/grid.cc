@@ -1,0 +1,214 @@
+#include "grid/grid.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "grid/edge_intensity.h"
+#include "grid/label_table.h"
+#include "grid/lattice_cleanup.h"
+#include "grid/lattice_forest.h"
+#include "grid/nearest_neighbors.h"
+
+namespace puzzlecal {
+namespace {
+
+bool Fail(std::string* why, const std::string& message) {
+  if (why) *why = message;
+  return false;
+}
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(
+             std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+bool GridOptions::Check(std::string* why) const {
+  if (num_neighbors < 1 || num_neighbors > 64)
+    return Fail(why, "num_neighbors must be in [1, 64]");
+  if (!(min_orientation_difference_deg >= 0 &&
+        min_orientation_difference_deg < 90))
+    return Fail(why, "min_orientation_difference_deg must be in [0, 90)");
+  if (!(min_edge_length_px >= 0 && std::isfinite(min_edge_length_px)))
+    return Fail(why, "min_edge_length_px must be finite and >= 0");
+  if (!(max_abs_coordinate_px > 0 && max_abs_coordinate_px <= 1e9))
+    return Fail(why, "max_abs_coordinate_px must be in (0, 1e9]");
+  if (intensity_samples < 3 || intensity_samples > 1000)
+    return Fail(why, "intensity_samples must be in [3, 1000]");
+  if (!(intensity_difference_fraction > 0 &&
+        std::isfinite(intensity_difference_fraction)))
+    return Fail(why, "intensity_difference_fraction must be finite and > 0");
+  if (!(penalty_factor >= 1 && std::isfinite(penalty_factor)))
+    return Fail(why, "penalty_factor must be finite and >= 1");
+  if (!(neighbor_weight_ratio > 1 && std::isfinite(neighbor_weight_ratio)))
+    return Fail(why, "neighbor_weight_ratio must be finite and > 1");
+  if (!(tree_mean_weight_ratio_min > 0 && tree_mean_weight_ratio_min < 1 &&
+        tree_mean_weight_ratio_max > 1 &&
+        std::isfinite(tree_mean_weight_ratio_max)))
+    return Fail(why,
+                "tree_mean_weight_ratio_min must be in (0, 1) and "
+                "tree_mean_weight_ratio_max finite and > 1");
+  if (!(max_collinearity_sin > 0 && max_collinearity_sin <= 1))
+    return Fail(why, "max_collinearity_sin must be in (0, 1]");
+  if (!(max_line_spacing_ratio >= 1 && std::isfinite(max_line_spacing_ratio)))
+    return Fail(why, "max_line_spacing_ratio must be finite and >= 1");
+  if (!(max_axis_deviation_deg > 0 && max_axis_deviation_deg <= 45))
+    return Fail(why, "max_axis_deviation_deg must be in (0, 45]");
+  if (!(max_adjacency_length_ratio >= 1 &&
+        std::isfinite(max_adjacency_length_ratio)))
+    return Fail(why, "max_adjacency_length_ratio must be finite and >= 1");
+  if (!(max_axis_aspect_ratio >= 1 && std::isfinite(max_axis_aspect_ratio)))
+    return Fail(why, "max_axis_aspect_ratio must be finite and >= 1");
+  if (kruskal_passes < 1 || kruskal_passes > 10)
+    return Fail(why, "kruskal_passes must be in [1, 10]");
+  if (!(line_prediction_tolerance > 0 &&
+        std::isfinite(line_prediction_tolerance)))
+    return Fail(why, "line_prediction_tolerance must be finite and > 0");
+  if (min_component_size < 1)
+    return Fail(why, "min_component_size must be >= 1");
+  return true;
+}
+
+std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
+                                     const cv::Mat& image,
+                                     const GridOptions& options,
+                                     GridSummary* summary_out) {
+  const auto start = std::chrono::steady_clock::now();
+  GridSummary local_summary;
+  GridSummary& summary = summary_out ? *summary_out : local_summary;
+  summary = GridSummary();
+  const int n = static_cast<int>(corners.size());
+  summary.num_input_corners = n;
+
+  std::string why;
+  if (!options.Check(&why)) {
+    summary.message = "invalid GridOptions: " + why;
+    return {};
+  }
+  if (!image.empty() && !IsSupportedGridImage(image)) {
+    summary.message =
+        "unsupported image type " + std::to_string(image.type()) +
+        " (expected CV_8UC1, CV_16UC1 or CV_32FC1, or an empty image)";
+    return {};
+  }
+  // Labels and tree ids must fit the label table's keys.
+  if (n > LabelTable::kMaxLabel) {
+    summary.message = "too many corners (" + std::to_string(n) + " > " +
+                      std::to_string(LabelTable::kMaxLabel) + ")";
+    return {};
+  }
+  summary.image_used = !image.empty();
+
+  // Valid corners; invalid ones stay out of every edge and tree.
+  LatticeNodes nodes;
+  nodes.xy.resize(n);
+  nodes.axis.resize(n);
+  nodes.valid.assign(n, 0);
+  std::vector<int> valid_index;
+  valid_index.reserve(n);
+  std::vector<Eigen::Vector2d> valid_xy;
+  valid_xy.reserve(n);
+  for (int i = 0; i < n; ++i) {
+    const Corner& c = corners[i];
+    nodes.xy[i] = c.xy;
+    const bool ok = std::isfinite(c.xy.x()) && std::isfinite(c.xy.y()) &&
+                    std::abs(c.xy.x()) <= options.max_abs_coordinate_px &&
+                    std::abs(c.xy.y()) <= options.max_abs_coordinate_px &&
+                    std::isfinite(c.orientation);
+    if (!ok) {
+      ++summary.num_invalid_corners;
+      nodes.xy[i].setZero();
+      continue;
+    }
+    nodes.valid[i] = 1;
+    const double axis_angle = c.orientation + M_PI / 4;
+    nodes.axis[i] = Eigen::Vector2d(std::cos(axis_angle), std::sin(axis_angle));
+    valid_index.push_back(i);
+    valid_xy.push_back(c.xy);
+  }
+  if (summary.num_invalid_corners > 0) {
+    summary.message = std::to_string(summary.num_invalid_corners) +
+                      " corners ignored (non-finite or beyond " +
+                      std::to_string(options.max_abs_coordinate_px) + " px)";
+  }
+
+  // k nearest neighbours -> unique candidate pairs.
+  auto phase_start = std::chrono::steady_clock::now();
+  std::vector<int> knn;
+  const int k = options.num_neighbors;
+  FindNearestNeighbors(valid_xy, k, &knn);
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(knn.size());
+  for (size_t v = 0; v < valid_xy.size(); ++v) {
+    for (int m = 0; m < k; ++m) {
+      const int w = knn[v * k + m];
+      if (w < 0) break;
+      const int a = valid_index[v], b = valid_index[w];
+      pairs.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  summary.num_candidate_edges = static_cast<int>(pairs.size());
+  summary.neighbors_ms = MillisecondsSince(phase_start);
+
+  // Orientation filter and weights.
+  phase_start = std::chrono::steady_clock::now();
+  const double min_abs_sin =
+      std::sin(options.min_orientation_difference_deg * M_PI / 180);
+  std::vector<GridEdge> edges;
+  edges.reserve(pairs.size());
+  for (const auto& [a, b] : pairs) {
+    const double difference = corners[a].orientation - corners[b].orientation;
+    if (!(std::abs(std::sin(difference)) > min_abs_sin)) {
+      ++summary.num_edges_orientation_filtered;
+      continue;
+    }
+    const double length = (nodes.xy[b] - nodes.xy[a]).norm();
+    if (!(length >= options.min_edge_length_px) || length <= 0) {
+      ++summary.num_edges_too_short;
+      continue;
+    }
+    GridEdge edge;
+    edge.a = a;
+    edge.b = b;
+    edge.length = length;
+    edge.weight = length;
+    if (summary.image_used &&
+        EdgeCrossesTile(image, nodes.xy[a], nodes.xy[b],
+                        options.intensity_samples,
+                        options.intensity_difference_fraction)) {
+      edge.weight *= options.penalty_factor;
+      ++summary.num_edges_penalised;
+    }
+    edges.push_back(edge);
+  }
+  std::sort(edges.begin(), edges.end(), GridEdgeLess);
+  summary.num_edges_considered = static_cast<int>(edges.size());
+  summary.weights_ms = MillisecondsSince(phase_start);
+
+  phase_start = std::chrono::steady_clock::now();
+  LatticeForest forest;
+  BuildLatticeForest(nodes, edges, options, &summary, &forest);
+  summary.kruskal_ms = MillisecondsSince(phase_start);
+
+  phase_start = std::chrono::steady_clock::now();
+  std::vector<GridComponent> components =
+      ExtractComponents(nodes.xy, forest, options, &summary);
+  summary.cleanup_ms = MillisecondsSince(phase_start);
+
+  summary.num_components = static_cast<int>(components.size());
+  for (const GridComponent& c : components)
+    summary.num_labelled_corners += static_cast<int>(c.corner.size());
+  summary.largest_component =
+      components.empty() ? 0 : static_cast<int>(components[0].corner.size());
+  summary.ok = true;
+  summary.total_ms = MillisecondsSince(start);
+  return components;
+}
+
+}  // namespace puzzlecal

@@ -1,0 +1,151 @@
+#ifndef PUZZLECAL_GRID_GRID_H_
+#define PUZZLECAL_GRID_GRID_H_
+
+// Corners -> lattice components: the minimum-spanning-tree grid of the thesis
+// (k nearest neighbours, eigenvector-orientation filter, intensity-thirds edge
+// penalty, Kruskal on a union-find with outlier checks), with labels that stay
+// consistent under perspective, fisheye distortion and reflection:
+// - every lattice direction is taken from the corner's own Hessian axes (the
+//   tile edges run at +-45 degrees to the eigenvectors), never from image x/y;
+// - two trees merge by one of the 8 lattice symmetries (rotation or
+//   reflection) plus an offset, chosen from both trees' axes at the joining
+//   edge and verified (no two corners on one label, no contradicting
+//   neighbours, collinear lines);
+// - a final pass removes corners that their lattice lines do not predict and
+//   splits components that fall apart.
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "detection/corner.h"
+#include "grid/grid_component.h"
+
+namespace puzzlecal {
+
+struct GridOptions {
+  // Nearest neighbours per corner that become candidate edges (thesis: 8).
+  int num_neighbors = 8;
+  // Candidate edges are kept only when the two corners' eigenvector
+  // orientations differ by more than this (mod 180 degrees); tile-edge
+  // neighbours differ by about 90, diagonal ones by about 0 (thesis: 45).
+  double min_orientation_difference_deg = 45.0;
+  // Edges shorter than this (pixels) are dropped: duplicate detections.
+  double min_edge_length_px = 1.0;
+  // Corners with |x| or |y| above this (pixels) are ignored as invalid.
+  double max_abs_coordinate_px = 1e6;
+
+  // Grey levels sampled evenly along an edge (at (s + 0.5) / n of its length)
+  // for the intensity penalty (thesis: 15).
+  int intensity_samples = 15;
+  // An edge is penalised when the mean grey level of its first and last
+  // thirds differ by more than this fraction of its mean (thesis: 0.5): it
+  // crosses a tile instead of running along a tile edge.
+  double intensity_difference_fraction = 0.5;
+  // Weight = length x this factor for penalised edges (thesis: 3; above
+  // neighbor_weight_ratio so a penalised edge never joins normal ones).
+  double penalty_factor = 3.0;
+
+  // Merge check at both ends of the joining edge: every tree edge already at
+  // that corner on the same lattice line has a weight within this factor of
+  // the joining edge's weight (thesis eq. 4.2: 2.9, there against all edges
+  // at the corner; steep views foreshorten one axis by more than that).
+  double neighbor_weight_ratio = 2.9;
+  // Merge check: mean edge weight of the larger tree / mean edge weight of
+  // the smaller tree lies in (min, max) (thesis eq. 4.3: 0.3, 2.9), per
+  // lattice axis, where both trees have edges along it.
+  double tree_mean_weight_ratio_min = 0.3;
+  double tree_mean_weight_ratio_max = 2.9;
+  // Collinearity of three consecutive corners on one lattice line: |sin| of
+  // the turning angle at most this (thesis: 0.342 = sin 20 degrees), and the
+  // turn less than 90 degrees.
+  double max_collinearity_sin = 0.342;
+  // Three consecutive corners on a lattice line: the ratio of their two
+  // spacings lies within [1 / max, max] (perspective and fisheye change the
+  // spacing slowly).
+  double max_line_spacing_ratio = 2.0;
+  // A lattice step must point within this angle (degrees) of the corner's
+  // axis estimate (eigenvector +- 45 degrees); steps near 45 degrees are
+  // ambiguous between the two axes and are not used. Steep views put the true
+  // axis up to ~26 degrees off the estimate.
+  double max_axis_deviation_deg = 38.0;
+  // Two corners that a merge makes lattice neighbours must be at most this
+  // factor farther apart (or closer) than the tree edges on the same lattice
+  // line at either corner (or, for a corner without any tree edge, the
+  // joining edge).
+  double max_adjacency_length_ratio = 2.0;
+  // ... and, when a corner has tree edges only across that line, at most
+  // this factor (the foreshortening of one axis against the other in steep
+  // views: 1 / sin(viewing angle) and more under perspective).
+  double max_axis_aspect_ratio = 5.0;
+  // Kruskal passes over the sorted edges; a later pass retries edges between
+  // trees that an earlier pass refused (the trees have grown since).
+  int kruskal_passes = 2;
+
+  // Final pass: a corner is predicted from the next two corners on each of
+  // its lattice lines (linear extrapolation). A prediction holds when the
+  // error is at most this fraction of the spacing of those two corners.
+  double line_prediction_tolerance = 0.35;
+  // Components with fewer corners are dropped (not returned).
+  int min_component_size = 4;
+
+  // False with a reason when a field is out of range.
+  bool Check(std::string* why = nullptr) const;
+};
+
+// What BuildGrid did.
+struct GridSummary {
+  bool ok = false;      // false: no grid was built, see `message`
+  std::string message;  // why not, or notes (e.g. ignored corners)
+
+  int num_input_corners = 0;
+  int num_invalid_corners = 0;  // NaN/inf/huge coordinates or orientation
+  bool image_used = false;      // intensity penalty applied
+
+  // Edges.
+  int num_candidate_edges = 0;             // unique k-nearest-neighbour pairs
+  int num_edges_orientation_filtered = 0;  // dropped: orientations too alike
+  int num_edges_too_short = 0;             // dropped: duplicate positions
+  int num_edges_considered = 0;            // given to Kruskal
+  int num_edges_penalised = 0;             // intensity-thirds penalty applied
+
+  // Kruskal.
+  int num_merges = 0;                           // accepted unions
+  int num_edges_same_tree = 0;                  // both ends already joined
+  int num_rejected_neighbor_weight = 0;         // eq. 4.2
+  int num_rejected_tree_mean_weight = 0;        // eq. 4.3
+  int num_rejected_ambiguous_axis = 0;          // step near 45 degrees
+  int num_rejected_label_collision = 0;         // two corners on one label
+  int num_rejected_neighbor_contradiction = 0;  // direction/length mismatch
+  int num_rejected_collinearity = 0;            // lines bend or jump
+
+  // Final pass.
+  int num_removed_by_prediction = 0;  // corners their lines did not predict
+  int num_components_dropped = 0;     // below min_component_size
+  int num_components = 0;             // returned
+  int num_labelled_corners = 0;       // corners in returned components
+  int largest_component = 0;
+
+  // Wall time in milliseconds.
+  double neighbors_ms = 0;
+  double weights_ms = 0;
+  double kruskal_ms = 0;
+  double cleanup_ms = 0;
+  double total_ms = 0;
+};
+
+// Builds lattice components from detected corners.
+// corners: from detection/; image: the grey image the corners came from
+// (CV_8UC1, CV_16UC1 or CV_32FC1) for the intensity penalty, or empty for
+// none. Returns components sorted by size (largest first, ties by smallest
+// corner index); labels of a component start at (0, 0) in its minimum.
+// Deterministic. Invalid corners are ignored; bad options or an unsupported
+// image type return no components with a reason in `summary`.
+std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
+                                     const cv::Mat& image,
+                                     const GridOptions& options = {},
+                                     GridSummary* summary = nullptr);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_GRID_GRID_H_

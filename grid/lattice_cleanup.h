@@ -1,0 +1,26 @@
+#ifndef PUZZLECAL_GRID_LATTICE_CLEANUP_H_
+#define PUZZLECAL_GRID_LATTICE_CLEANUP_H_
+
+// The final pass of BuildGrid (grid/grid.h): every corner must be where its
+// lattice lines predict it; components that fall apart are split.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "grid/grid.h"
+#include "grid/lattice_forest.h"
+
+namespace puzzlecal {
+
+// Turns the forest into components: removes corners whose lattice lines
+// contradict them more often than they support them (repeatedly), splits
+// trees into 4-connected label sets, drops sets smaller than
+// options.min_component_size, shifts labels to start at (0, 0) and sorts the
+// components (largest first, ties by smallest corner index).
+std::vector<GridComponent> ExtractComponents(
+    const std::vector<Eigen::Vector2d>& xy, const LatticeForest& forest,
+    const GridOptions& options, GridSummary* summary);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_GRID_LATTICE_CLEANUP_H_

@@ -1,0 +1,355 @@
+#include "grid/lattice_forest.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+#include "grid/dihedral.h"
+#include "grid/label_table.h"
+
+namespace puzzlecal {
+
+bool GridEdgeLess(const GridEdge& x, const GridEdge& y) {
+  if (x.weight != y.weight) return x.weight < y.weight;
+  if (x.a != y.a) return x.a < y.a;
+  return x.b < y.b;
+}
+
+namespace {
+
+// Why a merge was refused.
+enum class Refusal {
+  kNone,
+  kNeighborWeight,
+  kTreeMeanWeight,
+  kAmbiguousAxis,
+  kLabelCollision,
+  kNeighborContradiction,
+  kCollinearity,
+};
+
+// Direction index of an image vector in a corner's own axes: k = 0..3 for the
+// axis estimate rotated by k * 90 degrees; `cosine` of the angle between them.
+struct AxisStep {
+  int k = 0;
+  double cosine = 0;
+};
+
+class Forest {
+ public:
+  Forest(const LatticeNodes& nodes, const GridOptions& options)
+      : nodes_(nodes),
+        options_(options),
+        min_axis_cosine_(std::cos(options.max_axis_deviation_deg * M_PI / 180)),
+        table_(static_cast<int>(nodes.xy.size())) {
+    const int n = static_cast<int>(nodes.xy.size());
+    parent_.resize(n);
+    size_.assign(n, 1);
+    next_.assign(n, -1);
+    tail_.resize(n);
+    weight_sum_.assign(n, {0.0, 0.0});
+    edge_count_.assign(n, {0, 0});
+    label_.assign(n, Eigen::Vector2i::Zero());
+    frame_.assign(n, Dihedral());
+    neighbor_.assign(n, {-1, -1, -1, -1});
+    neighbor_weight_.assign(n, {0, 0, 0, 0});
+    neighbor_length_.assign(n, {0, 0, 0, 0});
+    for (int i = 0; i < n; ++i) {
+      parent_[i] = i;
+      tail_[i] = i;
+      if (nodes.valid[i]) table_.Insert(i, label_[i], i);
+    }
+  }
+
+  int Find(int x) {
+    int root = x;
+    while (parent_[root] != root) root = parent_[root];
+    while (parent_[x] != root) {  // path compression
+      const int next = parent_[x];
+      parent_[x] = root;
+      x = next;
+    }
+    return root;
+  }
+
+  // Tries to join the trees of the edge's ends; returns why not.
+  Refusal TryMerge(const GridEdge& edge);
+
+  void Export(LatticeForest* forest) {
+    const int n = static_cast<int>(nodes_.xy.size());
+    forest->tree.assign(n, -1);
+    forest->label = label_;
+    for (int i = 0; i < n; ++i)
+      if (nodes_.valid[i]) forest->tree[i] = Find(i);
+  }
+
+ private:
+  Eigen::Vector2d Direction(int node, int k) const {
+    const Eigen::Vector2d& a = nodes_.axis[node];
+    switch (Mod4(k)) {
+      case 0:
+        return a;
+      case 1:
+        return Eigen::Vector2d(-a.y(), a.x());
+      case 2:
+        return -a;
+      default:
+        return Eigen::Vector2d(a.y(), -a.x());
+    }
+  }
+
+  AxisStep Classify(int node, const Eigen::Vector2d& v) const {
+    const Eigen::Vector2d& a = nodes_.axis[node];
+    const double along = a.dot(v);
+    const double across = a.x() * v.y() - a.y() * v.x();
+    const double norm = v.norm();
+    AxisStep step;
+    if (std::abs(along) >= std::abs(across)) {
+      step.k = along >= 0 ? 0 : 2;
+      step.cosine = norm > 0 ? std::abs(along) / norm : 0;
+    } else {
+      step.k = across >= 0 ? 1 : 3;
+      step.cosine = norm > 0 ? std::abs(across) / norm : 0;
+    }
+    return step;
+  }
+
+  // Mean length of the tree edges at `node` in own-axis slots k and k + 2
+  // (one lattice line), or in the other two slots; 0 when there are none.
+  double LineEdgeLength(int node, int k) const {
+    double sum = 0;
+    int count = 0;
+    for (int slot : {Mod4(k), Mod4(k + 2)}) {
+      if (neighbor_[node][slot] >= 0) {
+        sum += neighbor_length_[node][slot];
+        ++count;
+      }
+    }
+    return count > 0 ? sum / count : 0.0;
+  }
+
+  // The distance of a new lattice neighbour in own-axis direction k of `node`
+  // fits the tree edges there: within max_adjacency_length_ratio of those on
+  // the same line, else within max_axis_aspect_ratio of those across, else
+  // within max_adjacency_length_ratio of `fallback`.
+  bool LengthFits(int node, int k, double dist, double fallback) const {
+    double ref = LineEdgeLength(node, k);
+    double r = options_.max_adjacency_length_ratio;
+    if (ref == 0) {
+      ref = LineEdgeLength(node, k + 1);
+      if (ref > 0) {
+        r = options_.max_axis_aspect_ratio;
+      } else {
+        ref = fallback;
+      }
+    }
+    return dist <= r * ref && dist * r >= ref;
+  }
+
+  // Three consecutive corners p0, p1, p2 on one lattice line: the line turns
+  // by less than the collinearity limit and the spacing changes slowly.
+  bool Collinear(int p0, int p1, int p2) const {
+    const Eigen::Vector2d v1 = nodes_.xy[p1] - nodes_.xy[p0];
+    const Eigen::Vector2d v2 = nodes_.xy[p2] - nodes_.xy[p1];
+    const double n1 = v1.norm(), n2 = v2.norm();
+    if (!(n1 > 0 && n2 > 0)) return false;
+    const double cross = v1.x() * v2.y() - v1.y() * v2.x();
+    if (v1.dot(v2) <= 0) return false;
+    if (std::abs(cross) > options_.max_collinearity_sin * n1 * n2) return false;
+    const double ratio = n2 / n1;
+    return ratio <= options_.max_line_spacing_ratio &&
+           ratio * options_.max_line_spacing_ratio >= 1.0;
+  }
+
+  // n (in the tree being moved, new frame `frame_n`) and m (in the kept tree)
+  // would become lattice neighbours with m at step d from n.
+  bool AdjacencyAgrees(int n, const Dihedral& frame_n, int m, int d,
+                       double fallback_length) const {
+    const Eigen::Vector2d v = nodes_.xy[m] - nodes_.xy[n];
+    const AxisStep at_n = Classify(n, v);
+    const AxisStep at_m = Classify(m, -v);
+    if (at_n.cosine < min_axis_cosine_ || at_m.cosine < min_axis_cosine_)
+      return false;
+    if (frame_n.Apply(at_n.k) != d) return false;
+    if (frame_[m].Apply(at_m.k) != Mod4(d + 2)) return false;
+    const double dist = v.norm();
+    return LengthFits(n, at_n.k, dist, fallback_length) &&
+           LengthFits(m, at_m.k, dist, fallback_length);
+  }
+
+  const LatticeNodes& nodes_;
+  const GridOptions& options_;
+  const double min_axis_cosine_;
+  LabelTable table_;
+
+  // Union-find and member lists (a root's list starts at the root).
+  std::vector<int> parent_;
+  std::vector<int> size_;
+  std::vector<int> next_;
+  std::vector<int> tail_;
+  // Per root and lattice axis (0 = i, 1 = j): sum and count of edge weights.
+  std::vector<std::array<double, 2>> weight_sum_;
+  std::vector<std::array<int, 2>> edge_count_;
+
+  // Per corner: label in its tree, the map from its own axis directions
+  // (k = 0..3) to lattice steps, and its tree edges by own axis direction.
+  std::vector<Eigen::Vector2i> label_;
+  std::vector<Dihedral> frame_;
+  std::vector<std::array<int, 4>> neighbor_;
+  std::vector<std::array<double, 4>> neighbor_weight_;
+  std::vector<std::array<double, 4>> neighbor_length_;
+};
+
+Refusal Forest::TryMerge(const GridEdge& edge) {
+  int a = edge.a, b = edge.b;
+  int ra = Find(a), rb = Find(b);
+  // The larger tree (ties: smaller root index) keeps its labels.
+  if (size_[ra] < size_[rb] || (size_[ra] == size_[rb] && ra > rb)) {
+    std::swap(a, b);
+    std::swap(ra, rb);
+  }
+  const double w = edge.weight;
+
+  // The step a -> b in a's own axes and b -> a in b's.
+  const Eigen::Vector2d e = nodes_.xy[b] - nodes_.xy[a];
+  const AxisStep at_a = Classify(a, e);
+  const AxisStep at_b = Classify(b, -e);
+  if (at_a.cosine < min_axis_cosine_ || at_b.cosine < min_axis_cosine_)
+    return Refusal::kAmbiguousAxis;
+
+  // Thesis eq. 4.2 at both ends, against the tree edges on the same lattice
+  // line only: steep views legitimately foreshorten one axis by more than
+  // the ratio, so edges of the other axis are not compared.
+  const double wr = options_.neighbor_weight_ratio;
+  for (const auto& [x, k] : {std::pair{a, at_a.k}, std::pair{b, at_b.k}}) {
+    for (int slot : {Mod4(k), Mod4(k + 2)}) {
+      if (neighbor_[x][slot] < 0) continue;
+      const double other = neighbor_weight_[x][slot];
+      if (!(other * wr > w && other < w * wr)) return Refusal::kNeighborWeight;
+    }
+  }
+
+  // b's direction kb points where a's ka + 2 points; b's kb + 1 runs along
+  // a's ka + 1 or against it (then a reflection of the own axes).
+  const int sigma =
+      Direction(b, at_b.k + 1).dot(Direction(a, at_a.k + 1)) < 0 ? 1 : -1;
+  const Dihedral b_axes_to_a_axes{sigma, Mod4(at_a.k + 2 - sigma * at_b.k)};
+  // Labels of b's tree -> labels of a's tree.
+  const Dihedral rotation =
+      frame_[a].Compose(b_axes_to_a_axes).Compose(frame_[b].Inverse());
+  const Eigen::Vector2i offset = label_[a] +
+                                 LatticeStep(frame_[a].Apply(at_a.k)) -
+                                 rotation.Apply(label_[b]);
+  const Dihedral rotation_inverse = rotation.Inverse();
+
+  // Thesis eq. 4.3, per lattice axis (for the same reason): the mean edge
+  // weights of the two trees along one axis, where both have edges on it.
+  for (int axis = 0; axis < 2; ++axis) {
+    const int moved_axis = rotation_inverse.Apply(axis) % 2;
+    if (edge_count_[ra][axis] == 0 || edge_count_[rb][moved_axis] == 0)
+      continue;
+    const double ratio =
+        (weight_sum_[ra][axis] / edge_count_[ra][axis]) /
+        (weight_sum_[rb][moved_axis] / edge_count_[rb][moved_axis]);
+    if (!(ratio > options_.tree_mean_weight_ratio_min &&
+          ratio < options_.tree_mean_weight_ratio_max))
+      return Refusal::kTreeMeanWeight;
+  }
+
+  // Verify every corner of the moved tree in its new place.
+  for (int n = rb; n >= 0; n = next_[n]) {
+    const Eigen::Vector2i new_label = rotation.Apply(label_[n]) + offset;
+    if (new_label.cwiseAbs().maxCoeff() > LabelTable::kMaxLabel)
+      return Refusal::kLabelCollision;
+    if (table_.Find(ra, new_label) >= 0) return Refusal::kLabelCollision;
+    const Dihedral new_frame = rotation.Compose(frame_[n]);
+    for (int d = 0; d < 4; ++d) {
+      const Eigen::Vector2i step = LatticeStep(d);
+      const int m = table_.Find(ra, new_label + step);
+      if (m < 0) continue;
+      if (!AdjacencyAgrees(n, new_frame, m, d, edge.length))
+        return Refusal::kNeighborContradiction;
+      // The lattice line through n and m, continued on both sides.
+      const int before =
+          table_.Find(rb, label_[n] - rotation_inverse.Apply(step));
+      if (before >= 0 && !Collinear(before, n, m))
+        return Refusal::kCollinearity;
+      const int after = table_.Find(ra, new_label + 2 * step);
+      if (after >= 0 && !Collinear(n, m, after)) return Refusal::kCollinearity;
+    }
+  }
+
+  // Commit: relabel the smaller tree into the larger one.
+  for (int n = rb; n >= 0; n = next_[n]) {
+    table_.Erase(rb, label_[n]);
+    label_[n] = rotation.Apply(label_[n]) + offset;
+    frame_[n] = rotation.Compose(frame_[n]);
+    table_.Insert(ra, label_[n], n);
+  }
+  parent_[rb] = ra;
+  size_[ra] += size_[rb];
+  next_[tail_[ra]] = rb;
+  tail_[ra] = tail_[rb];
+  for (int axis = 0; axis < 2; ++axis) {
+    const int moved_axis = rotation_inverse.Apply(axis) % 2;
+    weight_sum_[ra][axis] += weight_sum_[rb][moved_axis];
+    edge_count_[ra][axis] += edge_count_[rb][moved_axis];
+  }
+  const int edge_axis = frame_[a].Apply(at_a.k) % 2;
+  weight_sum_[ra][edge_axis] += w;
+  edge_count_[ra][edge_axis] += 1;
+  neighbor_[a][at_a.k] = b;
+  neighbor_weight_[a][at_a.k] = w;
+  neighbor_length_[a][at_a.k] = edge.length;
+  neighbor_[b][at_b.k] = a;
+  neighbor_weight_[b][at_b.k] = w;
+  neighbor_length_[b][at_b.k] = edge.length;
+  return Refusal::kNone;
+}
+
+}  // namespace
+
+void BuildLatticeForest(const LatticeNodes& nodes,
+                        const std::vector<GridEdge>& sorted_edges,
+                        const GridOptions& options, GridSummary* summary,
+                        LatticeForest* forest) {
+  Forest state(nodes, options);
+  for (int pass = 0; pass < options.kruskal_passes; ++pass) {
+    int merges_this_pass = 0;
+    for (const GridEdge& edge : sorted_edges) {
+      if (state.Find(edge.a) == state.Find(edge.b)) {
+        if (pass == 0) ++summary->num_edges_same_tree;
+        continue;
+      }
+      switch (state.TryMerge(edge)) {
+        case Refusal::kNone:
+          ++summary->num_merges;
+          ++merges_this_pass;
+          break;
+        case Refusal::kNeighborWeight:
+          ++summary->num_rejected_neighbor_weight;
+          break;
+        case Refusal::kTreeMeanWeight:
+          ++summary->num_rejected_tree_mean_weight;
+          break;
+        case Refusal::kAmbiguousAxis:
+          ++summary->num_rejected_ambiguous_axis;
+          break;
+        case Refusal::kLabelCollision:
+          ++summary->num_rejected_label_collision;
+          break;
+        case Refusal::kNeighborContradiction:
+          ++summary->num_rejected_neighbor_contradiction;
+          break;
+        case Refusal::kCollinearity:
+          ++summary->num_rejected_collinearity;
+          break;
+      }
+    }
+    if (pass > 0 && merges_this_pass == 0) break;
+  }
+  state.Export(forest);
+}
+
+}  // namespace puzzlecal

@@ -1,0 +1,127 @@
+#include "grid/nearest_neighbors.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace puzzlecal {
+namespace {
+
+// The value at quantile q (in [0, 1]) of `values` (reordered in place).
+double Quantile(std::vector<double>* values, double q) {
+  const size_t index = static_cast<size_t>(q * (values->size() - 1));
+  std::nth_element(values->begin(), values->begin() + index, values->end());
+  return (*values)[index];
+}
+
+// Keeps the k best (distance, index) pairs in ascending order.
+struct TopK {
+  int k;
+  int count = 0;
+  double* dist;
+  int* index;
+
+  void Offer(double d, int i) {
+    if (count == k &&
+        (d > dist[k - 1] || (d == dist[k - 1] && i > index[k - 1])))
+      return;
+    int pos = count < k ? count++ : k - 1;
+    while (pos > 0 &&
+           (dist[pos - 1] > d || (dist[pos - 1] == d && index[pos - 1] > i))) {
+      dist[pos] = dist[pos - 1];
+      index[pos] = index[pos - 1];
+      --pos;
+    }
+    dist[pos] = d;
+    index[pos] = i;
+  }
+};
+
+}  // namespace
+
+void FindNearestNeighbors(const std::vector<Eigen::Vector2d>& points, int k,
+                          std::vector<int>* neighbors) {
+  const int n = static_cast<int>(points.size());
+  neighbors->assign(static_cast<size_t>(n) * std::max(k, 0), -1);
+  if (n < 2 || k <= 0) return;
+
+  std::vector<double> coords(n);
+  for (int i = 0; i < n; ++i) coords[i] = points[i].x();
+  const double x_lo = Quantile(&coords, 0.01);
+  const double x_hi = Quantile(&coords, 0.99);
+  for (int i = 0; i < n; ++i) coords[i] = points[i].y();
+  const double y_lo = Quantile(&coords, 0.01);
+  const double y_hi = Quantile(&coords, 0.99);
+  const double width = std::max(x_hi - x_lo, 1e-9);
+  const double height = std::max(y_hi - y_lo, 1e-9);
+  // About two points per cell.
+  double cell = std::sqrt(2.0 * width * height / n);
+  if (!(cell > 0)) cell = std::max(width, height);
+  constexpr int kMaxCellsPerAxis = 4096;
+  const int nx = static_cast<int>(
+      std::clamp(std::ceil(width / cell), 1.0, double(kMaxCellsPerAxis)));
+  const int ny = static_cast<int>(
+      std::clamp(std::ceil(height / cell), 1.0, double(kMaxCellsPerAxis)));
+  const double cell_x = width / nx;
+  const double cell_y = height / ny;
+  const double cell_min = std::min(cell_x, cell_y);
+
+  auto cell_of = [&](const Eigen::Vector2d& p, int* cx, int* cy) {
+    *cx = static_cast<int>(
+        std::clamp(std::floor((p.x() - x_lo) / cell_x), 0.0, nx - 1.0));
+    *cy = static_cast<int>(
+        std::clamp(std::floor((p.y() - y_lo) / cell_y), 0.0, ny - 1.0));
+  };
+
+  // Counting sort of the points into cells.
+  std::vector<int> cell_index(n);
+  std::vector<int> cell_start(static_cast<size_t>(nx) * ny + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    int cx, cy;
+    cell_of(points[i], &cx, &cy);
+    cell_index[i] = cy * nx + cx;
+    ++cell_start[cell_index[i] + 1];
+  }
+  for (size_t c = 1; c < cell_start.size(); ++c)
+    cell_start[c] += cell_start[c - 1];
+  std::vector<int> cell_points(n);
+  {
+    std::vector<int> fill(cell_start.begin(), cell_start.end() - 1);
+    for (int i = 0; i < n; ++i) cell_points[fill[cell_index[i]]++] = i;
+  }
+
+  std::vector<double> best_dist(k);
+  std::vector<int> best_index(k);
+  const int max_ring = std::max(nx, ny);
+  for (int i = 0; i < n; ++i) {
+    TopK top{k, 0, best_dist.data(), best_index.data()};
+    int qx, qy;
+    cell_of(points[i], &qx, &qy);
+    const Eigen::Vector2d& q = points[i];
+    for (int ring = 0; ring <= max_ring; ++ring) {
+      const int y0 = qy - ring, y1 = qy + ring;
+      const int x0 = qx - ring, x1 = qx + ring;
+      for (int cy = std::max(y0, 0); cy <= std::min(y1, ny - 1); ++cy) {
+        const bool full_row = (cy == y0 || cy == y1);
+        const int step = full_row ? 1 : std::max(x1 - x0, 1);
+        for (int cx = x0; cx <= x1; cx += step) {
+          if (cx < 0 || cx >= nx) continue;
+          const int c = cy * nx + cx;
+          for (int s = cell_start[c]; s < cell_start[c + 1]; ++s) {
+            const int j = cell_points[s];
+            if (j == i) continue;
+            top.Offer((points[j] - q).squaredNorm(), j);
+          }
+        }
+      }
+      // Points in cells of ring r + 1 or beyond are at least r cells away.
+      if (top.count == k) {
+        const double bound = ring * cell_min;
+        if (top.dist[k - 1] <= bound * bound) break;
+      }
+    }
+    std::copy(best_index.begin(), best_index.begin() + top.count,
+              neighbors->begin() + static_cast<size_t>(i) * k);
+  }
+}
+
+}  // namespace puzzlecal
