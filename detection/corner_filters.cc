@@ -41,13 +41,22 @@ RingMeasure MeasureRing(const cv::Mat& image, double x, double y,
     return m;
   }
   m.inside = true;
+  // Unit circle offsets, computed once per sample count.
+  static thread_local int table_samples = 0;
+  static thread_local double table_cos[64], table_sin[64];
+  const double step = 2.0 * M_PI / samples;
+  if (table_samples != samples) {
+    for (int i = 0; i < samples; ++i) {
+      table_cos[i] = std::cos(i * step);
+      table_sin[i] = std::sin(i * step);
+    }
+    table_samples = samples;
+  }
   float v[64];
   double mean = 0.0;
-  const double step = 2.0 * M_PI / samples;
   for (int i = 0; i < samples; ++i) {
-    const double a = i * step;
-    v[i] = SampleBilinear(image, x + radius * std::cos(a),
-                          y + radius * std::sin(a));
+    v[i] = SampleBilinear(image, x + radius * table_cos[i],
+                          y + radius * table_sin[i]);
     mean += v[i];
   }
   mean /= samples;
@@ -58,9 +67,9 @@ RingMeasure MeasureRing(const cv::Mat& image, double x, double y,
     const double odd = 0.5 * (v[i] - v[i + half]);
     even_energy += even * even;
     odd_energy += odd * odd;
-    const double a = 2.0 * i * step;
-    re2 += even * std::cos(a);
-    im2 += even * std::sin(a);
+    // cos(2a), sin(2a) of sample i are the table entries of sample 2i.
+    re2 += even * table_cos[(2 * i) % samples];
+    im2 += even * table_sin[(2 * i) % samples];
   }
   // Second-harmonic amplitude of the symmetric part (cos 2a, sin 2a).
   const double amplitude = 2.0 * std::hypot(re2, im2) / half;

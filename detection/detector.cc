@@ -1,7 +1,7 @@
 #include "detection/detector.h"
 
 #include <algorithm>
-#include <chrono>
+#include <ctime>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -50,8 +50,8 @@ bool DetectorOptions::Check(std::string* why) const {
   if (!(min_ring_second_harmonic >= 0.0 && min_ring_second_harmonic <= 1.0)) {
     return fail("min_ring_second_harmonic must be in [0, 1]");
   }
-  if (!(window_fraction_of_neighbor > 0.0 && window_fraction_of_neighbor < 1.0)) {
-    return fail("window_fraction_of_neighbor must be in (0, 1)");
+  if (!(window_fraction_of_neighbor > 0.0 && window_fraction_of_neighbor <= 1.0)) {
+    return fail("window_fraction_of_neighbor must be in (0, 1]");
   }
   if (min_window_px < 2 || max_window_px > 64 || min_window_px > max_window_px) {
     return fail("need 2 <= min_window_px <= max_window_px <= 64");
@@ -70,31 +70,47 @@ bool DetectorOptions::Check(std::string* why) const {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+// CPU time of the calling thread: on a shared machine wall time measures
+// the neighbours, not the detector.
+struct Clock {
+  using time_point = double;  // milliseconds
+  static time_point now() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+  }
+};
 
-double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start)
-      .count();
-}
+double MsSince(Clock::time_point start) { return Clock::now() - start; }
 
-// Converts the input to a CV_32FC1 image in [0, 1] (for finite inputs).
-// Returns false with a reason for unsupported types.
-bool ToNormalizedFloat(const cv::Mat& image, bool normalize_by_max,
-                       cv::Mat* grey, double* normalizer, std::string* why) {
-  cv::Mat single;
+// Buffers reused by consecutive calls on one thread (same-size images then
+// cause no allocation and no page faults).
+struct Workspace {
+  cv::Mat single;                // one-channel input (colour converted)
+  cv::Mat finite;                // float input with non-finite pixels zeroed
+  std::vector<cv::Mat> blurred;  // per level, CV_32FC1, grey in [0, 1]
+  cv::Mat response;
+  std::vector<float> scratch;
+};
+
+// Picks the one-channel, finite version of the input and the grey value
+// that maps to 1.0. Returns false with a reason for unsupported types.
+bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
+                  const cv::Mat** single, double* normalizer, std::string* why) {
   if (image.channels() == 1) {
-    single = image;
+    *single = &image;
   } else if ((image.channels() == 3 || image.channels() == 4) &&
              (image.depth() == CV_8U || image.depth() == CV_16U ||
               image.depth() == CV_32F)) {
-    cv::cvtColor(image, single,
+    cv::cvtColor(image, ws->single,
                  image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+    *single = &ws->single;
   } else {
     *why = "unsupported number of channels";
     return false;
   }
   double full_scale = 1.0;
-  switch (single.depth()) {
+  switch ((*single)->depth()) {
     case CV_8U:
       full_scale = 255.0;
       break;
@@ -108,29 +124,24 @@ bool ToNormalizedFloat(const cv::Mat& image, bool normalize_by_max,
       *why = "unsupported pixel type (need 8-bit, 16-bit or 32-bit float)";
       return false;
   }
-  if (single.depth() == CV_32F) {
-    single.copyTo(*grey);
-    // Non-finite pixels become 0 (NaN fails every comparison).
-    for (int y = 0; y < grey->rows; ++y) {
-      float* row = grey->ptr<float>(y);
-      for (int x = 0; x < grey->cols; ++x) {
+  if ((*single)->depth() == CV_32F) {
+    // Non-finite pixels become 0.
+    (*single)->copyTo(ws->finite);
+    for (int y = 0; y < ws->finite.rows; ++y) {
+      float* row = ws->finite.ptr<float>(y);
+      for (int x = 0; x < ws->finite.cols; ++x) {
         if (!std::isfinite(row[x])) row[x] = 0.0f;
       }
     }
+    *single = &ws->finite;
   }
   double scale = full_scale;
   if (normalize_by_max) {
     double max_value = 0.0;
-    cv::minMaxLoc(single.depth() == CV_32F ? *grey : single, nullptr,
-                  &max_value);
-    scale = max_value > 0.0 ? max_value : full_scale;
+    cv::minMaxLoc(**single, nullptr, &max_value);
+    if (max_value > 0.0) scale = max_value;
   }
   *normalizer = scale;
-  if (single.depth() == CV_32F) {
-    if (scale != 1.0) *grey *= 1.0 / scale;
-  } else {
-    single.convertTo(*grey, CV_32F, 1.0 / scale);
-  }
   return true;
 }
 
@@ -216,21 +227,27 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
 
   // --- preprocessing ---
   Clock::time_point t = Clock::now();
-  cv::Mat grey;
-  if (!ToNormalizedFloat(image, options.normalize_by_max, &grey,
-                         &s.normalizer, &why)) {
+  static thread_local Workspace ws;
+  const cv::Mat* single = nullptr;
+  if (!PrepareInput(image, options.normalize_by_max, &ws, &single,
+                    &s.normalizer, &why)) {
     s.message = why;
     return corners;
   }
-  std::vector<cv::Mat> blurred(options.num_levels);
+  std::vector<cv::Mat>& blurred = ws.blurred;
+  blurred.resize(options.num_levels);
   if (options.blur_sigma_px > 0.0) {
+    // One separable pass from the input type straight to float, with the
+    // normalisation folded into the kernel.
     const int ksize =
         2 * static_cast<int>(std::ceil(2.0 * options.blur_sigma_px)) + 1;
-    cv::GaussianBlur(grey, blurred[0], cv::Size(ksize, ksize),
-                     options.blur_sigma_px, options.blur_sigma_px,
-                     cv::BORDER_REPLICATE);
+    const cv::Mat kernel =
+        cv::getGaussianKernel(ksize, options.blur_sigma_px, CV_32F);
+    const cv::Mat kernel_scaled = kernel * (1.0 / s.normalizer);
+    cv::sepFilter2D(*single, blurred[0], CV_32F, kernel_scaled, kernel,
+                    cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
   } else {
-    blurred[0] = grey;
+    single->convertTo(blurred[0], CV_32F, 1.0 / s.normalizer);
   }
   int levels = 1;
   for (int l = 1; l < options.num_levels; ++l) {
@@ -245,10 +262,9 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
 
   // --- per level: response, threshold, NMS, filters ---
   std::vector<Candidate> candidates;
-  cv::Mat response;
-  std::vector<float> scratch;
+  cv::Mat& response = ws.response;
+  std::vector<float>& scratch = ws.scratch;
   std::vector<ResponsePeak> peaks;
-  cv::Mat level0_response;  // kept for the thesis's centroid refinement
   for (int l = options.first_level; l < levels; ++l) {
     t = Clock::now();
     ComputeSaddleResponse(blurred[l], static_cast<float>(options.trace_weight_k),
@@ -258,7 +274,7 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
     t = Clock::now();
     double threshold = options.min_response;
     if (options.noise_response_factor > 0.0) {
-      const double median = SampledMedian(response, 5, &scratch);
+      const double median = SampledMedian(response, 8, &scratch);
       threshold = std::max(threshold,
                            options.noise_response_factor * std::sqrt(median));
     }

@@ -92,12 +92,12 @@ struct DetectorOptions {
   SubpixelMethod subpixel = SubpixelMethod::kGradientOrthogonality;
   // Half-size of the refinement window as a fraction of the distance to the
   // nearest other corner (a tile edge); clamped to the two bounds below. > 0.
-  double window_fraction_of_neighbor = 0.4;
+  double window_fraction_of_neighbor = 0.5;
   // Bounds of the window half-size in full-resolution pixels; the upper one is
   // also used for a corner without neighbours. 2 <= min <= max <= 64.
   int min_window_px = 2;
-  int max_window_px = 10;
-  // Iterations of the gradient-orthogonality solve (window re-centred). >= 1.
+  int max_window_px = 12;
+  // Newton iterations of the gradient-orthogonality fixed point. >= 1.
   int max_iterations = 6;
   // Stop when the update is shorter than this (pixels). > 0.
   double convergence_px = 0.005;
@@ -135,7 +135,8 @@ struct DetectorSummary {
   int refine_failed = 0;      // dropped because refinement diverged
   int merged_duplicates = 0;  // dropped as duplicates after refinement
   int corners = 0;            // returned
-  // Wall time per stage, milliseconds.
+  // CPU time of the calling thread per stage, milliseconds (work done inside
+  // OpenCV's own worker threads, if enabled, is not counted).
   double ms_preprocess = 0.0;  // conversion, normalisation, blur, pyramid
   double ms_response = 0.0;    // Hessian responses
   double ms_nms = 0.0;         // thresholds and non-maximum suppression

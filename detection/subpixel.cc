@@ -2,10 +2,128 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
+
+#include <Eigen/LU>
 
 #include "detection/corner_filters.h"
 
 namespace puzzlecal {
+
+namespace {
+
+// Central-difference gradients of a square patch of the image, computed once
+// per corner and reused by every solve.
+class GradientPatch {
+ public:
+  // Fills the patch of radius `radius` around (cx, cy); false when it does
+  // not fit into the image (with one pixel for the differences).
+  bool Fill(const cv::Mat& image, int cx, int cy, int radius) {
+    // Shrink (down to `radius - 3`) to stay inside the image.
+    const int room = std::min({cx - 1, cy - 1, image.cols - 2 - cx,
+                               image.rows - 2 - cy});
+    radius = std::max(std::min(radius, room), radius - 3);
+    if (cx - radius < 1 || cy - radius < 1 || cx + radius > image.cols - 2 ||
+        cy + radius > image.rows - 2) {
+      return false;
+    }
+    x0_ = cx - radius;
+    y0_ = cy - radius;
+    size_ = 2 * radius + 1;
+    // Rows padded to a multiple of kLanes (zero products) for the solve.
+    stride_ = (size_ + kLanes - 1) / kLanes * kLanes;
+    const size_t n = static_cast<size_t>(stride_) * size_;
+    gxx_.assign(n, 0.0f);
+    gxy_.assign(n, 0.0f);
+    gyy_.assign(n, 0.0f);
+    for (int j = 0; j < size_; ++j) {
+      const int y = y0_ + j;
+      const float* up = image.ptr<float>(y - 1);
+      const float* row = image.ptr<float>(y);
+      const float* down = image.ptr<float>(y + 1);
+      const size_t offset = static_cast<size_t>(j) * stride_;
+      for (int i = 0; i < size_; ++i) {
+        const int x = x0_ + i;
+        const float gx = 0.5f * (row[x + 1] - row[x - 1]);
+        const float gy = 0.5f * (down[x] - up[x]);
+        gxx_[offset + i] = gx * gx;
+        gxy_[offset + i] = gx * gy;
+        gyy_[offset + i] = gy * gy;
+      }
+    }
+    return true;
+  }
+
+  // True when the disc of radius h around p lies inside the patch.
+  bool Covers(const Eigen::Vector2d& p, double h) const {
+    return p.x() - h >= x0_ && p.y() - h >= y0_ &&
+           p.x() + h <= x0_ + size_ - 1 && p.y() + h <= y0_ + size_ - 1;
+  }
+
+  // One weighted least-squares solve with the window centred on p (weights
+  // 1 - r^2 / h^2: zero at the rim so pixels entering or leaving the window
+  // do not jump, yet broad enough to use the straight edge arms): returns
+  // the point minimising sum w g g^T (q - x) over x. False when the system
+  // is ill-conditioned (fewer than two edge directions).
+  bool Solve(const Eigen::Vector2d& p, double h, Eigen::Vector2d* solution) const {
+    // Float sums in kLanes independent lanes so the loop vectorises; the
+    // rounding error is far below 0.001 px for windows up to 64 px.
+    const float inv_h2 = static_cast<float>(1.0 / (h * h));
+    const int j0 = std::max(0, static_cast<int>(std::ceil(p.y() - h)) - y0_);
+    const int j1 =
+        std::min(size_ - 1, static_cast<int>(std::floor(p.y() + h)) - y0_);
+    float dx0[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      dx0[l] = static_cast<float>(x0_ + l - p.x());
+    }
+    float a00[kLanes] = {}, a01[kLanes] = {}, a11[kLanes] = {};
+    float b0[kLanes] = {}, b1[kLanes] = {};
+    for (int j = j0; j <= j1; ++j) {
+      const float dy = static_cast<float>(y0_ + j - p.y());
+      const float dy2 = dy * dy;
+      const size_t offset = static_cast<size_t>(j) * stride_;
+      for (int i = 0; i < stride_; i += kLanes) {
+        const float* gxx = &gxx_[offset + i];
+        const float* gxy = &gxy_[offset + i];
+        const float* gyy = &gyy_[offset + i];
+        for (int l = 0; l < kLanes; ++l) {
+          const float dx = dx0[l] + static_cast<float>(i);
+          // Weight 1 - r^2 / h^2, zero outside the disc.
+          const float w = std::max(0.0f, 1.0f - (dx * dx + dy2) * inv_h2);
+          const float wxx = w * gxx[l], wxy = w * gxy[l], wyy = w * gyy[l];
+          a00[l] += wxx;
+          a01[l] += wxy;
+          a11[l] += wyy;
+          // Relative to p for numerical range.
+          b0[l] += wxx * dx + wxy * dy;
+          b1[l] += wxy * dx + wyy * dy;
+        }
+      }
+    }
+    double s00 = 0, s01 = 0, s11 = 0, t0 = 0, t1 = 0;
+    for (int l = 0; l < kLanes; ++l) {
+      s00 += a00[l];
+      s01 += a01[l];
+      s11 += a11[l];
+      t0 += b0[l];
+      t1 += b1[l];
+    }
+    const double det = s00 * s11 - s01 * s01;
+    const double trace = s00 + s11;
+    if (!(trace > 0.0) || det < 0.05 * trace * trace) return false;
+    *solution = p + Eigen::Vector2d((s11 * t0 - s01 * t1) / det,
+                                    (s00 * t1 - s01 * t0) / det);
+    return std::isfinite(solution->x()) && std::isfinite(solution->y());
+  }
+
+ private:
+  static constexpr int kLanes = 8;
+  int x0_ = 0, y0_ = 0, size_ = 0, stride_ = 0;
+  // Gradient products per pixel, rows of `stride_` floats; reused between
+  // corners.
+  std::vector<float> gxx_, gxy_, gyy_;
+};
+}  // namespace
 
 GradientRefineResult RefineByGradientOrthogonality(
     const cv::Mat& image, const Eigen::Vector2d& start, int half_window,
@@ -13,54 +131,56 @@ GradientRefineResult RefineByGradientOrthogonality(
   GradientRefineResult result;
   result.xy = start;
   if (!std::isfinite(start.x()) || !std::isfinite(start.y()) ||
-      half_window < 1) {
+      half_window < 1 || std::abs(start.x()) > 1e6 ||
+      std::abs(start.y()) > 1e6) {
     return result;
   }
+  // Room for the window plus a few pixels of movement.
+  static thread_local GradientPatch patch;
   const double h = half_window;
-  const double inv_h2 = 1.0 / (h * h);
+  if (!patch.Fill(image, static_cast<int>(std::lround(start.x())),
+                  static_cast<int>(std::lround(start.y())), half_window + 3)) {
+    return result;
+  }
+  // The solve with the window centred on p returns F(p); the corner is the
+  // fixed point F(p) = p. Plain iteration p <- F(p) converges slowly when the
+  // blur is wide compared with the window (the weights move with p), so we
+  // run Newton on G(p) = F(p) - p with a finite-difference Jacobian computed
+  // once (chord method).
+  constexpr double kStep = 0.25;  // finite-difference step, pixels
   Eigen::Vector2d p = start;
+  Eigen::Vector2d f;
+  if (!patch.Solve(p, h, &f)) return result;
+  Eigen::Vector2d g = f - p;
+  Eigen::Matrix2d jacobian;
+  for (int axis = 0; axis < 2; ++axis) {
+    Eigen::Vector2d shifted = p;
+    shifted[axis] += kStep;
+    Eigen::Vector2d f_shifted;
+    if (!patch.Solve(shifted, h, &f_shifted)) return result;
+    jacobian.col(axis) = ((f_shifted - shifted) - g) / kStep;
+  }
+  // Fall back to plain iteration if the Jacobian is degenerate.
+  const bool use_newton = std::abs(jacobian.determinant()) > 1e-3;
+  const Eigen::Matrix2d inverse =
+      use_newton ? Eigen::Matrix2d(jacobian.inverse())
+                 : Eigen::Matrix2d(-Eigen::Matrix2d::Identity());
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     result.iterations = iteration + 1;
-    const int cx = static_cast<int>(std::lround(p.x()));
-    const int cy = static_cast<int>(std::lround(p.y()));
-    // Central differences need one more pixel on each side.
-    if (cx - half_window < 1 || cy - half_window < 1 ||
-        cx + half_window > image.cols - 2 ||
-        cy + half_window > image.rows - 2) {
+    Eigen::Vector2d step = -inverse * g;
+    const double length = step.norm();
+    if (!std::isfinite(length)) return result;
+    if (length > 1.0) step /= length;  // at most one pixel per step
+    p += step;
+    if ((p - start).norm() > h) return result;
+    if (!patch.Covers(p, h) &&
+        !patch.Fill(image, static_cast<int>(std::lround(p.x())),
+                    static_cast<int>(std::lround(p.y())), half_window + 3)) {
       return result;
     }
-    double a00 = 0, a01 = 0, a11 = 0, b0 = 0, b1 = 0;
-    for (int y = cy - half_window; y <= cy + half_window; ++y) {
-      const float* up = image.ptr<float>(y - 1);
-      const float* row = image.ptr<float>(y);
-      const float* down = image.ptr<float>(y + 1);
-      const double dy = y - p.y();
-      for (int x = cx - half_window; x <= cx + half_window; ++x) {
-        const double dx = x - p.x();
-        const double r2 = (dx * dx + dy * dy) * inv_h2;
-        if (r2 >= 1.0) continue;
-        const double w = (1.0 - r2) * (1.0 - r2);
-        const double gx = 0.5 * (row[x + 1] - row[x - 1]);
-        const double gy = 0.5 * (down[x] - up[x]);
-        const double wxx = w * gx * gx, wxy = w * gx * gy, wyy = w * gy * gy;
-        a00 += wxx;
-        a01 += wxy;
-        a11 += wyy;
-        b0 += wxx * x + wxy * y;
-        b1 += wxy * x + wyy * y;
-      }
-    }
-    const double det = a00 * a11 - a01 * a01;
-    const double trace = a00 + a11;
-    // Both gradient directions must be present (a corner, not an edge).
-    if (!(trace > 0.0) || det < 0.05 * trace * trace) return result;
-    const Eigen::Vector2d next((a11 * b0 - a01 * b1) / det,
-                               (a00 * b1 - a01 * b0) / det);
-    if (!std::isfinite(next.x()) || !std::isfinite(next.y())) return result;
-    const double step = (next - p).norm();
-    p = next;
-    if ((p - start).norm() > h) return result;
-    if (step < convergence_px) break;
+    if (!patch.Solve(p, h, &f)) return result;
+    g = f - p;
+    if (length < convergence_px) break;
   }
   result.ok = true;
   result.xy = p;

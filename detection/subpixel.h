@@ -17,8 +17,9 @@ struct GradientRefineResult {
 // Gradient orthogonality: at a corner p every image gradient g(q) in the
 // neighbourhood is orthogonal to q - p (q lies on an edge through p, or the
 // gradient vanishes). Solves sum w g g^T (q - p) = 0 in least squares with
-// smooth biweight weights w = (1 - |q - p|^2 / h^2)^2 of half-size h
-// centred on the current estimate, and iterates. `image` is CV_32FC1
+// weights w = 1 - |q - p|^2 / h^2 of half-size h centred on the estimate;
+// the fixed point (window centred on its own solution) is found by Newton
+// iterations with a finite-difference Jacobian. `image` is CV_32FC1
 // (blurred). Fails when the window leaves the image, the system is
 // ill-conditioned (fewer than two edge directions) or the estimate leaves
 // the window.

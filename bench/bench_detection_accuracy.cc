@@ -1,0 +1,190 @@
+// Sub-pixel accuracy of the corner detector against sim/ truth, side by side
+// with cv::cornerSubPix (started from the detector's integer peaks) and
+// cv::findChessboardCornersSB, over blur x noise. Prints JSON.
+//
+// Usage: bench_detection_accuracy [views_per_cell]
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/camera_models.h"
+#include "decode/board.h"
+#include "detection/detector.h"
+#include "sim/render.h"
+
+namespace puzzlecal {
+namespace {
+
+struct ErrorStats {
+  double sum_sq = 0.0;
+  int matched = 0;
+  int expected = 0;
+  void Add(double error) {
+    sum_sq += error * error;
+    ++matched;
+  }
+  double Rms() const { return matched > 0 ? std::sqrt(sum_sq / matched) : NAN; }
+  double Recall() const {
+    return expected > 0 ? static_cast<double>(matched) / expected : NAN;
+  }
+};
+
+// Nearest point of `points` to `p`, its distance in *distance; -1 if none.
+int Nearest(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& p,
+            double* distance) {
+  int best = -1;
+  double best_d = INFINITY;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double d = (points[i] - p).norm();
+    if (d < best_d) {
+      best_d = d;
+      best = static_cast<int>(i);
+    }
+  }
+  *distance = best_d;
+  return best;
+}
+
+std::string Num(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.4f", v);
+  return buffer;
+}
+
+}  // namespace
+}  // namespace puzzlecal
+
+int main(int argc, char** argv) {
+  using namespace puzzlecal;
+  cv::setNumThreads(1);
+  const int views = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+  const double blurs[] = {0.5, 1.0, 2.0, 3.0};
+  const double noises[] = {0.0, 0.01, 0.03, 0.05};
+
+  Board board;
+  board.type = BoardType::kCheckerboard;
+  board.cols = 11;
+  board.rows = 8;
+  board.tile_size_m = 0.02;
+
+  std::printf("{\n  \"board\": \"checkerboard 11x8 corners\",\n"
+              "  \"views_per_cell\": %d,\n  \"tiles_px\": \"20..60\",\n"
+              "  \"cells\": [\n", views);
+  bool first_cell = true;
+  for (double blur : blurs) {
+    for (double noise : noises) {
+      ErrorStats ours, centroid, subpix, sb;
+      int sb_views = 0;
+      for (int v = 0; v < views; ++v) {
+        // Tile size 20..60 px, a rotation about the optical axis and a tilt.
+        const double tile_px = 20.0 + 40.0 * v / std::max(1, views - 1);
+        const double fx = 800.0;
+        Camera camera;
+        camera.model = CameraModelId::kPinholeRadtan;
+        camera.width = static_cast<int>(tile_px * 15);
+        camera.height = static_cast<int>(tile_px * 12);
+        camera.params = {fx, fx, camera.width / 2.0 - 0.3,
+                         camera.height / 2.0 + 0.2, 0, 0, 0, 0, 0};
+        const double z = fx * board.tile_size_m / tile_px;
+        Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
+        const Eigen::Matrix3d rotation =
+            (Eigen::AngleAxisd(0.15 + 0.37 * v, Eigen::Vector3d::UnitZ()) *
+             Eigen::AngleAxisd(0.12 * ((v % 3) - 1), Eigen::Vector3d::UnitX()) *
+             Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()))
+                .toRotationMatrix();
+        const Eigen::Vector3d centre((board.cols - 1) * 0.5 * board.tile_size_m,
+                                     (board.rows - 1) * 0.5 * board.tile_size_m,
+                                     0.0);
+        cam_from_board.linear() = rotation;
+        cam_from_board.translation() = Eigen::Vector3d(0, 0, z) - rotation * centre;
+        RenderOptions render;
+        render.blur_sigma_px = blur;
+        render.noise_sigma = noise;
+        render.seed = 1000 + v;
+        RenderTruth truth;
+        const cv::Mat image =
+            RenderBoard(board, camera, cam_from_board, render, &truth);
+        if (image.empty()) continue;
+        std::vector<Eigen::Vector2d> truth_xy;
+        for (const TruthCorner& t : truth.corners) {
+          if (t.visible) truth_xy.push_back(t.xy);
+        }
+        const double match_radius = std::max(2.0, 0.3 * tile_px);
+
+        auto score = [&](const std::vector<Eigen::Vector2d>& found,
+                         ErrorStats* stats) {
+          stats->expected += static_cast<int>(truth_xy.size());
+          for (const Eigen::Vector2d& t : truth_xy) {
+            double d;
+            if (Nearest(found, t, &d) >= 0 && d < match_radius) stats->Add(d);
+          }
+        };
+        DetectorOptions options;
+        std::vector<Eigen::Vector2d> found;
+        for (const Corner& c : DetectCorners(image, options)) found.push_back(c.xy);
+        score(found, &ours);
+
+        options.subpixel = SubpixelMethod::kCentroid;
+        found.clear();
+        for (const Corner& c : DetectCorners(image, options)) found.push_back(c.xy);
+        score(found, &centroid);
+
+        // cornerSubPix from the detector's integer peaks, the window size the
+        // detector picks (half the tile, at most 12 px).
+        options.subpixel = SubpixelMethod::kNone;
+        std::vector<cv::Point2f> start;
+        for (const Corner& c : DetectCorners(image, options)) {
+          double d;
+          if (Nearest(truth_xy, c.xy, &d) >= 0 && d < match_radius) {
+            start.emplace_back(c.xy.x(), c.xy.y());
+          }
+        }
+        if (!start.empty()) {
+          const int window = std::clamp(
+              static_cast<int>(std::floor(0.5 * tile_px)), 2, 12);
+          cv::cornerSubPix(image, start, cv::Size(window, window),
+                           cv::Size(-1, -1),
+                           cv::TermCriteria(cv::TermCriteria::EPS +
+                                                cv::TermCriteria::COUNT,
+                                            50, 0.001));
+        }
+        found.clear();
+        for (const cv::Point2f& p : start) found.emplace_back(p.x, p.y);
+        score(found, &subpix);
+
+        std::vector<cv::Point2f> sb_corners;
+        if (cv::findChessboardCornersSB(
+                image, cv::Size(board.cols, board.rows), sb_corners,
+                cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) {
+          ++sb_views;
+          found.clear();
+          for (const cv::Point2f& p : sb_corners) found.emplace_back(p.x, p.y);
+          score(found, &sb);
+        }
+      }
+      std::printf("%s    {\"blur_px\": %.1f, \"noise\": %.2f, "
+                  "\"ours_rms_px\": %s, \"ours_recall\": %s, "
+                  "\"thesis_centroid_rms_px\": %s, "
+                  "\"cornersubpix_rms_px\": %s, \"sb_rms_px\": %s, "
+                  "\"sb_views_found\": %d, \"views\": %d}",
+                  first_cell ? "" : ",\n", blur, noise, Num(ours.Rms()).c_str(),
+                  Num(ours.Recall()).c_str(), Num(centroid.Rms()).c_str(),
+                  Num(subpix.Rms()).c_str(), Num(sb.Rms()).c_str(), sb_views,
+                  views);
+      std::fflush(stdout);
+      first_cell = false;
+    }
+  }
+  std::printf("\n  ]\n}\n");
+  return 0;
+}
