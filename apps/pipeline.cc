@@ -1,0 +1,192 @@
+#include "apps/pipeline.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <thread>
+
+namespace puzzlecal {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                       start)
+      .count();
+}
+
+// Relative labels of different components are not comparable: a view built
+// from them keeps the component with the most points (a checkerboard view;
+// any consistent labelling is a rigid motion of the board plane).
+void KeepLargestComponent(DecodeResult* decode) {
+  std::map<int, int> points_per_component;
+  for (int component : decode->component) ++points_per_component[component];
+  int best = -1, best_count = 0;
+  for (const auto& [component, count] : points_per_component) {
+    if (count > best_count) {  // ties: the lower index, i.e. the larger grid
+      best = component;
+      best_count = count;
+    }
+  }
+  DecodeResult kept = *decode;
+  kept.observation = BoardObservation();
+  kept.corner_index.clear();
+  kept.component.clear();
+  for (size_t k = 0; k < decode->component.size(); ++k) {
+    if (decode->component[k] != best) continue;
+    kept.observation.id.push_back(decode->observation.id[k]);
+    kept.observation.xy.push_back(decode->observation.xy[k]);
+    kept.corner_index.push_back(decode->corner_index[k]);
+    kept.component.push_back(best);
+  }
+  *decode = std::move(kept);
+}
+
+}  // namespace
+
+const char* ImageOutcomeName(ImageOutcome outcome) {
+  switch (outcome) {
+    case ImageOutcome::kUsable:
+      return "usable";
+    case ImageOutcome::kUnreadable:
+      return "unreadable";
+    case ImageOutcome::kNoCorners:
+      return "no corners";
+    case ImageOutcome::kNoGrid:
+      return "no consistent grid";
+    case ImageOutcome::kNotDecoded:
+      return "code not recognised";
+    case ImageOutcome::kTooFewCorners:
+      return "too few corners";
+    case ImageOutcome::kSizeMismatch:
+      return "image size differs";
+  }
+  return "unknown";
+}
+
+bool PipelineOptions::Check(std::string* why) const {
+  std::string inner;
+  if (!detector.Check(&inner)) {
+    if (why != nullptr) *why = "detector: " + inner;
+    return false;
+  }
+  if (!grid.Check(&inner)) {
+    if (why != nullptr) *why = "grid: " + inner;
+    return false;
+  }
+  if (!decode.Check(&inner)) {
+    if (why != nullptr) *why = "decode: " + inner;
+    return false;
+  }
+  if (!load.Check(&inner)) {
+    if (why != nullptr) *why = "load: " + inner;
+    return false;
+  }
+  if (min_corners < 4) {
+    if (why != nullptr) *why = "min_corners must be >= 4";
+    return false;
+  }
+  return true;
+}
+
+void ProcessGreyImage(const cv::Mat& grey, const Board& board,
+                      const PipelineOptions& options, ImageResult* result) {
+  result->width = grey.cols;
+  result->height = grey.rows;
+  auto start = std::chrono::steady_clock::now();
+  DetectorSummary detector_summary;
+  result->corners = DetectCorners(grey, options.detector, &detector_summary);
+  result->seconds_detect = SecondsSince(start);
+  if (!detector_summary.ok) {
+    result->outcome = ImageOutcome::kNoCorners;
+    result->reason = detector_summary.message;
+    return;
+  }
+  if (static_cast<int>(result->corners.size()) < options.min_corners) {
+    result->outcome = ImageOutcome::kNoCorners;
+    result->reason = "found " + std::to_string(result->corners.size()) +
+                     " corners, a view needs " +
+                     std::to_string(options.min_corners);
+    return;
+  }
+  start = std::chrono::steady_clock::now();
+  result->components = BuildGrid(result->corners, grey, options.grid);
+  if (result->components.empty() ||
+      static_cast<int>(result->components.front().corner.size()) <
+          options.min_corners) {
+    result->seconds_grid_decode = SecondsSince(start);
+    result->outcome = ImageOutcome::kNoGrid;
+    result->reason =
+        "no lattice of " + std::to_string(options.min_corners) +
+        " or more consistent corners among " +
+        std::to_string(result->corners.size()) + " detections";
+    return;
+  }
+  result->decode = DecodeBoard(board, result->corners, result->components,
+                               grey, options.decode);
+  result->seconds_grid_decode = SecondsSince(start);
+  if (board.type == BoardType::kPuzzleBoard && !result->decode.decoded) {
+    result->outcome = ImageOutcome::kNotDecoded;
+    result->reason = result->decode.reason;
+    return;
+  }
+  if (!result->decode.absolute_ids) KeepLargestComponent(&result->decode);
+  const int num_ids = static_cast<int>(result->decode.observation.id.size());
+  if (num_ids < options.min_corners) {
+    result->outcome = ImageOutcome::kTooFewCorners;
+    result->reason = std::to_string(num_ids) +
+                     " corners with board ids, a view needs " +
+                     std::to_string(options.min_corners);
+    return;
+  }
+  result->outcome = ImageOutcome::kUsable;
+  result->reason = std::to_string(num_ids) + " corners";
+}
+
+ImageResult ProcessImageFile(const std::string& file, const Board& board,
+                             const PipelineOptions& options) {
+  ImageResult result;
+  result.file = file;
+  const auto start = std::chrono::steady_clock::now();
+  cv::Mat grey;
+  std::string error;
+  const bool loaded = LoadGreyImage(file, options.load, &grey, &error);
+  result.seconds_load = SecondsSince(start);
+  if (!loaded) {
+    result.outcome = ImageOutcome::kUnreadable;
+    result.reason = error;
+    return result;
+  }
+  ProcessGreyImage(grey, board, options, &result);
+  return result;
+}
+
+std::vector<ImageResult> ProcessImageFiles(
+    const std::vector<std::string>& files, const Board& board,
+    const PipelineOptions& options, int num_threads,
+    const std::function<void(size_t, const ImageResult&)>& on_done) {
+  std::vector<ImageResult> results(files.size());
+  if (num_threads <= 0) {
+    num_threads = std::max(1u, std::thread::hardware_concurrency());
+  }
+  num_threads = std::min<int>(num_threads, std::max<size_t>(1, files.size()));
+  std::atomic<size_t> next{0};
+  std::mutex done_mutex;
+  auto worker = [&]() {
+    for (size_t i = next++; i < files.size(); i = next++) {
+      results[i] = ProcessImageFile(files[i], board, options);
+      if (on_done) {
+        std::lock_guard<std::mutex> lock(done_mutex);
+        on_done(i, results[i]);
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < num_threads; ++t) threads.emplace_back(worker);
+  worker();
+  for (std::thread& thread : threads) thread.join();
+  return results;
+}
+
+}  // namespace puzzlecal

@@ -1,0 +1,82 @@
+#ifndef PUZZLECAL_APPS_PIPELINE_H_
+#define PUZZLECAL_APPS_PIPELINE_H_
+
+// One image through detection -> grid -> decode, and a folder of images in
+// parallel with a bounded number of images in memory.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "apps/image_io.h"
+#include "decode/board.h"
+#include "decode/decoder.h"
+#include "detection/corner.h"
+#include "detection/detector.h"
+#include "grid/grid.h"
+#include "grid/grid_component.h"
+
+namespace puzzlecal {
+
+// What an image yielded.
+enum class ImageOutcome {
+  kUsable,            // enough corners with board ids
+  kUnreadable,        // the file could not be loaded
+  kNoCorners,         // the detector found too few corners
+  kNoGrid,            // no consistent lattice among the corners
+  kNotDecoded,        // PuzzleBoard: no component decoded
+  kTooFewCorners,     // decoded, but fewer corners than a view needs
+  kSizeMismatch,      // image size differs from the first image's
+};
+
+// "usable", "unreadable", "no corners", ...
+const char* ImageOutcomeName(ImageOutcome outcome);
+
+struct PipelineOptions {
+  DetectorOptions detector;  // corner detection
+  GridOptions grid;          // lattice reconstruction
+  DecodeOptions decode;      // board ids
+  ImageLoadOptions load;     // image loading limits
+  // An image needs at least this many corners with board ids to be a view.
+  // Default 6 (a pose has 6 degrees of freedom; fewer cannot constrain it).
+  int min_corners = 6;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+struct ImageResult {
+  std::string file;
+  int width = 0;
+  int height = 0;
+  ImageOutcome outcome = ImageOutcome::kUnreadable;
+  std::string reason;                      // why not usable, or details
+  std::vector<Corner> corners;             // all detections
+  std::vector<GridComponent> components;   // lattice components
+  DecodeResult decode;                     // ids and per-component decisions
+  double seconds_load = 0;                 // reading and decoding the file
+  double seconds_detect = 0;               // corner detection
+  double seconds_grid_decode = 0;          // grid + decode
+};
+
+// Runs detection, grid and decode on a grey image.
+void ProcessGreyImage(const cv::Mat& grey, const Board& board,
+                      const PipelineOptions& options, ImageResult* result);
+
+// Loads `file` and processes it; the image is released on return.
+ImageResult ProcessImageFile(const std::string& file, const Board& board,
+                             const PipelineOptions& options);
+
+// Processes `files` on `num_threads` workers (0 = all cores), each holding
+// one image at a time. Results come in the order of `files` and do not depend
+// on the thread count. `on_done(index, result)` is called (serialised) as each
+// image finishes, for progress output.
+std::vector<ImageResult> ProcessImageFiles(
+    const std::vector<std::string>& files, const Board& board,
+    const PipelineOptions& options, int num_threads,
+    const std::function<void(size_t, const ImageResult&)>& on_done = {});
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_APPS_PIPELINE_H_
