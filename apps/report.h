@@ -1,0 +1,123 @@
+#ifndef PUZZLECAL_APPS_REPORT_H_
+#define PUZZLECAL_APPS_REPORT_H_
+
+// The calibration report (`puzzlecal calibrate --report DIR`): a markdown
+// summary and PNG plots a user can judge the calibration by.
+
+#include <string>
+#include <vector>
+
+#include "apps/image_io.h"
+#include "calib/calibrate.h"
+#include "calib/calibration_view.h"
+#include "decode/board.h"
+
+namespace puzzlecal {
+
+// One input image of the run, in input order.
+struct ReportImage {
+  std::string file;     // path as given
+  std::string outcome;  // "used", "unreadable", "no corners", ...
+  std::string reason;   // details (may be empty)
+  int corners_detected = 0;
+  int corners_used = 0;  // inlier corners in the calibration
+  int view_index = -1;   // index into the CalibrationView list, -1 if none
+};
+
+struct ReportOptions {
+  // Views drawn as overlays (the image with detected and reprojected
+  // corners): half of them the worst views by RMS, the rest the best.
+  // Default 4; 0 draws none.
+  int num_overlays = 4;
+  // Views listed as the worst ones in summary.md. Default 5.
+  int num_worst_views = 5;
+  // Residual arrows are drawn this many times longer than the residual.
+  // 0 (the default) picks a 1-2-5 factor that makes the 95th percentile
+  // residual about 3 % of the image width; the factor is written on the plot.
+  double residual_arrow_scale = 0;
+  // Bins of the residual histogram. Default 40.
+  int histogram_bins = 40;
+  // Cells of the coverage heatmap across the image width (square cells).
+  // Default 24.
+  int coverage_cells_across = 24;
+  // Spacing in image pixels of the grid on which the distortion map is
+  // computed before bilinear upsampling. Default 8.
+  int distortion_grid_step_px = 8;
+  // Width in pixels of the image-shaped plots (residuals, coverage,
+  // distortion; the height follows the image's aspect ratio). Default 1200.
+  int image_plot_width = 1200;
+  // Size in pixels of the charts (histogram, per-view RMS). Default
+  // 1200 x 600.
+  int chart_width = 1200;
+  int chart_height = 600;
+  // Overlays wider than this are scaled down to it. Default 1600.
+  int overlay_max_width = 1600;
+  // A view whose RMS exceeds this factor times the overall RMS is marked in
+  // the per-view chart and the summary. Default 2.
+  double high_rms_factor = 2.0;
+  // Limits for re-loading view images for the overlays.
+  ImageLoadOptions load;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+struct ReportInput {
+  Board board;
+  // The calibration and the views it was given (same order as
+  // result->view_used). Both must be set.
+  const CalibrationResult* result = nullptr;
+  const std::vector<CalibrationView>* views = nullptr;
+  // False when Calibrate failed; the report then says why
+  // (calibration_error) and draws what the result holds.
+  bool calibration_ok = true;
+  std::string calibration_error;
+  // Every input image, in input order.
+  std::vector<ReportImage> images;
+  // Wall-clock split of the run in seconds (negative = not measured):
+  // reading and decoding image files, detection (corners, grid, decode),
+  // calibration, and the whole run; and the worker threads used.
+  double seconds_load = -1;
+  double seconds_detect = -1;
+  double seconds_calibrate = -1;
+  double seconds_total = -1;
+  int threads = 0;
+};
+
+// What WriteReport did.
+struct ReportSummary {
+  std::vector<std::string> files;     // written, in order (file names)
+  std::vector<std::string> warnings;  // e.g. an overlay image not readable
+};
+
+// Writes into `dir` (created if needed): summary.md, residuals.png,
+// residual_histogram.png, view_rms.png, coverage.png, distortion.png and
+// overlay_<image name>.png for options.num_overlays views. Files are
+// written atomically (temporary name, then rename). Returns false with a
+// message naming the path on failure; `summary` (optional) lists the files.
+bool WriteReport(const std::string& dir, const ReportInput& input,
+                 const ReportOptions& options, std::string* error,
+                 ReportSummary* summary = nullptr);
+
+// The markdown summary alone (what summary.md holds); `png_files` are the
+// PNG files written next to it, listed with how to read each.
+std::string ReportMarkdown(const ReportInput& input,
+                           const ReportOptions& options,
+                           const std::vector<std::string>& png_files);
+
+// How far the model's distortion moves `pixel`: the distance in pixels
+// between `pixel` and where its ray (camera.Unproject) lands in the same
+// camera without distortion (distortion parameters 0: the pinhole for the
+// pinhole models, the equidistant fisheye r = f * theta for kannala-brandt),
+// and the ray's angle from the optical axis in degrees. False when the model
+// has no ray for the pixel (the undistortion does not converge).
+bool DistortionShift(const Camera& camera, const Eigen::Vector2d& pixel,
+                     double* shift_px, double* ray_angle_deg);
+
+// A parameter value and its standard deviation as the summary prints them:
+// both rounded to three significant digits of sigma (sigma > 0), or the value to
+// 8 significant digits when sigma is unknown (<= 0 or not finite).
+std::string FormatWithSigma(double value, double sigma, std::string* sigma_text);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_APPS_REPORT_H_
