@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -72,6 +73,15 @@ bool FullCheckerboardMap(const LabelLattice& lattice, int handedness,
   return found;
 }
 
+// Rule 3 of the acceptance rule (decoder.h).
+int RequiredMargin(double agreement, const DecodeOptions& options) {
+  const double q = std::max(1.0 - agreement, 0.02);
+  if (q >= 0.5) return std::numeric_limits<int>::max();
+  const double per_edge = 2.0 * std::log10((1.0 - q) / q);
+  const int needed = static_cast<int>(std::ceil(options.min_log10_odds / per_edge));
+  return std::max(options.min_margin, needed);
+}
+
 struct AcceptedComponent {
   int component = -1;
   const LabelLattice* lattice = nullptr;
@@ -79,18 +89,18 @@ struct AcceptedComponent {
   std::vector<char> keep;  // per lattice point
 };
 
-// Decodes one PuzzleBoard component; fills `decoding` and, when accepted,
-// `accepted`.
-bool DecodePuzzleComponent(const LabelLattice& lattice, const cv::Mat& grey,
-                           const Board& board, const DecodeOptions& options,
-                           ComponentDecoding* decoding,
-                           AcceptedComponent* accepted) {
+}  // namespace
+
+bool DecodeComponentBits(const LabelLattice& lattice,
+                         const EdgeBitReading& reading, const Board& board,
+                         const DecodeOptions& options,
+                         ComponentDecoding* decoding, LabelToBoard* map,
+                         std::vector<char>* keep) {
   const int handedness = decoding->handedness;
   if (handedness == 0) {
     decoding->reason = "labels do not span two lattice directions";
     return false;
   }
-  const EdgeBitReading reading = ReadEdgeBits(lattice, grey, options.bits);
   decoding->edges = static_cast<int>(reading.edges.size());
   decoding->bits_read = reading.num_read;
   if (reading.num_read < options.min_bits_read) {
@@ -137,10 +147,11 @@ bool DecodePuzzleComponent(const LabelLattice& lattice, const cv::Mat& grey,
     why = Format("best position agrees with %.1f %% of %.0f bits (need %.1f %%)",
                  100.0 * decoding->agreement, decoding->bits_read,
                  100.0 * options.min_agreement);
-  } else if (decoding->margin < options.min_margin) {
+  } else if (decoding->margin < RequiredMargin(decoding->agreement, options)) {
     why = Format("ambiguous: best position leads the second by %.0f bits "
-                 "(need %.0f)",
-                 decoding->margin, options.min_margin);
+                 "(need %.0f at %.1f %% agreement)",
+                 decoding->margin, RequiredMargin(decoding->agreement, options),
+                 100.0 * decoding->agreement);
   } else if (decoding->log10_nfa > options.max_log10_nfa) {
     why = Format("too little evidence: a random pattern would match this well "
                  "10^%.1f times (allowed 10^%.1f)",
@@ -181,35 +192,31 @@ bool DecodePuzzleComponent(const LabelLattice& lattice, const cv::Mat& grey,
   }
 
   // Accepted: label -> board map for the original labels.
-  accepted->lattice = &lattice;
-  accepted->map.rotation = search.best.rotation;
-  accepted->map.offset =
-      search.best.offset - search.best.rotation * lattice.min_label;
-  decoding->rotation = accepted->map.rotation;
-  decoding->offset = accepted->map.offset;
+  map->rotation = search.best.rotation;
+  map->offset = search.best.offset - search.best.rotation * lattice.min_label;
+  decoding->rotation = map->rotation;
+  decoding->offset = map->offset;
   decoding->decoded = true;
   // Corners whose own edges mostly contradict the code are mislabelled.
   std::vector<int> disagreeing(lattice.xy.size(), 0);
   for (const EdgeBit& edge : reading.edges) {
     if (!edge.read) continue;
     const int bit = edge.confidence > 0 ? 1 : 0;
-    if (bit == BoardBitOfLabelEdge(accepted->map, edge.from, edge.axis)) continue;
+    if (bit == BoardBitOfLabelEdge(*map, edge.from, edge.axis)) continue;
     const Eigen::Vector2i to =
         edge.from + (edge.axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1));
     ++disagreeing[lattice.At(edge.from)];
     ++disagreeing[lattice.At(to)];
   }
-  accepted->keep.assign(lattice.xy.size(), 1);
+  keep->assign(lattice.xy.size(), 1);
   for (size_t k = 0; k < lattice.xy.size(); ++k) {
     if (disagreeing[k] >= options.drop_corner_min_disagreeing_edges) {
-      accepted->keep[k] = 0;
+      (*keep)[k] = 0;
       ++decoding->corners_dropped;
     }
   }
   return true;
 }
-
-}  // namespace
 
 bool DecodeOptions::Check(std::string* why) const {
   auto fail = [why](const char* message) {
@@ -224,6 +231,7 @@ bool DecodeOptions::Check(std::string* why) const {
     return fail("min_agreement must be in [0.5, 1]");
   }
   if (min_margin < 1) return fail("min_margin must be >= 1");
+  if (!(min_log10_odds >= 0.0)) return fail("min_log10_odds must be >= 0");
   if (!(max_log10_nfa <= 0.0)) return fail("max_log10_nfa must be <= 0");
   if (drop_corner_min_disagreeing_edges < 1) {
     return fail("drop_corner_min_disagreeing_edges must be >= 1");
@@ -299,8 +307,10 @@ DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
     }
     AcceptedComponent candidate;
     candidate.component = static_cast<int>(c);
-    if (DecodePuzzleComponent(lattice, grey, board, options, &decoding,
-                              &candidate)) {
+    candidate.lattice = &lattice;
+    const EdgeBitReading reading = ReadEdgeBits(lattice, grey, options.bits);
+    if (DecodeComponentBits(lattice, reading, board, options, &decoding,
+                            &candidate.map, &candidate.keep)) {
       accepted.push_back(std::move(candidate));
     }
   }

@@ -19,7 +19,12 @@
 //  1. bits_read >= min_bits_read (a 3 x 3-tile window has 24 edges);
 //  2. agreement = bits_agreeing / bits_read >= min_agreement;
 //  3. margin = agreeing edges at the best position minus at the second-best
-//     position inside the printed board (any rotation) >= min_margin;
+//     position inside the printed board (any rotation) >= the larger of
+//     min_margin and the margin at which, with the bit error rate
+//     q = max(1 - agreement, 0.02) the view shows, the best position is
+//     10^min_log10_odds times likelier than the second: each edge of margin
+//     is worth ((1 - q) / q)^2. Noisy views need a wider lead (q = 0.2: 4
+//     edges; q = 0.1: 3; clean: 2);
 //  4. the false-alarm figure log10(NFA) <= max_log10_nfa, where NFA = number
 //     of in-board hypotheses x P(Binomial(bins_read, 1/2) >= bins_agreeing):
 //     the expected number of positions a random pattern would match this
@@ -47,6 +52,7 @@
 
 #include "decode/board.h"
 #include "decode/edge_bits.h"
+#include "decode/position_search.h"
 #include "detection/corner.h"
 #include "grid/grid_component.h"
 
@@ -70,9 +76,16 @@ struct DecodeOptions {
   // Rule 3: minimum lead of the best position over the second best, in
   // agreeing edges. Default 2; >= 1.
   int min_margin = 2;
+  // Rule 3: required odds (log10) of the best over the second-best position
+  // given the observed bit error rate. Default 4 (at 20 % flipped bits,
+  // odds of 10^2 let 1 in 150 5x5-tile windows through with wrong ids);
+  // >= 0.
+  double min_log10_odds = 4.0;
   // Rule 4: maximum log10 of the expected number of false matches. Default
-  // -2 (one random pattern in 100 would pass); <= 0.
-  double max_log10_nfa = -2.0;
+  // -3 (about one random pattern in 1000 passes; a clean 3 x 3-tile window
+  // on the 72 x 52 board reaches -3.4, at -2 random-code windows were
+  // accepted 1 in 200); <= 0.
+  double max_log10_nfa = -3.0;
   // Rule 5: refuse when a position outside the printed board matches
   // strictly better. Default true.
   bool refuse_better_off_board = true;
@@ -135,6 +148,16 @@ DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
                          const std::vector<GridComponent>& components,
                          const cv::Mat& image,
                          const DecodeOptions& options = DecodeOptions());
+
+// The PuzzleBoard decision for one component from its edge readings (the
+// part of DecodeBoard after ReadEdgeBits; exposed so tests can corrupt bits).
+// `decoding->handedness` must be set (LabelHandedness). On acceptance fills
+// `map` and `keep` (per lattice point: 0 = dropped for disagreeing edges).
+bool DecodeComponentBits(const LabelLattice& lattice,
+                         const EdgeBitReading& reading, const Board& board,
+                         const DecodeOptions& options,
+                         ComponentDecoding* decoding, LabelToBoard* map,
+                         std::vector<char>* keep);
 
 }  // namespace puzzlecal
 
