@@ -141,18 +141,23 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
   std::vector<int> knn;
   const int k = options.num_neighbors;
   FindNearestNeighbors(valid_xy, k, &knn);
+  // Each unordered pair once, without sorting: from the smaller index, or
+  // from the larger one when the smaller does not list it.
   std::vector<std::pair<int, int>> pairs;
   pairs.reserve(knn.size());
   for (size_t v = 0; v < valid_xy.size(); ++v) {
     for (int m = 0; m < k; ++m) {
       const int w = knn[v * k + m];
       if (w < 0) break;
+      if (w < static_cast<int>(v)) {
+        const int* list = &knn[static_cast<size_t>(w) * k];
+        if (std::find(list, list + k, static_cast<int>(v)) != list + k)
+          continue;
+      }
       const int a = valid_index[v], b = valid_index[w];
       pairs.emplace_back(std::min(a, b), std::max(a, b));
     }
   }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   summary.num_candidate_edges = static_cast<int>(pairs.size());
   summary.neighbors_ms = MillisecondsSince(phase_start);
 
