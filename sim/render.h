@@ -13,6 +13,7 @@
 
 #include "calib/camera_models.h"
 #include "decode/board.h"
+#include "sim/pixel_rays.h"
 
 namespace puzzlecal {
 
@@ -38,7 +39,7 @@ struct PatternVariant {
 // Everything that turns the ideal pattern into a realistic 8-bit image.
 struct RenderOptions {
   // Supersamples per pixel along each axis (n x n per pixel) for
-  // anti-aliasing; >= 1.
+  // anti-aliasing; in [1, 16].
   int supersampling = 4;
   // Standard deviation of the Gaussian optical blur in pixels; 0 = none.
   double blur_sigma_px = 0.7;
@@ -48,8 +49,10 @@ struct RenderOptions {
   double white_level = 0.9;
   // Grey level of everything that is not the board, in [0, 1].
   double background_level = 0.45;
-  // Margin of paper around the outermost inner corners, in tiles (the
-  // printed page of SPEC.md has half-tile border tiles plus this white).
+  // White paper around the printed pattern, in tiles. The pattern itself
+  // ends half a tile outside the outermost inner corners for a PuzzleBoard
+  // (SPEC.md's half border tiles) and one full tile outside for a plain
+  // checkerboard; this margin comes on top. >= 0.
   double paper_margin_tiles = 1.0;
   // Linear lighting gradient across the image: relative change of brightness
   // from the left to the right edge (0 = uniform).
@@ -57,7 +60,8 @@ struct RenderOptions {
   // Vignetting: brightness falls as cos^4-like 1 - v * (r / r_max)^2 with the
   // distance r from the image centre; 0 = none, in [0, 1).
   double vignetting = 0.0;
-  // Display gamma applied to the linear intensity (1 = none).
+  // Encoding gamma: the output is linear^(1 / gamma), as cameras store
+  // images (1 = none, 2.2 brightens the darks); > 0.
   double gamma = 1.0;
   // Standard deviation of additive Gaussian noise as a fraction of the
   // black-white contrast (white_level - black_level); 0 = none.
@@ -77,8 +81,12 @@ struct RenderOptions {
 struct TruthCorner {
   Eigen::Vector2i id = Eigen::Vector2i::Zero();  // absolute (col, row) id
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // exact pixel position
-  // Inside the image (with a margin of 1 px), in front of the camera and not
-  // under an occluder.
+  // Exact pixel position, NaN when the model cannot project the corner
+  // (behind a pinhole camera).
+  // Visible: projects inside the image with a margin of 1 px (x in
+  // [0.5, width - 1.5], same for y), the camera looks at the printed side,
+  // the pixel's viewing ray is the corner's own (no fold-over of the
+  // distortion) and no occluder lies within 1 px of it.
   bool visible = false;
 };
 
@@ -89,11 +97,39 @@ struct RenderTruth {
   std::vector<TruthCorner> corners;  // every printed inner corner of the board
 };
 
+// What a render did.
+struct RenderSummary {
+  bool ok = false;      // an image was produced
+  std::string reason;   // why not, naming the offending input
+  int num_visible_corners = 0;   // TruthCorner::visible count
+  int num_pixels_without_ray = 0;  // pixels the model has no ray for
+                                   // (outside a fisheye's image circle)
+  int num_pixels_on_board = 0;   // pixels whose centre sees the paper
+};
+
 // Renders `board` seen by `camera` from `cam_from_board` into an 8-bit grey
-// image of camera.width x camera.height. Fills `truth` when not null.
+// image (CV_8UC1) of camera.width x camera.height. Each pixel averages
+// options.supersampling^2 sub-pixel rays intersected with the board plane.
+// Fills `truth` when not null. On bad input returns an empty image and says
+// why in `summary`. The camera's pixel rays are cached per thread, so a
+// series of renders through one camera unprojects only once.
 cv::Mat RenderBoard(const Board& board, const Camera& camera,
                     const Eigen::Isometry3d& cam_from_board,
-                    const RenderOptions& options, RenderTruth* truth = nullptr);
+                    const RenderOptions& options, RenderTruth* truth = nullptr,
+                    RenderSummary* summary = nullptr);
+
+// The same with explicitly precomputed rays (rays.camera() is the camera).
+cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
+                    const Eigen::Isometry3d& cam_from_board,
+                    const RenderOptions& options, RenderTruth* truth = nullptr,
+                    RenderSummary* summary = nullptr);
+
+// Every printed inner corner of `board` (Board::AllIds order) with its exact
+// projection and visibility as TruthCorner defines it.
+std::vector<TruthCorner> ProjectBoardCorners(
+    const Board& board, const Camera& camera,
+    const Eigen::Isometry3d& cam_from_board,
+    const std::vector<Occluder>& occluders);
 
 }  // namespace puzzlecal
 

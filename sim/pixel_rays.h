@@ -1,0 +1,53 @@
+#ifndef PUZZLECAL_SIM_PIXEL_RAYS_H_
+#define PUZZLECAL_SIM_PIXEL_RAYS_H_
+
+// Viewing rays through the corners of every pixel of a camera, unprojected
+// once so that many renders through the same camera share the iterative
+// Unproject work. Rays at sub-pixel positions are interpolated bilinearly
+// between the four corners of their pixel (the error is second order in the
+// pixel size, far below 1e-4 px for real lenses).
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calib/camera_models.h"
+
+namespace puzzlecal {
+
+// False with a reason when `camera` cannot be rendered: unknown parameter
+// count, non-finite parameters, non-positive focal lengths, image size
+// outside [1, 20000].
+bool CheckRenderCamera(const Camera& camera, std::string* why = nullptr);
+
+class PixelRayGrid {
+ public:
+  // Unprojects the (width + 1) x (height + 1) pixel corners of `camera`.
+  // False with a reason (and an empty grid) when the camera is unusable.
+  bool Compute(const Camera& camera, std::string* why = nullptr);
+
+  // True when this grid was computed for exactly this camera.
+  bool Matches(const Camera& camera) const;
+  bool empty() const { return rays_.empty(); }
+  const Camera& camera() const { return camera_; }
+
+  // Unit ray in the camera frame through the pixel corner (cx - 0.5,
+  // cy - 0.5), cx in [0, width], cy in [0, height]. NaN where Unproject did
+  // not converge (outside the model's image circle or fold-over region).
+  const double* Ray(int cx, int cy) const {
+    return rays_.data() + 3 * (static_cast<size_t>(cy) * (camera_.width + 1) +
+                               cx);
+  }
+  // Number of pixel corners without a ray.
+  int num_invalid() const { return num_invalid_; }
+
+ private:
+  Camera camera_;
+  std::vector<double> rays_;
+  int num_invalid_ = 0;
+};
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_SIM_PIXEL_RAYS_H_

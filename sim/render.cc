@@ -1,0 +1,435 @@
+#include "sim/render.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
+
+#include "sim/board_pattern.h"
+
+namespace puzzlecal {
+namespace {
+
+// SplitMix64: a tiny, fully specified generator, so the noise is the same on
+// every platform and independent per image row.
+uint64_t SplitMix64(uint64_t* state) {
+  uint64_t z = (*state += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+// Uniform in (0, 1).
+double Uniform(uint64_t* state) {
+  return ((SplitMix64(state) >> 11) + 0.5) * (1.0 / 9007199254740992.0);
+}
+
+bool IsFiniteRange(double v, double lo, double hi) {
+  return std::isfinite(v) && v >= lo && v <= hi;
+}
+
+bool PoseIsValid(const Eigen::Isometry3d& pose, std::string* why) {
+  if (!pose.matrix().allFinite()) {
+    *why = "cam_from_board has non-finite entries";
+    return false;
+  }
+  const Eigen::Matrix3d r = pose.linear();
+  if ((r.transpose() * r - Eigen::Matrix3d::Identity()).norm() > 1e-6 ||
+      r.determinant() < 0) {
+    *why = "cam_from_board rotation is not a proper rotation";
+    return false;
+  }
+  return true;
+}
+
+cv::Mat Fail(RenderSummary* summary, const std::string& reason) {
+  summary->ok = false;
+  summary->reason = reason;
+  return cv::Mat();
+}
+
+// True when an occluder of the row may cover part of pixel (x, y).
+bool PixelMayBeOccluded(const std::vector<const Occluder*>& occluders, int x,
+                        int y) {
+  for (const Occluder* o : occluders) {
+    const double dx = std::max(std::abs(x - o->center_px.x()) - 0.5, 0.0);
+    const double dy = std::max(std::abs(y - o->center_px.y()) - 0.5, 0.0);
+    if (dx * dx + dy * dy <= o->radius_px * o->radius_px) return true;
+  }
+  return false;
+}
+
+// The samples of one pixel's n x n grid, in [0, 1) offsets from the pixel's
+// top-left corner.
+struct SubGrid {
+  int n = 1;
+  double offset[16] = {};
+};
+
+}  // namespace
+
+bool RenderOptions::Check(std::string* why) const {
+  auto fail = [why](const std::string& message) {
+    if (why != nullptr) *why = message;
+    return false;
+  };
+  if (supersampling < 1 || supersampling > 16) {
+    return fail("supersampling must be in [1, 16]");
+  }
+  if (!IsFiniteRange(blur_sigma_px, 0.0, 50.0)) {
+    return fail("blur_sigma_px must be in [0, 50]");
+  }
+  if (!IsFiniteRange(black_level, 0.0, 1.0) ||
+      !IsFiniteRange(white_level, 0.0, 1.0) || !(black_level < white_level)) {
+    return fail("black_level and white_level must be in [0, 1] with "
+                "black_level < white_level");
+  }
+  if (!IsFiniteRange(background_level, 0.0, 1.0)) {
+    return fail("background_level must be in [0, 1]");
+  }
+  if (!IsFiniteRange(paper_margin_tiles, 0.0, 1000.0)) {
+    return fail("paper_margin_tiles must be in [0, 1000]");
+  }
+  if (!(std::isfinite(lighting_gradient) && std::abs(lighting_gradient) < 2.0)) {
+    return fail("lighting_gradient must be in (-2, 2)");
+  }
+  if (!(std::isfinite(vignetting) && vignetting >= 0.0 && vignetting < 1.0)) {
+    return fail("vignetting must be in [0, 1)");
+  }
+  if (!(std::isfinite(gamma) && gamma > 0.05 && gamma < 20.0)) {
+    return fail("gamma must be in (0.05, 20)");
+  }
+  if (!IsFiniteRange(noise_sigma, 0.0, 10.0)) {
+    return fail("noise_sigma must be in [0, 10]");
+  }
+  for (size_t i = 0; i < occluders.size(); ++i) {
+    const Occluder& o = occluders[i];
+    if (!o.center_px.allFinite() || !IsFiniteRange(o.radius_px, 0.0, 1e6) ||
+        !IsFiniteRange(o.grey, 0.0, 1.0)) {
+      return fail("occluder " + std::to_string(i) +
+                  ": center_px must be finite, radius_px >= 0, grey in "
+                  "[0, 1]");
+    }
+  }
+  return true;
+}
+
+std::vector<TruthCorner> ProjectBoardCorners(
+    const Board& board, const Camera& camera,
+    const Eigen::Isometry3d& cam_from_board,
+    const std::vector<Occluder>& occluders) {
+  std::vector<TruthCorner> corners;
+  const std::vector<Eigen::Vector2i> ids = board.AllIds();
+  corners.reserve(ids.size());
+  // The printed side faces the camera when the camera centre lies at z < 0
+  // in the board frame (board z points into the page).
+  const Eigen::Vector3d center_in_board =
+      -(cam_from_board.linear().transpose() * cam_from_board.translation());
+  const bool sees_print = center_in_board.z() < 0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const Eigen::Vector2i& id : ids) {
+    TruthCorner corner;
+    corner.id = id;
+    const Eigen::Vector3d point = cam_from_board * board.Point(id);
+    Eigen::Vector2d xy;
+    if (!camera.Project(point, &xy) || !xy.allFinite()) {
+      corner.xy = Eigen::Vector2d(nan, nan);
+      corners.push_back(corner);
+      continue;
+    }
+    corner.xy = xy;
+    bool visible = sees_print && xy.x() >= 0.5 &&
+                   xy.x() <= camera.width - 1.5 && xy.y() >= 0.5 &&
+                   xy.y() <= camera.height - 1.5;
+    if (visible) {
+      // The pixel must see this corner along its own ray: strong distortion
+      // can fold several rays onto one pixel, and the image shows only one.
+      Eigen::Vector3d ray;
+      const UnprojectStatus status = camera.Unproject(xy, &ray);
+      const double cos_angle = ray.dot(point.normalized());
+      visible = status.converged && cos_angle > std::cos(1e-6);
+    }
+    for (const Occluder& o : occluders) {
+      if (visible && (xy - o.center_px).norm() < o.radius_px + 1.0) {
+        visible = false;
+      }
+    }
+    corner.visible = visible;
+    corners.push_back(corner);
+  }
+  return corners;
+}
+
+cv::Mat RenderBoard(const Board& board, const Camera& camera,
+                    const Eigen::Isometry3d& cam_from_board,
+                    const RenderOptions& options, RenderTruth* truth,
+                    RenderSummary* summary) {
+  RenderSummary local_summary;
+  if (summary == nullptr) summary = &local_summary;
+  *summary = RenderSummary();
+  // One grid per thread: a series of renders through one camera pays the
+  // iterative unprojection once.
+  thread_local PixelRayGrid cached_rays;
+  if (!cached_rays.Matches(camera)) {
+    std::string why;
+    if (!cached_rays.Compute(camera, &why)) return Fail(summary, why);
+  }
+  return RenderBoard(board, cached_rays, cam_from_board, options, truth,
+                     summary);
+}
+
+cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
+                    const Eigen::Isometry3d& cam_from_board,
+                    const RenderOptions& options, RenderTruth* truth,
+                    RenderSummary* summary) {
+  RenderSummary local_summary;
+  if (summary == nullptr) summary = &local_summary;
+  *summary = RenderSummary();
+  std::string why;
+  if (!options.Check(&why)) return Fail(summary, "render options: " + why);
+  if (!board.Check(&why)) return Fail(summary, "board: " + why);
+  if (rays.empty()) {
+    return Fail(summary, "pixel rays were not computed (unusable camera)");
+  }
+  if (!PoseIsValid(cam_from_board, &why)) return Fail(summary, why);
+
+  const Camera& camera = rays.camera();
+  const int width = camera.width, height = camera.height;
+
+  // Camera centre and rotation in the board frame, lengths in tiles.
+  const Eigen::Matrix3d board_from_cam_rotation =
+      cam_from_board.linear().transpose();
+  const Eigen::Vector3d center =
+      -(board_from_cam_rotation * cam_from_board.translation()) /
+      board.tile_size_m;
+  const bool sees_print = center.z() < 0;
+
+  const BoardPattern pattern(board, options.variant,
+                             options.paper_margin_tiles);
+  SubGrid sub;
+  sub.n = options.supersampling;
+  for (int i = 0; i < sub.n; ++i) sub.offset[i] = (i + 0.5) / sub.n;
+  const double inv_samples = 1.0 / (sub.n * sub.n);
+
+  const double black_value =
+      sees_print ? options.black_level : options.white_level;
+  auto ink_value = [&](BoardInk ink) {
+    switch (ink) {
+      case BoardInk::kBlack:
+        return black_value;
+      case BoardInk::kWhite:
+      case BoardInk::kPaper:
+        return options.white_level;
+      case BoardInk::kNone:
+        break;
+    }
+    return options.background_level;
+  };
+  auto mix_value = [&](const InkMix& mix) {
+    return mix.black * black_value + mix.white * options.white_level +
+           mix.none * options.background_level;
+  };
+
+  cv::Mat1f linear(height, width);
+  std::vector<int> no_ray_per_row(height, 0), on_board_per_row(height, 0);
+  const std::vector<Occluder>& occluders = options.occluders;
+
+  // Rows are independent: the same image for any thread count.
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+    std::vector<const Occluder*> row_occluders;
+    row_occluders.reserve(occluders.size());
+    for (int y = range.start; y < range.end; ++y) {
+      row_occluders.clear();
+      for (const Occluder& o : occluders) {
+        if (std::abs(o.center_px.y() - y) <= o.radius_px + 0.5) {
+          row_occluders.push_back(&o);
+        }
+      }
+      float* out = linear.ptr<float>(y);
+      for (int x = 0; x < width; ++x) {
+        const double* corner_rays[4] = {rays.Ray(x, y), rays.Ray(x + 1, y),
+                                        rays.Ray(x, y + 1),
+                                        rays.Ray(x + 1, y + 1)};
+        bool has_ray = true;
+        Eigen::Vector3d b[4];
+        for (int k = 0; k < 4; ++k) {
+          const Eigen::Map<const Eigen::Vector3d> r(corner_rays[k]);
+          if (!r.allFinite()) has_ray = false;
+          b[k] = board_from_cam_rotation * r;
+        }
+        if (!has_ray) ++no_ray_per_row[y];
+        // Where the pixel's corner rays meet the board plane (tiles).
+        Eigen::Vector2d hit[4];
+        int num_hits = 0;
+        for (int k = 0; k < 4 && has_ray; ++k) {
+          if (!(b[k].z() * center.z() < 0)) continue;
+          const double t = -center.z() / b[k].z();
+          hit[k] = center.head<2>() + t * b[k].head<2>();
+          ++num_hits;
+        }
+        const bool all_hit = has_ray && num_hits == 4;
+        // Sub-pixel rays are convex combinations of the corner rays, so when
+        // no corner ray heads towards the plane none does; without rays the
+        // model sees nothing. Either way the pixel is background.
+        if ((!has_ray || num_hits == 0) &&
+            (row_occluders.empty() ||
+             !PixelMayBeOccluded(row_occluders, x, y))) {
+          out[x] = static_cast<float>(options.background_level);
+          continue;
+        }
+        // Board-plane footprint of one sample step (zero = hard samples when
+        // a corner ray misses the plane).
+        Eigen::Matrix2d footprint = Eigen::Matrix2d::Zero();
+        if (all_hit) {
+          footprint.col(0) = 0.5 * ((hit[1] - hit[0]) + (hit[3] - hit[2]));
+          footprint.col(1) = 0.5 * ((hit[2] - hit[0]) + (hit[3] - hit[1]));
+          // Most pixels see one ink only: shade them once. The box of the
+          // corner hits is padded for the curvature of distorted pixel
+          // footprints.
+          if (row_occluders.empty() || !PixelMayBeOccluded(row_occluders, x, y)) {
+            Eigen::Vector2d lo = hit[0], hi = hit[0];
+            for (int k = 1; k < 4; ++k) {
+              lo = lo.cwiseMin(hit[k]);
+              hi = hi.cwiseMax(hit[k]);
+            }
+            const Eigen::Vector2d pad = 0.25 * (hi - lo);
+            lo -= pad;
+            hi += pad;
+            const BoardPattern::BoxContent content =
+                pattern.Classify(lo.x(), lo.y(), hi.x(), hi.y());
+            // Where the pixel centre's ray meets the plane (the centre
+            // ray heads towards it: it is a mean of the corner rays).
+            const Eigen::Vector3d d_mid = 0.25 * (b[0] + b[1] + b[2] + b[3]);
+            const Eigen::Vector2d mid =
+                center.head<2>() + (-center.z() / d_mid.z()) * d_mid.head<2>();
+            if (content == BoardPattern::BoxContent::kUniform) {
+              const BoardInk ink = pattern.Sample(mid.x(), mid.y());
+              out[x] = static_cast<float>(ink_value(ink));
+              if (ink != BoardInk::kNone) ++on_board_per_row[y];
+              continue;
+            }
+            if (content == BoardPattern::BoxContent::kOneEdge) {
+              // One straight edge: the exact coverage of the whole pixel's
+              // footprint needs no supersamples.
+              out[x] = static_cast<float>(
+                  mix_value(pattern.SampleArea(mid.x(), mid.y(), footprint)));
+              ++on_board_per_row[y];
+              continue;
+            }
+          }
+          footprint /= sub.n;
+        }
+        double sum = 0.0;
+        for (int j = 0; j < sub.n; ++j) {
+          const double wy = sub.offset[j];
+          const Eigen::Vector3d left = b[0] + wy * (b[2] - b[0]);
+          const Eigen::Vector3d right = b[1] + wy * (b[3] - b[1]);
+          const Eigen::Vector3d step = right - left;
+          for (int i = 0; i < sub.n; ++i) {
+            const double wx = sub.offset[i];
+            bool occluded = false;
+            for (const Occluder* o : row_occluders) {
+              const double dx = x - 0.5 + wx - o->center_px.x();
+              const double dy = y - 0.5 + wy - o->center_px.y();
+              if (dx * dx + dy * dy < o->radius_px * o->radius_px) {
+                sum += o->grey;
+                occluded = true;
+                break;
+              }
+            }
+            if (occluded) continue;
+            if (!has_ray) {
+              sum += options.background_level;
+              continue;
+            }
+            const Eigen::Vector3d d = left + wx * step;
+            // The ray meets the plane z = 0 in front of the camera only when
+            // it heads towards it.
+            if (!(d.z() * center.z() < 0)) {
+              sum += options.background_level;
+              continue;
+            }
+            const double t = -center.z() / d.z();
+            sum += mix_value(pattern.SampleArea(center.x() + t * d.x(),
+                                                center.y() + t * d.y(),
+                                                footprint));
+          }
+        }
+        out[x] = static_cast<float>(sum * inv_samples);
+        if (all_hit) {
+          const Eigen::Vector2d mid = 0.25 * (hit[0] + hit[1] + hit[2] + hit[3]);
+          if (pattern.Sample(mid.x(), mid.y()) != BoardInk::kNone) {
+            ++on_board_per_row[y];
+          }
+        }
+      }
+    }
+  });
+
+  if (options.blur_sigma_px > 0) {
+    cv::GaussianBlur(linear, linear, cv::Size(0, 0), options.blur_sigma_px,
+                     options.blur_sigma_px, cv::BORDER_REPLICATE);
+  }
+
+  cv::Mat1b image(height, width);
+  const double contrast = options.white_level - options.black_level;
+  const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
+  const double r2_max = std::max(cx * cx + cy * cy, 1e-12);
+  const double inv_gamma = 1.0 / options.gamma;
+  const double x_span = std::max(width - 1, 1);
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+    for (int y = range.start; y < range.end; ++y) {
+      uint64_t rng = options.seed * 0xD1B54A32D192ED03ULL +
+                     static_cast<uint64_t>(y) * 0x9E3779B97F4A7C15ULL;
+      const float* in = linear.ptr<float>(y);
+      uint8_t* out = image.ptr<uint8_t>(y);
+      double spare_normal = 0.0;
+      bool has_spare = false;
+      for (int x = 0; x < width; ++x) {
+        double v = in[x];
+        v *= 1.0 + options.lighting_gradient * (x / x_span - 0.5);
+        const double dx = x - cx, dy = y - cy;
+        v *= 1.0 - options.vignetting * (dx * dx + dy * dy) / r2_max;
+        v = std::clamp(v, 0.0, 1.0);
+        if (inv_gamma != 1.0) v = std::pow(v, inv_gamma);
+        if (options.noise_sigma > 0) {
+          double normal;
+          if (has_spare) {
+            normal = spare_normal;
+            has_spare = false;
+          } else {
+            // Box-Muller: two normals from two uniforms.
+            const double radius = std::sqrt(-2.0 * std::log(Uniform(&rng)));
+            const double angle = 2.0 * M_PI * Uniform(&rng);
+            normal = radius * std::cos(angle);
+            spare_normal = radius * std::sin(angle);
+            has_spare = true;
+          }
+          v += options.noise_sigma * contrast * normal;
+        }
+        out[x] = static_cast<uint8_t>(
+            std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+      }
+    }
+  });
+
+  summary->ok = true;
+  for (int y = 0; y < height; ++y) {
+    summary->num_pixels_without_ray += no_ray_per_row[y];
+    summary->num_pixels_on_board += on_board_per_row[y];
+  }
+  std::vector<TruthCorner> corners =
+      ProjectBoardCorners(board, camera, cam_from_board, options.occluders);
+  for (const TruthCorner& c : corners) {
+    summary->num_visible_corners += c.visible ? 1 : 0;
+  }
+  if (truth != nullptr) {
+    truth->camera = camera;
+    truth->cam_from_board = cam_from_board;
+    truth->corners = std::move(corners);
+  }
+  return image;
+}
+
+}  // namespace puzzlecal
