@@ -134,9 +134,25 @@ void Solve(Problem* state, const std::vector<bool>& fixed,
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.gradient_tolerance = 1e-14;
   solver_options.parameter_tolerance = 1e-12;
-  solver_options.num_threads = options.num_threads;
+  solver_options.num_threads = options.deterministic ? 1 : options.num_threads;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solve(solver_options, &problem, &outcome->summary);
+}
+
+// Largest angle between the board normals of two used views, degrees.
+double OrientationSpreadDeg(const std::vector<Eigen::Isometry3d>& poses,
+                            const std::vector<bool>& used) {
+  double spread = 0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    if (!used[i]) continue;
+    const Eigen::Vector3d a = poses[i].linear().col(2);
+    for (size_t j = i + 1; j < poses.size(); ++j) {
+      if (!used[j]) continue;
+      const Eigen::Vector3d b = poses[j].linear().col(2);
+      spread = std::max(spread, std::atan2(a.cross(b).norm(), a.dot(b)));
+    }
+  }
+  return spread * 180.0 / M_PI;
 }
 
 // Fraction of coverage-grid cells that hold at least one corner.
@@ -279,15 +295,17 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     ++usable;
   }
   if (usable < options.min_views) return too_few_views(usable);
-  if (result->orientation_spread_deg < options.min_orientation_spread_deg) {
+  auto parallel_views = [&](double spread_deg) {
     return Fail("all views show the board at nearly the same orientation "
                 "(largest angle between board normals " +
-                    Format("%.1f", result->orientation_spread_deg) +
-                    " degrees, need " +
+                    Format("%.1f", spread_deg) + " degrees, need " +
                     Format("%.1f", options.min_orientation_spread_deg) +
                     "), so the focal length is undetermined: add views with "
                     "the board tilted by 30 degrees or more",
                 error);
+  };
+  if (result->orientation_spread_deg < options.min_orientation_spread_deg) {
+    return parallel_views(result->orientation_spread_deg);
   }
 
   // Fixed parameters.
@@ -325,7 +343,7 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     std::vector<bool> staged = fixed;
     for (int k = kDistortionBegin; k < kNumParams; ++k) staged[k] = true;
     Solve<Model>(&state, staged, options, &loss, &outcome);
-    iterations += outcome.summary.iterations.size();
+    iterations += outcome.summary.iterations.size(); if (getenv("CALIB_DEBUG")) fprintf(stderr, "%s\n", outcome.summary.BriefReport().c_str());
     if (!outcome.summary.IsSolutionUsable()) {
       return Fail("the first solve (distortion held at zero) failed: " +
                       outcome.summary.message,
@@ -333,7 +351,7 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     }
   }
   Solve<Model>(&state, fixed, options, &loss, &outcome);
-  iterations += outcome.summary.iterations.size();
+  iterations += outcome.summary.iterations.size(); if (getenv("CALIB_DEBUG")) fprintf(stderr, "%s\n", outcome.summary.FullReport().c_str());
 
   // k-sigma outlier rejection.
   int rounds = 0;
@@ -397,7 +415,7 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     }
     ++rounds;
     Solve<Model>(&state, fixed, options, &loss, &outcome);
-    iterations += outcome.summary.iterations.size();
+    iterations += outcome.summary.iterations.size(); if (getenv("CALIB_DEBUG")) fprintf(stderr, "%s\n", outcome.summary.BriefReport().c_str());
     compute_residuals(&projects);
   }
 
@@ -438,6 +456,10 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
   }
   result->num_views_used = used;
   result->num_corners_used = corners;
+  // The initial poses come from rough intrinsics; judge the orientations
+  // again with the final ones.
+  result->orientation_spread_deg =
+      OrientationSpreadDeg(result->cam_from_board, state.view_used);
   result->num_outliers = outliers;
   result->rms_px = corners > 0 ? std::sqrt(sum2 / (2.0 * corners)) : 0.0;
   result->rms_point_px = corners > 0 ? std::sqrt(sum2 / corners) : 0.0;
@@ -452,7 +474,8 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
   if (options.compute_covariance && any_free && outcome.problem &&
       2 * corners > free_params && outcome.summary.IsSolutionUsable()) {
     ceres::Covariance::Options covariance_options;
-    covariance_options.num_threads = options.num_threads;
+    covariance_options.num_threads =
+        options.deterministic ? 1 : options.num_threads;
     ceres::Covariance covariance(covariance_options);
     std::vector<std::pair<const double*, const double*>> blocks = {
         {state.params.data(), state.params.data()}};
@@ -524,6 +547,9 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
                 error);
   }
   if (used < options.min_views) return too_few_views(used);
+  if (result->orientation_spread_deg < options.min_orientation_spread_deg) {
+    return parallel_views(result->orientation_spread_deg);
+  }
   if (!(result->rms_px <= options.max_rms_px)) {
     return Fail("the reprojection RMS is " + Format("%.2f", result->rms_px) +
                     " px (limit " + Format("%.2f", options.max_rms_px) +

@@ -58,9 +58,14 @@ struct CalibrationOptions {
   int max_iterations = 100;
   // Relative cost change that ends a solve. Default 1e-12.
   double function_tolerance = 1e-12;
-  // Threads for the Ceres solve. Default 1. Results do not depend on it
-  // beyond the last bits of floating point (see the report's figures).
+  // Threads for the Ceres solve and the covariance. Default 1. Only used
+  // when `deterministic` is false: Ceres sums over residual blocks in the
+  // order its threads finish, so a multi-threaded solve can differ in the
+  // last bits from run to run.
   int num_threads = 1;
+  // Run Ceres on one thread so that the same input gives the same output,
+  // bit for bit, whatever num_threads says. Default true.
+  bool deterministic = true;
 
   // A view needs at least this many corners to be used. Default 6.
   int min_corners_per_view = 6;
@@ -80,7 +85,7 @@ struct CalibrationOptions {
 
   // Fit fx, fy, cx, cy first with the distortion held at zero, then all.
   // Makes the start from the undistorted initialisation safer. Default true.
-  bool staged_distortion = true;
+  bool staged_distortion = false;
   // Compute the parameter covariance and standard deviations. Default true.
   bool compute_covariance = true;
 

@@ -179,9 +179,11 @@ double SearchFocalLength(CameraModelId model, int width, int height,
   const double log_min = std::log(options.focal_search_min_ratio * diagonal);
   const double log_max = std::log(options.focal_search_max_ratio * diagonal);
   const int steps = options.focal_search_steps;
+  InitializationOptions search_options = options;
+  search_options.reweight_iterations = options.focal_search_reweight_iterations;
   auto cost_at = [&](double log_f) {
     return ViewFitCost(CandidateCamera(model, width, height, std::exp(log_f)),
-                       views, options);
+                       views, search_options);
   };
   int best = 0;
   double best_value = std::numeric_limits<double>::infinity();
@@ -198,7 +200,7 @@ double SearchFocalLength(CameraModelId model, int width, int height,
   const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
   double c = b - ratio * (b - a), d = a + ratio * (b - a);
   double fc = cost_at(c), fd = cost_at(d);
-  for (int it = 0; it < 30; ++it) {
+  for (int it = 0; it < options.focal_search_refine_iterations; ++it) {
     if (fc < fd) {
       b = d;
       d = c;
@@ -358,6 +360,14 @@ bool InitializationOptions::Check(std::string* why) const {
   }
   if (focal_search_steps < 3) {
     return Fail("initialization.focal_search_steps must be >= 3", why);
+  }
+  if (focal_search_refine_iterations < 0) {
+    return Fail("initialization.focal_search_refine_iterations must be >= 0",
+                why);
+  }
+  if (focal_search_reweight_iterations < 0) {
+    return Fail("initialization.focal_search_reweight_iterations must be >= 0",
+                why);
   }
   if (!(focal_search_truncation_px > 0)) {
     return Fail("initialization.focal_search_truncation_px must be > 0", why);

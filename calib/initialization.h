@@ -37,16 +37,23 @@ struct InitializationOptions {
   double focal_search_min_ratio = 0.05;
   double focal_search_max_ratio = 3.0;
   // Number of log-spaced candidates before the golden-section refinement.
-  // Default 64.
-  int focal_search_steps = 64;
+  // Default 40.
+  int focal_search_steps = 40;
+  // Golden-section iterations after the scan. Default 20.
+  int focal_search_refine_iterations = 20;
+  // Outlier rounds of the homography fits inside the focal search (the
+  // truncated cost already bounds the effect of outliers). Default 1.
+  int focal_search_reweight_iterations = 1;
   // Pixel errors above this are truncated in the focal-search cost, so that
   // outliers and badly fitting views cannot dominate it. Default 8 px.
   double focal_search_truncation_px = 8.0;
   // At most this many views (evenly spread over the input) take part in the
   // focal search; all views get a pose afterwards. Default 60.
   int focal_search_max_views = 60;
-  // Iterations of the per-view pose refinement (Ceres, Huber loss). Default 20.
-  int pose_refine_iterations = 20;
+  // Iterations of the per-view pose refinement (Ceres, Huber loss) after the
+  // homography pose. Default 0: the bundle adjustment refines the poses
+  // anyway, and the homography pose is close enough to start it.
+  int pose_refine_iterations = 0;
   // Huber scale of the pose refinement, pixels. Default 2.
   double pose_refine_loss_px = 2.0;
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "calib/camera_models.h"
+#include "tests/calib/opencv_reference.h"
 #include "tests/calib/synthetic_views.h"
 
 namespace puzzlecal {
@@ -49,6 +50,10 @@ SyntheticScene PinholeScene(const Camera& camera) {
   scene.num_views = 20;
   scene.max_direction_deg = 32;
   scene.min_visible_fraction = 1.0;
+  scene.min_tilt_deg = 20;
+  scene.max_tilt_deg = 60;
+  scene.min_distance = 0.8;
+  scene.max_distance = 1.6;
   return scene;
 }
 
@@ -66,10 +71,12 @@ SyntheticScene FisheyeScene() {
   return scene;
 }
 
-struct ModelCase {
-  const char* name;
-  SyntheticScene scene;
-};
+bool RunCalibration(const SyntheticData& data, const SyntheticScene& scene,
+                    const CalibrationOptions& options, CalibrationResult* result,
+         std::string* error) {
+  return Calibrate(data.views, scene.camera.model, scene.camera.width,
+                   scene.camera.height, options, result, error);
+}
 
 class AccuracyTest : public ::testing::TestWithParam<int> {};
 
@@ -110,6 +117,308 @@ TEST_P(AccuracyTest, ReachesTheNoiseFloor) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, AccuracyTest, ::testing::Values(0, 1, 2));
+
+
+// cv::calibrateCamera / cv::fisheye::calibrate on the same correspondences.
+// Where OpenCV converges, both minimise the same reprojection error, so the
+// parameters must agree well inside their standard deviations.
+TEST_P(AccuracyTest, AgreesWithOpenCvWhereOpenCvConverges) {
+  SyntheticScene scene = SceneFor(GetParam());
+  if (scene.camera.model == CameraModelId::kKannalaBrandt) {
+    // OpenCV's fisheye model divides by z: keep every corner within 80
+    // degrees of the axis so that OpenCV has a chance.
+    scene.max_direction_deg = 45;
+    scene.max_corner_angle_deg = 80;
+  }
+  const SyntheticData data = MakeSyntheticData(scene);
+  CalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(RunCalibration(data, scene, CalibrationOptions(), &result, &error)) << error;
+  const testing::OpenCvCalibration cv = testing::CalibrateWithOpenCv(
+      data.views, scene.camera.model, scene.camera.width, scene.camera.height);
+  ASSERT_TRUE(cv.ok) << cv.error;
+  const std::vector<std::string> names =
+      CameraModelParamNames(scene.camera.model);
+  for (size_t k = 0; k < names.size(); ++k) {
+    std::printf("%-3s truth %12.6f puzzlecal %12.6f (+- %.2g) opencv %12.6f\n",
+                names[k].c_str(), scene.camera.params[k],
+                result.camera.params[k], result.param_stddev[k], cv.params[k]);
+  }
+  std::printf("rms per corner: puzzlecal %.5f opencv %.5f\n",
+              result.rms_point_px, cv.rms_point_px);
+  EXPECT_NEAR(cv.rms_point_px, result.rms_point_px,
+              1e-3 * result.rms_point_px);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NEAR(result.camera.params[k], cv.params[k],
+                0.2 * result.param_stddev[k])
+        << names[k];
+  }
+}
+
+// The 190 degree lens with corners up to 95 degrees off the axis: OpenCV's
+// fisheye model cannot represent rays beyond 90 degrees and starts from
+// f = max(w, h) / pi; puzzlecal must still reach the truth.
+TEST(CalibrateTest, FisheyeBeyondNinetyDegreesWhereOpenCvFails) {
+  const SyntheticScene scene = FisheyeScene();
+  const SyntheticData data = MakeSyntheticData(scene);
+  int beyond_90 = 0;
+  for (size_t v = 0; v < data.views.size(); ++v) {
+    for (const auto& b : data.views[v].board_points) {
+      beyond_90 += (data.cam_from_board[v] * b).z() <= 0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(beyond_90, 0) << "the scene should reach beyond 90 degrees";
+  CalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(RunCalibration(data, scene, CalibrationOptions(), &result, &error)) << error;
+  ExpectAccurate(scene.camera, result, scene.noise_px);
+  const testing::OpenCvCalibration cv = testing::CalibrateWithOpenCv(
+      data.views, scene.camera.model, scene.camera.width, scene.camera.height);
+  if (!cv.ok) {
+    std::printf("opencv fisheye::calibrate failed: %s\n", cv.error.c_str());
+  } else {
+    std::printf("opencv fisheye::calibrate: fx %.3f (truth %.3f) rms %.3f px; "
+                "puzzlecal fx %.3f rms %.3f px (%d corners beyond 90 deg)\n",
+                cv.params[0], scene.camera.params[0], cv.rms_point_px,
+                result.camera.params[0], result.rms_point_px, beyond_90);
+  }
+}
+
+TEST(CalibrateTest, GrossOutliersAreRejectedAndReported) {
+  for (int model = 0; model < 3; ++model) {
+    SyntheticScene scene = SceneFor(model);
+    scene.outlier_fraction = 0.05;
+    const SyntheticData data = MakeSyntheticData(scene);
+    int injected = 0;
+    for (const auto& view : data.is_outlier) {
+      for (bool o : view) injected += o ? 1 : 0;
+    }
+    ASSERT_GT(injected, 40);
+    CalibrationResult result;
+    std::string error;
+    ASSERT_TRUE(RunCalibration(data, scene, CalibrationOptions(), &result, &error))
+        << error;
+    SCOPED_TRACE(CameraModelName(scene.camera.model));
+    ExpectAccurate(scene.camera, result, scene.noise_px);
+    // Every injected outlier is flagged; at most a few good corners are.
+    int missed = 0, false_alarms = 0;
+    for (size_t v = 0; v < data.views.size(); ++v) {
+      for (size_t i = 0; i < data.is_outlier[v].size(); ++i) {
+        if (data.is_outlier[v][i] && result.inlier[v][i]) ++missed;
+        if (!data.is_outlier[v][i] && !result.inlier[v][i]) ++false_alarms;
+      }
+    }
+    EXPECT_EQ(missed, 0);
+    EXPECT_LE(false_alarms, 3);
+    EXPECT_EQ(result.num_outliers, injected - missed + false_alarms);
+    EXPECT_GE(result.outlier_rounds, 1);
+  }
+}
+
+TEST(CalibrateTest, PartialViewsAreUsedFully) {
+  SyntheticScene scene = PinholeScene(testing::TruthRadtan());
+  scene.max_direction_deg = 50;  // boards cut by the image border
+  scene.min_visible_fraction = 0.25;
+  const SyntheticData data = MakeSyntheticData(scene);
+  int partial = 0;
+  for (const auto& view : data.views) {
+    partial += view.board_points.size() < 88 ? 1 : 0;
+  }
+  ASSERT_GE(partial, 5);
+  CalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(RunCalibration(data, scene, CalibrationOptions(), &result, &error)) << error;
+  EXPECT_EQ(result.num_views_used, scene.num_views);
+  EXPECT_GE(result.num_corners_used, data.num_corners - 3);
+  ExpectAccurate(scene.camera, result, scene.noise_px);
+}
+
+TEST(CalibrateTest, ResidualsAndPosesMatchTheTruth) {
+  const SyntheticScene scene = SceneFor(0);
+  const SyntheticData data = MakeSyntheticData(scene);
+  CalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(RunCalibration(data, scene, CalibrationOptions(), &result, &error)) << error;
+  ASSERT_EQ(result.cam_from_board.size(), data.views.size());
+  for (size_t v = 0; v < data.views.size(); ++v) {
+    const Eigen::Isometry3d diff =
+        result.cam_from_board[v] * data.cam_from_board[v].inverse();
+    EXPECT_LT(Eigen::AngleAxisd(diff.linear()).angle(), 2e-3) << v;
+    EXPECT_LT((result.cam_from_board[v].translation() -
+               data.cam_from_board[v].translation()).norm(),
+              2e-3 * data.cam_from_board[v].translation().norm())
+        << v;
+    ASSERT_EQ(result.residuals[v].size(), data.views[v].image_points.size());
+    // The residual is the projection minus the observation.
+    const size_t i = data.views[v].image_points.size() / 2;
+    Eigen::Vector2d pixel;
+    ASSERT_TRUE(result.camera.Project(
+        result.cam_from_board[v] * data.views[v].board_points[i], &pixel));
+    EXPECT_NEAR((pixel - data.views[v].image_points[i] - result.residuals[v][i])
+                    .norm(), 0, 1e-9);
+  }
+}
+
+TEST(CalibrateTest, SameResultForAnyThreadCount) {
+  const SyntheticScene scene = SceneFor(2);
+  const SyntheticData data = MakeSyntheticData(scene);
+  std::vector<std::vector<double>> params;
+  for (int threads : {1, 2, 4}) {
+    CalibrationOptions options;
+    options.num_threads = threads;  // deterministic by default
+    CalibrationResult result;
+    std::string error;
+    ASSERT_TRUE(RunCalibration(data, scene, options, &result, &error)) << error;
+    params.push_back(result.camera.params);
+    params.back().insert(params.back().end(), result.param_stddev.begin(),
+                         result.param_stddev.end());
+    params.back().push_back(result.rms_px);
+  }
+  for (size_t k = 0; k < params[0].size(); ++k) {
+    EXPECT_EQ(params[0][k], params[1][k]) << k;
+    EXPECT_EQ(params[0][k], params[2][k]) << k;
+  }
+}
+
+// Without the deterministic switch the threads change only the last bits.
+TEST(CalibrateTest, MultiThreadedSolveAgreesClosely) {
+  const SyntheticScene scene = SceneFor(0);
+  const SyntheticData data = MakeSyntheticData(scene);
+  CalibrationOptions options;
+  CalibrationResult single, multi;
+  std::string error;
+  ASSERT_TRUE(RunCalibration(data, scene, options, &single, &error)) << error;
+  options.deterministic = false;
+  options.num_threads = 2;
+  ASSERT_TRUE(RunCalibration(data, scene, options, &multi, &error)) << error;
+  for (size_t k = 0; k < single.camera.params.size(); ++k) {
+    EXPECT_NEAR(single.camera.params[k], multi.camera.params[k],
+                1e-3 * single.param_stddev[k])
+        << k;
+  }
+}
+
+TEST(CalibrateTest, FixedParametersStayFixed) {
+  const SyntheticScene scene = SceneFor(0);
+  const SyntheticData data = MakeSyntheticData(scene);
+  {
+    CalibrationOptions options;
+    options.fixed_params = {"k3"};
+    CalibrationResult result;
+    std::string error;
+    ASSERT_TRUE(RunCalibration(data, scene, options, &result, &error)) << error;
+    EXPECT_EQ(result.camera.params[8], 0.0);
+    EXPECT_EQ(result.param_stddev[8], 0.0);
+    EXPECT_TRUE(result.param_fixed[8]);
+    EXPECT_GT(result.param_stddev[4], 0.0);
+  }
+  {
+    // Distortion given and held: only f, c and the poses move.
+    CalibrationOptions options;
+    options.initial_params = scene.camera.params;
+    options.initial_params[0] *= 1.05;
+    options.initial_params[2] += 20;
+    options.fix_distortion = true;
+    CalibrationResult result;
+    std::string error;
+    ASSERT_TRUE(RunCalibration(data, scene, options, &result, &error)) << error;
+    for (int k = 4; k < 9; ++k) {
+      EXPECT_EQ(result.camera.params[k], scene.camera.params[k]);
+    }
+    EXPECT_NEAR(result.camera.params[0], scene.camera.params[0], 0.5);
+    EXPECT_NEAR(result.camera.params[2], scene.camera.params[2], 0.5);
+  }
+}
+
+TEST(CalibrateTest, TooFewViewsFailWithAReason) {
+  SyntheticScene scene = SceneFor(0);
+  scene.num_views = 2;
+  const SyntheticData data = MakeSyntheticData(scene);
+  CalibrationResult result;
+  std::string error;
+  EXPECT_FALSE(RunCalibration(data, scene, CalibrationOptions(), &result, &error));
+  EXPECT_NE(error.find("only 2 usable views"), std::string::npos) << error;
+  EXPECT_FALSE(Calibrate({}, CameraModelId::kPinholeRadtan, 640, 480,
+                         CalibrationOptions(), &result, &error));
+  EXPECT_NE(error.find("only 0 usable views"), std::string::npos) << error;
+}
+
+TEST(CalibrateTest, FrontoParallelViewsFailWithAReason) {
+  SyntheticScene scene = SceneFor(0);
+  scene.fronto_parallel = true;
+  scene.max_direction_deg = 25;
+  const SyntheticData data = MakeSyntheticData(scene);
+  ASSERT_EQ(static_cast<int>(data.views.size()), scene.num_views);
+  CalibrationResult result;
+  std::string error;
+  EXPECT_FALSE(RunCalibration(data, scene, CalibrationOptions(), &result, &error));
+  EXPECT_NE(error.find("tilted by 30 degrees"), std::string::npos) << error;
+  std::printf("%s\n", result.report.c_str());
+}
+
+TEST(CalibrateTest, ViewsAtOneSpotFailWithAReason) {
+  SyntheticScene scene = SceneFor(0);
+  scene.max_direction_deg = 2;
+  scene.min_distance = 6;
+  scene.max_distance = 7;
+  const SyntheticData data = MakeSyntheticData(scene);
+  ASSERT_EQ(static_cast<int>(data.views.size()), scene.num_views);
+  CalibrationResult result;
+  std::string error;
+  EXPECT_FALSE(RunCalibration(data, scene, CalibrationOptions(), &result, &error));
+  EXPECT_NE(error.find("move the board towards the corners"),
+            std::string::npos)
+      << error;
+}
+
+TEST(CalibrateTest, BadCorrespondencesAreSkippedWithAReason) {
+  const SyntheticScene scene = SceneFor(0);
+  SyntheticData data = MakeSyntheticData(scene);
+  data.views[0].image_points[5].x() = std::nan("");
+  data.views[1].image_points.pop_back();  // sizes differ
+  data.views[2].board_points.resize(3);   // too few corners
+  data.views[2].image_points.resize(3);
+  CalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(RunCalibration(data, scene, CalibrationOptions(), &result, &error)) << error;
+  EXPECT_TRUE(result.view_used[0]);
+  EXPECT_FALSE(result.inlier[0][5]);
+  EXPECT_FALSE(result.view_used[1]);
+  EXPECT_NE(result.view_reason[1].find("image points"), std::string::npos);
+  EXPECT_FALSE(result.view_used[2]);
+  EXPECT_NE(result.view_reason[2].find("only 3 corners"), std::string::npos);
+  EXPECT_EQ(result.num_views_used, scene.num_views - 2);
+  EXPECT_NE(result.report.find("synthetic_1"), std::string::npos);
+}
+
+TEST(CalibrateTest, InvalidOptionsAndInputsAreRejected) {
+  const SyntheticScene scene = SceneFor(0);
+  const SyntheticData data = MakeSyntheticData(scene);
+  CalibrationResult result;
+  std::string error;
+  CalibrationOptions options;
+  options.loss_scale_px = -1;
+  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
+  EXPECT_NE(error.find("loss_scale_px"), std::string::npos);
+  options = CalibrationOptions();
+  options.fixed_params = {"k9"};
+  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
+  EXPECT_NE(error.find("k9"), std::string::npos);
+  EXPECT_FALSE(Calibrate(data.views, CameraModelId::kPinholeRadtan, 0, 480,
+                         CalibrationOptions(), &result, &error));
+  EXPECT_NE(error.find("image size"), std::string::npos);
+}
+
+TEST(CalibrateTest, RobustLossNames) {
+  for (RobustLoss loss :
+       {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy}) {
+    RobustLoss parsed;
+    ASSERT_TRUE(RobustLossFromName(RobustLossName(loss), &parsed));
+    EXPECT_EQ(parsed, loss);
+  }
+  RobustLoss parsed;
+  EXPECT_FALSE(RobustLossFromName("tukey", &parsed));
+}
 
 }  // namespace
 }  // namespace puzzlecal

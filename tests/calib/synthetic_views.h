@@ -41,6 +41,9 @@ struct SyntheticScene {
   // Largest angle of a visible corner from the optical axis, degrees (the
   // lens' half field of view).
   double max_corner_angle_deg = 180;
+  // Board plane parallel to the image plane in every view (a degenerate
+  // set: the focal length is undetermined).
+  bool fronto_parallel = false;
   unsigned seed = 1;
 };
 
@@ -106,9 +109,11 @@ inline SyntheticData MakeSyntheticData(const SyntheticScene& scene) {
                               std::sin(theta) * std::sin(phi), cos_theta);
     // Board z along the viewing ray, then tilted about an axis across it.
     const Eigen::Matrix3d face =
-        Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), dir)
-            .toRotationMatrix();
-    const double tilt =
+        scene.fronto_parallel
+            ? Eigen::Matrix3d::Identity()
+            : Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), dir)
+                  .toRotationMatrix();
+    const double tilt = scene.fronto_parallel ? 0.0 :
         (scene.min_tilt_deg +
          uniform(rng) * (scene.max_tilt_deg - scene.min_tilt_deg)) * deg;
     const double axis_angle = 2 * M_PI * uniform(rng);
