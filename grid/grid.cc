@@ -68,6 +68,8 @@ bool GridOptions::Check(std::string* why) const {
   if (!(line_prediction_tolerance > 0 &&
         std::isfinite(line_prediction_tolerance)))
     return Fail(why, "line_prediction_tolerance must be finite and > 0");
+  if (!(saddle_sample_fraction > 0 && saddle_sample_fraction < 0.5))
+    return Fail(why, "saddle_sample_fraction must be in (0, 0.5)");
   if (min_component_size < 1)
     return Fail(why, "min_component_size must be >= 1");
   return true;
@@ -203,7 +205,8 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
 
   phase_start = std::chrono::steady_clock::now();
   std::vector<GridComponent> components =
-      ExtractComponents(nodes.xy, forest, options, &summary);
+      ExtractComponents(nodes.xy, summary.image_used ? image : cv::Mat(),
+                        forest, options, &summary);
   summary.cleanup_ms = MillisecondsSince(phase_start);
 
   summary.num_components = static_cast<int>(components.size());

@@ -82,9 +82,16 @@ struct GridOptions {
   // trees that an earlier pass refused (the trees have grown since).
   int kruskal_passes = 2;
 
-  // Final pass: a corner is predicted from the next two corners on each of
-  // its lattice lines (linear extrapolation). A prediction holds when the
-  // error is at most this fraction of the spacing of those two corners.
+  // Final pass, with an image: a corner stays only when the four tiles
+  // around it alternate dark/light (sampled at this fraction of the lattice
+  // diagonals from it): drops L-junctions at the board's border and clutter.
+  bool check_saddle_pattern = true;
+  double saddle_sample_fraction = 0.3;
+  // Final pass: a corner is predicted from the next three corners on each of
+  // its lattice lines (quadratic extrapolation); the prediction holds when
+  // the error is at most this fraction of the spacing of the nearest two.
+  // With only two further corners the merge's collinearity test is used.
+  // Corners contradicted by more lines than support them are removed.
   double line_prediction_tolerance = 0.35;
   // Components with fewer corners are dropped (not returned).
   int min_component_size = 4;
@@ -120,6 +127,7 @@ struct GridSummary {
   int num_rejected_collinearity = 0;            // lines bend or jump
 
   // Final pass.
+  int num_removed_not_saddle = 0;     // tiles around it do not alternate
   int num_removed_by_prediction = 0;  // corners their lines did not predict
   int num_components_dropped = 0;     // below min_component_size
   int num_components = 0;             // returned

@@ -5,6 +5,7 @@
 // lattice lines predict it; components that fall apart are split.
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 #include <vector>
 
 #include "grid/grid.h"
@@ -12,14 +13,17 @@
 
 namespace puzzlecal {
 
-// Turns the forest into components: removes corners whose lattice lines
+// Turns the forest into components: removes corners whose four tiles do not
+// alternate like a checkerboard's (when `image` is not empty) and corners
+// whose lattice lines
 // contradict them more often than they support them (repeatedly), splits
 // trees into 4-connected label sets, drops sets smaller than
 // options.min_component_size, shifts labels to start at (0, 0) and sorts the
 // components (largest first, ties by smallest corner index).
 std::vector<GridComponent> ExtractComponents(
-    const std::vector<Eigen::Vector2d>& xy, const LatticeForest& forest,
-    const GridOptions& options, GridSummary* summary);
+    const std::vector<Eigen::Vector2d>& xy, const cv::Mat& image,
+    const LatticeForest& forest, const GridOptions& options,
+    GridSummary* summary);
 
 }  // namespace puzzlecal
 

@@ -3,13 +3,13 @@
 // the fuzz target, in the normal build: BuildGrid and DecodeBoard must keep
 // their promises (valid indices, one label per corner, ids inside the board).
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "fuzz/grid_decode_case.h"
 
