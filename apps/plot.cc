@@ -140,13 +140,14 @@ void DrawTitle(cv::Mat* canvas, const std::string& title,
 }
 
 void DrawAxes(cv::Mat* canvas, const Frame& frame, const std::string& x_label,
-              const std::string& y_label, bool grid) {
+              const std::string& y_label, bool grid, bool x_ticks_on) {
   const cv::Rect& a = frame.area;
   const int tick = 5;
   const int x_target = std::max(2, a.width / 110);
   const int y_target = std::max(2, a.height / 70);
   const std::vector<double> x_ticks =
-      NiceTicks(frame.x_min, frame.x_max, x_target);
+      x_ticks_on ? NiceTicks(frame.x_min, frame.x_max, x_target)
+                 : std::vector<double>();
   const std::vector<double> y_ticks =
       NiceTicks(std::min(frame.y_min, frame.y_max),
                 std::max(frame.y_min, frame.y_max), y_target);

@@ -77,9 +77,10 @@ void DrawTitle(cv::Mat* canvas, const std::string& title,
                const std::string& subtitle);
 
 // Frame border, ticks with labels, optional light grid lines, and the axis
-// labels below and left of the frame.
+// labels below and left of the frame. x_ticks false leaves the x axis bare
+// (for charts that label their categories themselves).
 void DrawAxes(cv::Mat* canvas, const Frame& frame, const std::string& x_label,
-              const std::string& y_label, bool grid);
+              const std::string& y_label, bool grid, bool x_ticks = true);
 
 // Colour of `t` in [0, 1] (clamped) under an OpenCV colour map
 // (cv::COLORMAP_*).

@@ -212,13 +212,21 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
   // Draw inside the plot area only: arrows of outliers may leave it.
   cv::Mat area = canvas(frame.area);
   const cv::Point2d origin(frame.area.x, frame.area.y);
+  // Outliers can be off by tens of pixels: their arrows are cut to this
+  // length (canvas pixels) so they do not hide the rest.
+  const double outlier_cap = std::max(40.0, 3 * p95 * arrow_scale * layout.scale);
+  int num_capped = 0;
   auto draw = [&](const ResidualSample& s, const cv::Scalar& colour) {
     const cv::Point2d from =
         frame.ToCanvas(s.detected.x(), s.detected.y()) - origin;
     const Eigen::Vector2d tip_image = s.detected + arrow_scale * s.residual;
-    const cv::Point2d to =
-        frame.ToCanvas(tip_image.x(), tip_image.y()) - origin;
-    const double length = std::hypot(to.x - from.x, to.y - from.y);
+    cv::Point2d to = frame.ToCanvas(tip_image.x(), tip_image.y()) - origin;
+    double length = std::hypot(to.x - from.x, to.y - from.y);
+    if (!s.inlier && length > outlier_cap) {
+      to = from + (to - from) * (outlier_cap / length);
+      length = outlier_cap;
+      ++num_capped;
+    }
     if (length < 1.5) {
       cv::circle(area, Fixed(from), 1 << kShift, colour, cv::FILLED,
                  cv::LINE_AA, kShift);
@@ -258,7 +266,11 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
                  plot::kTickScale, plot::kBlack);
   DrawNote(&layout, 1,
            "Each arrow starts at a detected corner and points to where the "
-           "calibrated model reprojects it.");
+           "calibrated model reprojects it." +
+               (num_capped > 0
+                    ? Format(" %d outlier arrows are cut to %.0f px.",
+                             num_capped, outlier_cap)
+                    : std::string()));
   DrawNote(&layout, 2,
            "Random directions = noise; arrows aligned over a region = model "
            "error there (try another model) or a bent board.");
@@ -297,8 +309,9 @@ cv::Mat PlotCoverage(const ReportData& data, const ReportOptions& options) {
       if (n == 0) ++empty;
       const cv::Scalar colour =
           n == 0 ? plot::kWhite
-                 : plot::ColourMapValue(cv::COLORMAP_VIRIDIS,
-                                        static_cast<double>(n) / max_count);
+                 : plot::ColourMapValue(
+                       cv::COLORMAP_VIRIDIS,
+                       max_count > 1 ? (n - 1.0) / (max_count - 1) : 1.0);
       cv::rectangle(area, cv::Rect(a, b), colour, cv::FILLED);
       cv::rectangle(area, cv::Rect(a, b), plot::kLightGrey, 1);
     }
@@ -306,8 +319,8 @@ cv::Mat PlotCoverage(const ReportData& data, const ReportOptions& options) {
   plot::DrawAxes(&canvas, frame, "x (px)", "y (px)", false);
   const cv::Rect bar(frame.area.x + frame.area.width + 20, frame.area.y, 22,
                      frame.area.height);
-  plot::DrawColourBar(&canvas, bar, 0, std::max(1, max_count),
-                      cv::COLORMAP_VIRIDIS, "used corners per cell");
+  plot::DrawColourBar(&canvas, bar, 1, std::max(2, max_count),
+                      cv::COLORMAP_VIRIDIS, "used corners per cell (white: 0)");
   plot::DrawTitle(
       &canvas,
       Format("Coverage: used corners per %.0f x %.0f px cell", cell, cell),
@@ -375,6 +388,7 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
     return grid.at<double>(std::lround(fy) ? j1 : j0,
                            std::lround(fx) ? i1 : i0);
   };
+  int num_without_ray = 0;
   for (int v = 0; v < a.height; ++v) {
     for (int u = 0; u < a.width; ++u) {
       const double x = (u + 0.5) / layout.scale - 0.5;
@@ -384,6 +398,7 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
       const double t = sample(theta, gx, gy);
       theta_plot.at<double>(v, u) = t;
       cv::Vec3b colour(170, 170, 170);  // no ray
+      if (!std::isfinite(m)) ++num_without_ray;
       if (std::isfinite(m)) {
         const int index = static_cast<int>(
             std::lround(std::clamp(m / colour_max, 0.0, 1.0) * 255));
@@ -414,7 +429,7 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
   for (double level : levels) {
     const cv::Vec3b line_colour(255, 255, 255);
     const int width = level == 90 ? 2 : 1;
-    int label_u = -1;
+    int label_u = -1, label_v = -1;
     for (int v = 0; v + 1 < a.height; ++v) {
       for (int u = 0; u + 1 < a.width; ++u) {
         const double t = theta_plot.at<double>(v, u);
@@ -429,12 +444,22 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
             canvas.at<cv::Vec3b>(a.y + v + dv, a.x + u + du) = line_colour;
           }
         }
-        if (v == label_row && u > label_u) label_u = u;
+        // Label where the line is nearest the principal point's row (the
+        // right-most such place).
+        if (label_v < 0 || std::abs(v - label_row) < std::abs(label_v - label_row) ||
+            (std::abs(v - label_row) == std::abs(label_v - label_row) &&
+             u > label_u)) {
+          label_u = u;
+          label_v = v;
+        }
       }
     }
     if (label_u >= 0) {
       const std::string text = Format("%.0f deg", level);
-      const cv::Point anchor(a.x + label_u + 4, a.y + label_row - 4);
+      const cv::Size size = plot::TextSize(text, plot::kTickScale);
+      const cv::Point anchor(
+          a.x + std::clamp(label_u + 4, 2, a.width - size.width - 4),
+          a.y + std::clamp(label_v - 4, size.height + 4, a.height - 4));
       plot::DrawText(&canvas, text, anchor, plot::kTickScale, plot::kBlack,
                      Align::kLeft, 3);
       plot::DrawText(&canvas, text, anchor, plot::kTickScale, plot::kWhite);
@@ -467,12 +492,14 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
                             "(behind the image plane)."
                           : ""));
   DrawNote(&layout, 1,
-           "Grey: the model has no ray for these pixels (outside its valid "
-           "field of view).");
-  DrawNote(&layout, 2,
-           Format("Computed every %d px and interpolated; principal point "
-                  "(%.1f, %.1f).",
-                  step, principal.x(), principal.y()));
+           Format("Red cross: principal point (%.1f, %.1f). Computed every %d "
+                  "px and interpolated.",
+                  principal.x(), principal.y(), step));
+  if (num_without_ray > 0) {
+    DrawNote(&layout, 2,
+             "Grey: the model has no ray for these pixels (its distortion "
+             "cannot be inverted there).");
+  }
   cv::drawMarker(canvas, frame.ToCanvasPixel(principal.x(), principal.y()),
                  plot::kRed, cv::MARKER_CROSS, 14, 2, cv::LINE_AA);
   return canvas;
@@ -494,17 +521,17 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   const int bins = options.histogram_bins;
   const double width = range / bins;
   std::vector<int> inliers(bins, 0), outliers(bins, 0);
-  int beyond = 0;
-  auto add = [&](double norm, std::vector<int>* counts) {
+  int inliers_beyond = 0, outliers_beyond = 0;
+  auto add = [&](double norm, std::vector<int>* counts, int* beyond) {
     const int bin = static_cast<int>(norm / width);
     if (bin >= bins) {
-      ++beyond;
+      ++*beyond;
     } else {
       ++(*counts)[std::max(0, bin)];
     }
   };
-  for (double n : inlier_norms) add(n, &inliers);
-  for (double n : outlier_norms) add(n, &outliers);
+  for (double n : inlier_norms) add(n, &inliers, &inliers_beyond);
+  for (double n : outlier_norms) add(n, &outliers, &outliers_beyond);
   // Expected counts for Gaussian noise of sigma per coordinate: the error
   // length then follows a Rayleigh distribution.
   std::vector<double> expected(bins, 0);
@@ -554,12 +581,17 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   plot::DrawTitle(
       &canvas, "Residual lengths",
       Format("%zu used corners, %zu outliers; RMS %.3f px per coordinate; "
-             "median %.3f px, 95 %% below %.3f px%s",
+             "median length %.3f px, 95 %% below %.3f px",
              inlier_norms.size(), outlier_norms.size(), sigma,
-             Percentile(inlier_norms, 0.5), Percentile(inlier_norms, 0.95),
-             beyond > 0 ? Format("; %d beyond %.2f px not shown", beyond,
-                                 range).c_str()
-                        : ""));
+             Percentile(inlier_norms, 0.5), Percentile(inlier_norms, 0.95)));
+  if (inliers_beyond + outliers_beyond > 0) {
+    plot::DrawText(&canvas,
+                   Format("not shown: %d used corners and %d outliers beyond "
+                          "%.3g px",
+                          inliers_beyond, outliers_beyond, range),
+                   {frame.area.x + 10, frame.area.y + 22}, plot::kTickScale,
+                   plot::kBlack);
+  }
   const std::vector<plot::LegendEntry> legend = {
       {plot::LegendEntry::Marker::kBox, plot::kBlue, "used corners"},
       {plot::LegendEntry::Marker::kBox, plot::kRed, "outliers (dropped)"},
@@ -594,7 +626,8 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
   frame.x_max = std::max(1, num_views) + 0.5;
   frame.y_min = 0;
   frame.y_max = highest > 0 ? 1.12 * highest : 1;
-  plot::DrawAxes(&canvas, frame, "", "RMS per coordinate (px)", true);
+  plot::DrawAxes(&canvas, frame, "", "RMS per coordinate (px)", true,
+                 /*x_ticks=*/false);
   const double bar_width =
       std::max(1.0, 0.75 * frame.area.width / std::max(1, num_views));
   const int label_every = std::max(1, (num_views + 29) / 30);
@@ -641,7 +674,7 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
   const std::vector<plot::LegendEntry> legend = {
       {plot::LegendEntry::Marker::kBox, plot::kBlue, "view RMS"},
       {plot::LegendEntry::Marker::kBox, plot::kOrange,
-       Format("view RMS above %gx overall: check its overlay / image",
+       Format("view RMS above %gx overall (dotted): check the image",
               options.high_rms_factor)},
       {plot::LegendEntry::Marker::kDashedLine, plot::kRed,
        Format("overall RMS %.3f px", overall)},
@@ -671,16 +704,13 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
                       data.view_file[v].c_str(), grey.cols, grey.rows,
                       data.width, data.height);
   }
-  const double scale =
-      grey.cols > options.overlay_max_width
-          ? static_cast<double>(options.overlay_max_width) / grey.cols
-          : 1.0;
+  const double scale = static_cast<double>(options.overlay_width) / grey.cols;
+  const cv::Size scaled_size(
+      options.overlay_width,
+      std::max(1, static_cast<int>(std::lround(grey.rows * scale))));
   cv::Mat small;
-  if (scale < 1) {
-    cv::resize(grey, small, cv::Size(), scale, scale, cv::INTER_AREA);
-  } else {
-    small = grey;
-  }
+  cv::resize(grey, small, scaled_size, 0, 0,
+             scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
   // Fade the photo so the markers stand out.
   cv::Mat faded;
   small.convertTo(faded, CV_8U, 0.6, 50);
@@ -693,7 +723,7 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
   auto to_canvas = [&](const Eigen::Vector2d& p) {
     return cv::Point2d((p.x() + 0.5) * scale - 0.5, (p.y() + 0.5) * scale - 0.5);
   };
-  const int radius = std::max(3, static_cast<int>(std::lround(5 * scale)));
+  const int radius = 6;
   int inliers = 0, outliers = 0;
   const bool has_pose = v < static_cast<int>(result.cam_from_board.size());
   const Eigen::Isometry3d pose =
@@ -704,9 +734,9 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
     const bool inlier = result.inlier[v][i];
     (inlier ? inliers : outliers)++;
     const cv::Point2d detected = to_canvas(xy);
-    cv::circle(image_area, Fixed(detected), radius << kShift,
-               inlier ? plot::kGreen : plot::kRed, inlier ? 1 : 2, cv::LINE_AA,
-               kShift);
+    cv::circle(image_area, Fixed(detected), (inlier ? radius : radius + 3)
+                                                << kShift,
+               inlier ? plot::kGreen : plot::kRed, 2, cv::LINE_AA, kShift);
     Eigen::Vector2d projected;
     if (data.camera_valid && has_pose &&
         result.camera.Project(pose * view.board_points[i], &projected) &&
@@ -716,8 +746,7 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
         cv::line(image_area, Fixed(detected), Fixed(p), plot::kRed, 1,
                  cv::LINE_AA, kShift);
       }
-      plot::DrawCross(&image_area, p, std::max(2, radius - 1),
-                      cv::Scalar(200, 0, 200), 1);
+      plot::DrawCross(&image_area, p, radius - 2, cv::Scalar(200, 0, 200), 1);
     }
   }
   const std::string name = FileName(data.view_file[v]);
@@ -731,17 +760,26 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
              "used, %d outliers",
              data.view_rms[v], result.rms_px, inliers, outliers),
       {12, 56}, plot::kLabelScale, cv::Scalar(60, 60, 60));
+  // Legend line; each entry placed after the previous one's text.
   const int y = canvas.rows - 15;
-  cv::circle(canvas, {20, y - 5}, 5, plot::kGreen, 1, cv::LINE_AA);
-  plot::DrawText(&canvas, "detected corner (used)", {32, y}, plot::kTickScale,
+  int x = 20;
+  cv::circle(canvas, {x, y - 5}, 5, plot::kGreen, 2, cv::LINE_AA);
+  x += 12;
+  const std::string used_text = "detected corner (used)";
+  plot::DrawText(&canvas, used_text, {x, y}, plot::kTickScale, plot::kBlack);
+  x += plot::TextSize(used_text, plot::kTickScale).width + 30;
+  cv::circle(canvas, {x, y - 5}, 5, plot::kRed, 2, cv::LINE_AA);
+  x += 12;
+  const std::string outlier_text = "outlier (line to its reprojection)";
+  plot::DrawText(&canvas, outlier_text, {x, y}, plot::kTickScale,
                  plot::kBlack);
-  cv::circle(canvas, {230, y - 5}, 5, plot::kRed, 2, cv::LINE_AA);
-  plot::DrawText(&canvas, "outlier (line to its reprojection)", {242, y},
-                 plot::kTickScale, plot::kBlack);
-  plot::DrawCross(&canvas, cv::Point2d(530, y - 5), 5, cv::Scalar(200, 0, 200),
+  x += plot::TextSize(outlier_text, plot::kTickScale).width + 30;
+  plot::DrawCross(&canvas, cv::Point2d(x, y - 5), 5, cv::Scalar(200, 0, 200),
                   1);
-  plot::DrawText(&canvas, "reprojected by the calibrated model", {542, y},
-                 plot::kTickScale, plot::kBlack);
+  plot::DrawText(&canvas,
+                 "reprojected by the calibrated model (should sit in the "
+                 "circle)",
+                 {x + 12, y}, plot::kTickScale, plot::kBlack);
   return canvas;
 }
 
@@ -755,7 +793,9 @@ std::string SafeStem(const std::string& file) {
   return stem.empty() ? "view" : stem;
 }
 
-// Views for the overlays: the worst first, then the best, each once.
+// Views for the overlays: the worst by RMS first (the second of them the
+// view with the most outliers, when there are outliers, so the user sees
+// what was dropped), then the best; each view once.
 std::vector<std::pair<int, std::string>> PickOverlayViews(
     const ReportData& data, int count) {
   std::vector<int> used;
@@ -765,16 +805,36 @@ std::vector<std::pair<int, std::string>> PickOverlayViews(
   std::stable_sort(used.begin(), used.end(), [&](int a, int b) {
     return data.view_rms[a] > data.view_rms[b];
   });
-  std::vector<std::pair<int, std::string>> picked;
   const int n = std::min<int>(count, used.size());
-  const int worst = (n + 1) / 2;
-  for (int k = 0; k < worst; ++k) {
-    picked.emplace_back(used[k], k == 0 ? "worst view"
-                                        : Format("%d. worst view", k + 1));
+  const int num_worst = (n + 1) / 2;
+  int most_outliers = -1;
+  for (int v : used) {
+    if (data.view_outliers[v] > 0 &&
+        (most_outliers < 0 ||
+         data.view_outliers[v] > data.view_outliers[most_outliers])) {
+      most_outliers = v;
+    }
   }
-  for (int k = 0; k < n - worst; ++k) {
-    picked.emplace_back(used[used.size() - 1 - k],
-                        k == 0 ? "best view" : Format("%d. best view", k + 1));
+  std::vector<std::pair<int, std::string>> picked;
+  std::set<int> taken;
+  auto take = [&](int v, const std::string& rank) {
+    if (taken.insert(v).second) picked.emplace_back(v, rank);
+  };
+  for (int k = 0; k < static_cast<int>(used.size()) &&
+                  static_cast<int>(picked.size()) < num_worst;
+       ++k) {
+    if (k == 1 && most_outliers >= 0 && !taken.count(most_outliers)) {
+      take(most_outliers, Format("most outliers: %d",
+                                 data.view_outliers[most_outliers]));
+      if (static_cast<int>(picked.size()) >= num_worst) break;
+    }
+    take(used[k], k == 0 ? "worst view" : Format("%d. worst view", k + 1));
+  }
+  for (int k = 0; k < static_cast<int>(used.size()) &&
+                  static_cast<int>(picked.size()) < n;
+       ++k) {
+    take(used[used.size() - 1 - k],
+         k == 0 ? "best view" : Format("%d. best view", k + 1));
   }
   return picked;
 }
@@ -819,7 +879,9 @@ bool ReportOptions::Check(std::string* why) const {
     return fail("chart_width must be in [400, 10000], chart_height in "
                 "[300, 10000]");
   }
-  if (overlay_max_width < 100) return fail("overlay_max_width must be >= 100");
+  if (overlay_width < 400 || overlay_width > 10000) {
+    return fail("overlay_width must be in [400, 10000]");
+  }
   if (!(high_rms_factor > 1) || !std::isfinite(high_rms_factor)) {
     return fail("high_rms_factor must be > 1");
   }
@@ -893,9 +955,9 @@ std::string ReportMarkdown(const ReportInput& input,
                input.images.size(), result.num_views_used,
                static_cast<int>(input.views->size()));
   md << Format("| corners used | %d (%d outliers dropped in %d rejection "
-               "rounds) |\n",
+               "round%s) |\n",
                result.num_corners_used, result.num_outliers,
-               result.outlier_rounds);
+               result.outlier_rounds, result.outlier_rounds == 1 ? "" : "s");
   md << Format("| board orientations | normals spread over %.1f deg |\n",
                result.orientation_spread_deg);
   md << Format("| coverage | %.0f %% of the cells of an 8 x 8 grid over the "
@@ -937,6 +999,10 @@ std::string ReportMarkdown(const ReportInput& input,
     return data.view_rms[a] > data.view_rms[b];
   });
   md << "## Worst views\n\n";
+  if (!used.empty()) {
+    md << Format("Highest RMS of the %zu used views (overall %.3f px).\n\n",
+                 used.size(), result.rms_px);
+  }
   if (used.empty()) {
     md << "No view was used.\n\n";
   } else {
@@ -994,12 +1060,18 @@ std::string ReportMarkdown(const ReportInput& input,
   md << "| whole run | " << Seconds(input.seconds_total) << " |\n\n";
   if (input.threads > 0) {
     md << "Reading and detection ran on " << input.threads
-       << " threads; their times are summed over the threads.\n\n";
+       << " threads; their times are summed over the images, so together "
+          "they can exceed the whole run.\n\n";
   }
 
   md << "## Plots\n\n";
   if (png_files.empty()) md << "No plots were drawn.\n";
+  std::vector<std::string> overlays;
   for (const std::string& file : png_files) {
+    if (file.rfind("overlay_", 0) == 0) {
+      overlays.push_back(file);
+      continue;
+    }
     md << "- `" << file << "`: ";
     if (file == "residuals.png") {
       md << "an arrow from every detected corner towards its reprojection, "
@@ -1027,10 +1099,21 @@ std::string ReportMarkdown(const ReportInput& input,
          << ". White lines mark the angle of the ray from the optical "
             "axis.\n";
     } else {
-      md << "a view with its detected corners (green; red = outlier) and "
-            "the reprojection of each by the calibrated model (magenta "
-            "crosses); they should coincide.\n";
+      md << "\n";
     }
+  }
+  if (!overlays.empty()) {
+    // PickOverlayViews order: the worst views first, then the best.
+    const size_t worst = (overlays.size() + 1) / 2;
+    md << "- ";
+    for (size_t k = 0; k < overlays.size(); ++k) {
+      md << (k == 0 ? "" : k == worst ? " and " : ", ") << "`" << overlays[k]
+         << "`" << (k + 1 == worst ? " (the worst views by RMS)" : "")
+         << (k + 1 == overlays.size() && k >= worst ? " (the best)" : "");
+    }
+    md << ": the view image with its detected corners (green circles; red = "
+          "outlier) and their reprojections by the calibrated model (magenta "
+          "crosses), which should sit inside the circles.\n";
   }
   return md.str();
 }

@@ -50,8 +50,9 @@ struct ReportOptions {
   // 1200 x 600.
   int chart_width = 1200;
   int chart_height = 600;
-  // Overlays wider than this are scaled down to it. Default 1600.
-  int overlay_max_width = 1600;
+  // Width in pixels of the overlays: view images are scaled (up or down) to
+  // it, so markers and text keep a readable size. Default 1400.
+  int overlay_width = 1400;
   // A view whose RMS exceeds this factor times the overall RMS is marked in
   // the per-view chart and the summary. Default 2.
   double high_rms_factor = 2.0;
@@ -73,9 +74,11 @@ struct ReportInput {
   std::string calibration_error;
   // Every input image, in input order.
   std::vector<ReportImage> images;
-  // Wall-clock split of the run in seconds (negative = not measured):
-  // reading and decoding image files, detection (corners, grid, decode),
-  // calibration, and the whole run; and the worker threads used.
+  // Time of the run in seconds (negative = not measured): reading and
+  // decoding image files and detection (corners, grid, board ids), both
+  // summed over the images (so with several threads they can exceed the
+  // run's wall-clock time); calibration and the whole run, wall-clock. And
+  // the worker threads used.
   double seconds_load = -1;
   double seconds_detect = -1;
   double seconds_calibrate = -1;

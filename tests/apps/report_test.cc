@@ -196,7 +196,8 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
         << name;
   }
 
-  // Overlays: the worst two and the best two views by RMS.
+  // Overlays: the worst view by RMS, the view with the most outliers, and
+  // the best two views.
   std::vector<int> by_rms;
   for (size_t v = 0; v < run.result.view_rms_px.size(); ++v) {
     if (run.result.view_used[v]) by_rms.push_back(static_cast<int>(v));
@@ -205,7 +206,19 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
     return run.result.view_rms_px[a] > run.result.view_rms_px[b];
   });
   ASSERT_GE(by_rms.size(), 4u);
-  const std::vector<int> expected_overlays = {by_rms[0], by_rms[1],
+  int most_outliers = -1, max_outliers = 0;
+  for (int v : by_rms) {
+    const auto& inlier = run.result.inlier[v];
+    const int outliers = static_cast<int>(
+        std::count(inlier.begin(), inlier.end(), false));
+    if (outliers > max_outliers) {
+      max_outliers = outliers;
+      most_outliers = v;
+    }
+  }
+  ASSERT_GE(most_outliers, 0);
+  ASSERT_NE(most_outliers, by_rms[0]) << "pick a scene where they differ";
+  const std::vector<int> expected_overlays = {by_rms[0], most_outliers,
                                               by_rms.end()[-1],
                                               by_rms.end()[-2]};
   int overlays = 0;
@@ -217,10 +230,12 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
     char name[32];
     std::snprintf(name, sizeof(name), "overlay_view_%02d.png", v);
     ASSERT_TRUE(fs::exists(report_dir / name)) << name;
+    // Scaled to overlay_width, the image's aspect kept, plus text bands.
     const cv::Size size = PngSize(report_dir / name);
-    EXPECT_EQ(size.width, 640) << name;
-    EXPECT_GT(size.height, 480) << name;
-    EXPECT_LT(size.height, 480 + 200) << name;
+    EXPECT_EQ(size.width, options.overlay_width) << name;
+    const double image_height = options.overlay_width * 480.0 / 640;
+    EXPECT_GT(size.height, image_height) << name;
+    EXPECT_LT(size.height, image_height + 200) << name;
   }
 
   const std::string markdown = ReadText(report_dir / "summary.md");
@@ -276,7 +291,7 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   EXPECT_NE(markdown.find("| whole run | 2.50 |"), std::string::npos);
   for (const std::string& file : summary.files) {
     if (file == "summary.md") continue;
-    EXPECT_NE(markdown.find("- `" + file + "`"), std::string::npos) << file;
+    EXPECT_NE(markdown.find("`" + file + "`"), std::string::npos) << file;
   }
   RemoveUnlessKept(dir);
 }
@@ -319,7 +334,7 @@ TEST(ReportTest, FisheyeRunWithMissingImagesStillWritesEverything) {
     EXPECT_TRUE(fs::exists(dir / "report" / file)) << file;
     if (file.rfind("overlay_", 0) == 0) {
       ++overlays;
-      EXPECT_EQ(PngSize(dir / "report" / file).width, 800);
+      EXPECT_EQ(PngSize(dir / "report" / file).width, options.overlay_width);
     }
   }
   EXPECT_EQ(overlays, 1);
