@@ -6,6 +6,7 @@
 // reflection and offset (as grid/ would label them).
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <functional>
@@ -184,6 +185,55 @@ int main() {
     std::printf("  \"time_23x16_view\": {\"corners\": %zu, \"decoded\": %s, "
                 "\"median_ms\": %.3f, \"median_of_batches_ms\": %.3f},\n",
                 grid.corners.size(), result.decoded ? "true" : "false", ms, best);
+  }
+
+  // --- Bit confidence (|disc - mid level| / half contrast) by tile size, and
+  // on a plain checkerboard (no discs), behind EdgeBitOptions::min_confidence.
+  {
+    std::printf("  \"bit_confidence\": {");
+    const int sizes[] = {4, 5, 6, 8, 12, 0};  // 0: plain checkerboard, 12 px
+    for (int si = 0; si < 6; ++si) {
+      const bool plain = sizes[si] == 0;
+      const int tile_px = plain ? 12 : sizes[si];
+      Board board = MakePuzzleBoard(72, 52, 100, 200, 0.01);
+      if (plain) {
+        board.type = BoardType::kCheckerboard;
+        board.origin = Eigen::Vector2i::Zero();
+      }
+      RenderOptions ro;
+      ro.noise_sigma = 0.03;
+      RenderTruth truth;
+      const Eigen::Vector2d centre(board.origin.x() + 35.5, board.origin.y() + 25.5);
+      const cv::Mat image = RenderBoard(board, PinholeCamera(1280, 960, 800),
+                                        LookAt(board, centre, 8.0 / tile_px, 15, 5), ro,
+                                        &truth);
+      const TruthGrid grid = OneComponentFromTruth(truth, Eigen::Matrix2i::Identity(), {0, 0});
+      LabelLattice lattice;
+      std::string why;
+      std::vector<double> magnitude, signed_correct;
+      if (BuildLabelLattice(grid.corners, grid.components[0], 4096, &lattice, &why)) {
+        const EdgeBitReading reading = ReadEdgeBits(lattice, image, EdgeBitOptions());
+        for (const EdgeBit& e : reading.edges) {
+          magnitude.push_back(std::abs(e.confidence));
+          if (plain) continue;
+          const int bit = e.axis == 0 ? PuzzleBoardHorizontalEdgeBit(e.from.x(), e.from.y())
+                                      : PuzzleBoardVerticalEdgeBit(e.from.x(), e.from.y());
+          signed_correct.push_back(bit ? e.confidence : -e.confidence);
+        }
+      }
+      std::printf("%s\"%s\": {\"edges\": %zu, \"abs_p05_p50_p95\": [%.2f, %.2f, %.2f]",
+                  si == 0 ? "" : ", ",
+                  plain ? "plain_checkerboard_12px" : (std::to_string(tile_px) + "px").c_str(),
+                  magnitude.size(), Quantile(magnitude, 0.05), Quantile(magnitude, 0.5),
+                  Quantile(magnitude, 0.95));
+      if (!plain) {
+        std::printf(", \"toward_true_bit_p01_p05_p50\": [%.2f, %.2f, %.2f]",
+                    Quantile(signed_correct, 0.01), Quantile(signed_correct, 0.05),
+                    Quantile(signed_correct, 0.5));
+      }
+      std::printf("}");
+    }
+    std::printf("},\n");
   }
 
   // --- Windows x tile sizes (72x52 board, 10 mm tiles, 15 deg tilt, noise). ---
