@@ -21,6 +21,16 @@ namespace puzzlecal {
 // outside [1, 20000].
 bool CheckRenderCamera(const Camera& camera, std::string* why = nullptr);
 
+// Where the camera model stays one-to-one: the largest undistorted radius
+// (pinhole models: |(x/z, y/z)|; kannala-brandt: the angle theta from the
+// axis, at most pi) up to which the radial distortion keeps increasing.
+// Beyond it the polynomial folds back and the image shows nothing real.
+double MaxMonotonicRadius(const Camera& camera);
+
+// The undistorted radius of a camera-frame direction in the sense of
+// MaxMonotonicRadius (infinity for pinhole rays with z <= 0).
+double UndistortedRadius(const Camera& camera, const Eigen::Vector3d& ray);
+
 class PixelRayGrid {
  public:
   // Unprojects the (width + 1) x (height + 1) pixel corners of `camera`.
@@ -34,7 +44,7 @@ class PixelRayGrid {
 
   // Unit ray in the camera frame through the pixel corner (cx - 0.5,
   // cy - 0.5), cx in [0, width], cy in [0, height]. NaN where Unproject did
-  // not converge (outside the model's image circle or fold-over region).
+  // not converge or lies beyond MaxMonotonicRadius (fold-over region).
   const double* Ray(int cx, int cy) const {
     return rays_.data() + 3 * (static_cast<size_t>(cy) * (camera_.width + 1) +
                                cx);

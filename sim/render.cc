@@ -103,6 +103,9 @@ bool RenderOptions::Check(std::string* why) const {
   if (!IsFiniteRange(noise_sigma, 0.0, 10.0)) {
     return fail("noise_sigma must be in [0, 10]");
   }
+  if (!IsFiniteRange(field_of_view_deg, 0.0, 360.0)) {
+    return fail("field_of_view_deg must be in [0, 360]");
+  }
   for (size_t i = 0; i < occluders.size(); ++i) {
     const Occluder& o = occluders[i];
     if (!o.center_px.allFinite() || !IsFiniteRange(o.radius_px, 0.0, 1e6) ||
@@ -117,8 +120,7 @@ bool RenderOptions::Check(std::string* why) const {
 
 std::vector<TruthCorner> ProjectBoardCorners(
     const Board& board, const Camera& camera,
-    const Eigen::Isometry3d& cam_from_board,
-    const std::vector<Occluder>& occluders) {
+    const Eigen::Isometry3d& cam_from_board, const RenderOptions& options) {
   std::vector<TruthCorner> corners;
   const std::vector<Eigen::Vector2i> ids = board.AllIds();
   corners.reserve(ids.size());
@@ -127,6 +129,7 @@ std::vector<TruthCorner> ProjectBoardCorners(
   const Eigen::Vector3d center_in_board =
       -(cam_from_board.linear().transpose() * cam_from_board.translation());
   const bool sees_print = center_in_board.z() < 0;
+  const double max_radius = MaxMonotonicRadius(camera);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const Eigen::Vector2i& id : ids) {
     TruthCorner corner;
@@ -148,9 +151,21 @@ std::vector<TruthCorner> ProjectBoardCorners(
       Eigen::Vector3d ray;
       const UnprojectStatus status = camera.Unproject(xy, &ray);
       const double cos_angle = ray.dot(point.normalized());
-      visible = status.converged && cos_angle > std::cos(1e-6);
+      visible = status.converged && cos_angle > std::cos(1e-6) &&
+                UndistortedRadius(camera, point) < max_radius;
     }
-    for (const Occluder& o : occluders) {
+    if (visible && options.field_of_view_deg > 0) {
+      // One pixel of margin, measured by the model's local ray spread.
+      Eigen::Vector3d ray_next;
+      camera.Unproject(xy + Eigen::Vector2d(1.0, 0.0), &ray_next);
+      const double pixel_angle =
+          std::acos(std::clamp(ray_next.dot(point.normalized()), -1.0, 1.0));
+      const double angle = std::atan2(point.head<2>().norm(), point.z());
+      visible = std::isfinite(pixel_angle) &&
+                angle + pixel_angle <
+                    0.5 * options.field_of_view_deg * M_PI / 180.0;
+    }
+    for (const Occluder& o : options.occluders) {
       if (visible && (xy - o.center_px).norm() < o.radius_px + 1.0) {
         visible = false;
       }
@@ -367,6 +382,36 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
     }
   });
 
+  if (options.field_of_view_deg > 0) {
+    // The lens's image circle: black beyond half the field of view, with an
+    // anti-aliased rim one pixel wide (measured by the corner rays' spread).
+    const double max_angle = 0.5 * options.field_of_view_deg * M_PI / 180.0;
+    cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+      for (int y = range.start; y < range.end; ++y) {
+        float* out = linear.ptr<float>(y);
+        for (int x = 0; x < width; ++x) {
+          const Eigen::Map<const Eigen::Vector3d> r0(rays.Ray(x, y));
+          const Eigen::Map<const Eigen::Vector3d> r3(rays.Ray(x + 1, y + 1));
+          const Eigen::Map<const Eigen::Vector3d> r1(rays.Ray(x + 1, y));
+          const Eigen::Map<const Eigen::Vector3d> r2(rays.Ray(x, y + 1));
+          const Eigen::Vector3d mean = r0 + r1 + r2 + r3;
+          if (!mean.allFinite()) {  // no ray: outside the lens as well
+            out[x] = 0.0f;
+            continue;
+          }
+          const double angle = std::atan2(mean.head<2>().norm(), mean.z());
+          const double pixel_angle =
+              std::max(std::acos(std::clamp(r0.dot(r3), -1.0, 1.0)) /
+                           std::sqrt(2.0),
+                       1e-12);
+          const double inside =
+              std::clamp(0.5 + (max_angle - angle) / pixel_angle, 0.0, 1.0);
+          out[x] = static_cast<float>(out[x] * inside);
+        }
+      }
+    });
+  }
+
   if (options.blur_sigma_px > 0) {
     cv::GaussianBlur(linear, linear, cv::Size(0, 0), options.blur_sigma_px,
                      options.blur_sigma_px, cv::BORDER_REPLICATE);
@@ -380,8 +425,11 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
   const double x_span = std::max(width - 1, 1);
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
     for (int y = range.start; y < range.end; ++y) {
-      uint64_t rng = options.seed * 0xD1B54A32D192ED03ULL +
-                     static_cast<uint64_t>(y) * 0x9E3779B97F4A7C15ULL;
+      // Independent streams per row: hash (seed, row) into the state (a
+      // plain offset would make neighbouring rows shifted copies).
+      uint64_t row_key = static_cast<uint64_t>(y);
+      uint64_t rng = options.seed ^ SplitMix64(&row_key);
+      SplitMix64(&rng);
       const float* in = linear.ptr<float>(y);
       uint8_t* out = image.ptr<uint8_t>(y);
       double spare_normal = 0.0;
@@ -420,7 +468,7 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
     summary->num_pixels_on_board += on_board_per_row[y];
   }
   std::vector<TruthCorner> corners =
-      ProjectBoardCorners(board, camera, cam_from_board, options.occluders);
+      ProjectBoardCorners(board, camera, cam_from_board, options);
   for (const TruthCorner& c : corners) {
     summary->num_visible_corners += c.visible ? 1 : 0;
   }

@@ -68,6 +68,10 @@ struct RenderOptions {
   double noise_sigma = 0.0;
   // Seed of the noise generator (renders are deterministic).
   uint64_t seed = 1;
+  // Full field of view of the lens in degrees: rays more than half of it
+  // from the optical axis are black, which draws a fisheye's image circle;
+  // 0 = unlimited. In [0, 360].
+  double field_of_view_deg = 0.0;
   // Discs drawn over the image after the board (occluders).
   std::vector<Occluder> occluders;
   // True pattern or a variant for refusal tests.
@@ -86,7 +90,9 @@ struct TruthCorner {
   // Visible: projects inside the image with a margin of 1 px (x in
   // [0.5, width - 1.5], same for y), the camera looks at the printed side,
   // the pixel's viewing ray is the corner's own (no fold-over of the
-  // distortion) and no occluder lies within 1 px of it.
+  // distortion), it lies inside the lens's field of view (RenderOptions::
+  // field_of_view_deg, with a margin of 1 px) and no occluder lies within
+  // 1 px of it.
   bool visible = false;
 };
 
@@ -126,10 +132,10 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
 
 // Every printed inner corner of `board` (Board::AllIds order) with its exact
 // projection and visibility as TruthCorner defines it.
+// `options` supplies the occluders and the field of view.
 std::vector<TruthCorner> ProjectBoardCorners(
     const Board& board, const Camera& camera,
-    const Eigen::Isometry3d& cam_from_board,
-    const std::vector<Occluder>& occluders);
+    const Eigen::Isometry3d& cam_from_board, const RenderOptions& options);
 
 }  // namespace puzzlecal
 
