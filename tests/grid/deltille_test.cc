@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -99,8 +100,7 @@ TEST(DeltilleTest, FisheyePhotosHaveConsistentComponents) {
   for (int f = 0; f < 256; ++f) {
     char name[32];
     std::snprintf(name, sizeof name, "/%04d.png", f);
-    const cv::Mat probe = cv::imread(dir + name, cv::IMREAD_GRAYSCALE);
-    if (!probe.empty()) files.push_back(dir + name);
+    if (std::ifstream(dir + name).good()) files.push_back(dir + name);
   }
   if (files.empty()) {
     GTEST_SKIP() << "no deltille photos in " << dir
