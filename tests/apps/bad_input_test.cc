@@ -1,0 +1,600 @@
+// The bad-input matrix: the `puzzlecal` program fed missing, empty, broken,
+// odd and hostile inputs. Every case must end with a message that names the
+// file and the reason, the documented exit code (apps/subcommand.h), the
+// other images still processed, and no partial output.
+//
+// The images are rendered here (sim/render.h) into a temporary folder; the
+// program is the one built beside this test (<build>/apps/puzzlecal).
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "apps/subcommand.h"
+#include "calib/camera_models.h"
+#include "decode/board.h"
+#include "sim/render.h"
+
+namespace puzzlecal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------- helpers --
+
+fs::path ProgramPath() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  // Tests live in <build>/tests/, the program in <build>/apps/.
+  return self.parent_path().parent_path() / "apps" / "puzzlecal";
+}
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)),
+                     std::istreambuf_iterator<char>());
+}
+
+void WriteFile(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << bytes;
+}
+
+std::string Quote(const std::string& s) {
+  std::string quoted = "'";
+  for (char c : s) {
+    if (c == '\'') {
+      quoted += "'\\''";
+    } else {
+      quoted += c;
+    }
+  }
+  return quoted + "'";
+}
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+  std::string all() const { return out + err; }
+};
+
+// Files under the folder, recursively (to check for partial output).
+std::vector<std::string> FilesUnder(const fs::path& folder) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  if (!fs::exists(folder, ec)) return files;
+  for (const auto& entry : fs::recursive_directory_iterator(folder, ec)) {
+    if (entry.is_regular_file()) files.push_back(entry.path().string());
+  }
+  return files;
+}
+
+Board PuzzleBoard11x8() {
+  Board board;
+  board.type = BoardType::kPuzzleBoard;
+  board.cols = 11;
+  board.rows = 8;
+  board.origin = Eigen::Vector2i(0, 0);
+  board.tile_size_m = 0.06;
+  return board;
+}
+
+Camera PinholeCamera() {
+  Camera camera;
+  camera.model = CameraModelId::kPinholeRadtan;
+  camera.params = {560.0, 556.0, 321.0, 239.0, -0.08, 0.03, 0.0, 0.0, 0.0};
+  camera.width = 640;
+  camera.height = 480;
+  return camera;
+}
+
+// Board centre `distance` in front of the camera, turned by angle_x then
+// angle_y (radians) about its centre, shifted sideways by `shift`.
+Eigen::Isometry3d LookAtBoard(const Board& board, double distance,
+                              double angle_x, double angle_y,
+                              const Eigen::Vector3d& shift) {
+  const Eigen::Vector3d center(0.5 * (board.cols - 1) * board.tile_size_m,
+                               0.5 * (board.rows - 1) * board.tile_size_m, 0);
+  const Eigen::Matrix3d rotation =
+      (Eigen::AngleAxisd(angle_x, Eigen::Vector3d::UnitX()) *
+       Eigen::AngleAxisd(angle_y, Eigen::Vector3d::UnitY()))
+          .toRotationMatrix();
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation;
+  pose.translation() =
+      Eigen::Vector3d(0, 0, distance) + shift - rotation * center;
+  return pose;
+}
+
+cv::Mat Render(const Eigen::Isometry3d& pose, RenderTruth* truth = nullptr) {
+  RenderOptions options;
+  options.supersampling = 2;
+  options.blur_sigma_px = 0.8;
+  options.noise_sigma = 0.01;
+  RenderSummary summary;
+  cv::Mat image = RenderBoard(PuzzleBoard11x8(), PinholeCamera(), pose,
+                              options, truth, &summary);
+  EXPECT_TRUE(summary.ok) << summary.reason;
+  return image;
+}
+
+std::string EncodeImage(const cv::Mat& image, const std::string& extension) {
+  std::vector<uchar> bytes;
+  cv::imencode(extension, image, bytes);
+  return std::string(bytes.begin(), bytes.end());
+}
+
+// The views a calibration can use: tilted in several directions.
+const std::vector<Eigen::Isometry3d>& GoodPoses() {
+  static const std::vector<Eigen::Isometry3d> poses = [] {
+    const Board board = PuzzleBoard11x8();
+    return std::vector<Eigen::Isometry3d>{
+        LookAtBoard(board, 1.3, 0.35, 0.0, Eigen::Vector3d(0.0, 0.0, 0)),
+        LookAtBoard(board, 1.4, -0.3, 0.25, Eigen::Vector3d(0.05, 0.03, 0)),
+        LookAtBoard(board, 1.2, 0.1, -0.4, Eigen::Vector3d(-0.06, 0.0, 0)),
+        LookAtBoard(board, 1.5, -0.2, -0.3, Eigen::Vector3d(0.0, -0.05, 0)),
+        LookAtBoard(board, 1.35, 0.3, 0.35, Eigen::Vector3d(0.04, 0.05, 0)),
+    };
+  }();
+  return poses;
+}
+
+// ---------------------------------------------------------------- fixture --
+
+class BadInputTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = new fs::path(fs::temp_directory_path() /
+                         ("puzzlecal_bad_input_" + std::to_string(getpid())));
+    fs::remove_all(*root_);
+    fs::create_directories(*root_ / "good");
+    // Rendered once for the whole suite; every case copies what it needs.
+    for (size_t k = 0; k < GoodPoses().size(); ++k) {
+      const cv::Mat image = Render(GoodPoses()[k]);
+      WriteFile(*root_ / "good" / ("view" + std::to_string(k) + ".png"),
+                EncodeImage(image, ".png"));
+    }
+    WriteFile(*root_ / "board.yaml",
+              "type: puzzleboard\ncols: 11\nrows: 8\norigin: [0, 0]\n"
+              "tile_size_m: 0.060\n");
+  }
+
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(*root_, ec);
+    delete root_;
+    root_ = nullptr;
+  }
+
+  void SetUp() override {
+    program_ = ProgramPath();
+    ASSERT_TRUE(fs::exists(program_))
+        << "the puzzlecal program is not built beside the tests: " << program_;
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    case_dir_ = *root_ / info->name();
+    fs::remove_all(case_dir_);
+    fs::create_directories(case_dir_);
+  }
+
+  // A folder with the good views plus whatever the case adds.
+  fs::path ImagesWithGoodViews(const std::string& name, int num_good) {
+    const fs::path folder = case_dir_ / name;
+    fs::create_directories(folder);
+    for (int k = 0; k < num_good; ++k) {
+      const std::string file = "view" + std::to_string(k) + ".png";
+      fs::copy_file(*root_ / "good" / file, folder / file);
+    }
+    return folder;
+  }
+
+  fs::path BoardFile() const { return *root_ / "board.yaml"; }
+
+  RunResult Run(const std::string& arguments) const {
+    const fs::path out = case_dir_ / "stdout.txt";
+    const fs::path err = case_dir_ / "stderr.txt";
+    const std::string command = Quote(program_.string()) + " " + arguments +
+                                " >" + Quote(out.string()) + " 2>" +
+                                Quote(err.string()) + " </dev/null";
+    const int status = std::system(command.c_str());
+    RunResult result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.out = ReadFile(out);
+    result.err = ReadFile(err);
+    fs::remove(out);
+    fs::remove(err);
+    return result;
+  }
+
+  RunResult Detect(const fs::path& images, const fs::path& out) const {
+    return Run("detect --images " + Quote(images.string()) + " --out " +
+               Quote(out.string()));
+  }
+
+  // True when the program has `calibrate` (the test skips otherwise).
+  bool HasCalibrate() const {
+    return Run("calibrate --help").exit_code == kExitOk;
+  }
+
+  RunResult Calibrate(const fs::path& images, const fs::path& out,
+                      const std::string& extra = "") const {
+    return Run("calibrate --images " + Quote(images.string()) + " --board " +
+               Quote(BoardFile().string()) +
+               " --model pinhole-radtan --threads 2 --out " +
+               Quote(out.string()) + " " + extra);
+  }
+
+  // Per image of detections.yaml: file name -> (corners, reason).
+  struct DetectedImage {
+    int corners = -1;
+    std::string reason;
+  };
+  static std::map<std::string, DetectedImage> ReadDetections(
+      const fs::path& yaml) {
+    std::map<std::string, DetectedImage> images;
+    const YAML::Node root = YAML::LoadFile(yaml.string());
+    for (const YAML::Node& image : root["images"]) {
+      DetectedImage detected;
+      detected.corners = static_cast<int>(image["corners"].size());
+      if (image["reason"]) detected.reason = image["reason"].as<std::string>();
+      images[fs::path(image["file"].as<std::string>()).filename().string()] =
+          detected;
+    }
+    return images;
+  }
+
+  static fs::path* root_;
+  fs::path program_;
+  fs::path case_dir_;
+};
+
+fs::path* BadInputTest::root_ = nullptr;
+
+#define SKIP_WITHOUT_CALIBRATE()                                          \
+  if (!HasCalibrate()) {                                                  \
+    GTEST_SKIP() << "`puzzlecal calibrate` is not part of this build yet"; \
+  }
+
+// ------------------------------------------------------------------ cases --
+
+TEST_F(BadInputTest, MissingFolder) {
+  const fs::path missing = case_dir_ / "no_such_folder";
+  const fs::path out = case_dir_ / "detections.yaml";
+  const RunResult detect = Detect(missing, out);
+  EXPECT_EQ(detect.exit_code, kExitBadInput) << detect.all();
+  EXPECT_NE(detect.err.find(missing.string()), std::string::npos) << detect.err;
+  EXPECT_NE(detect.err.find("no such file"), std::string::npos) << detect.err;
+  EXPECT_FALSE(fs::exists(out));
+
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult calibrate = Calibrate(missing, camera);
+  EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
+  EXPECT_NE(calibrate.err.find(missing.string()), std::string::npos)
+      << calibrate.err;
+  EXPECT_FALSE(fs::exists(camera));
+}
+
+TEST_F(BadInputTest, EmptyFolder) {
+  const fs::path empty = case_dir_ / "empty";
+  fs::create_directories(empty);
+  const fs::path out = case_dir_ / "detections.yaml";
+  const RunResult detect = Detect(empty, out);
+  EXPECT_EQ(detect.exit_code, kExitBadInput) << detect.all();
+  EXPECT_NE(detect.err.find(empty.string()), std::string::npos) << detect.err;
+  EXPECT_NE(detect.err.find("no image"), std::string::npos) << detect.err;
+  EXPECT_FALSE(fs::exists(out));
+
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult calibrate = Calibrate(empty, camera);
+  EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
+  EXPECT_NE(calibrate.err.find(empty.string()), std::string::npos)
+      << calibrate.err;
+  EXPECT_FALSE(fs::exists(camera));
+}
+
+// Text files, a text file named .png and a JPEG name holding random bytes:
+// nothing is an image, so the run fails as bad input and names them.
+TEST_F(BadInputTest, FolderOfNonImages) {
+  const fs::path folder = case_dir_ / "non_images";
+  fs::create_directories(folder);
+  WriteFile(folder / "notes.txt", "not an image\n");
+  WriteFile(folder / "fake.png", "this is text, not a PNG\n");
+  std::string noise(4096, '\0');
+  for (size_t k = 0; k < noise.size(); ++k) noise[k] = char((k * 7919) >> 3);
+  WriteFile(folder / "random.jpg", noise);
+  const fs::path out = case_dir_ / "detections.yaml";
+  const RunResult detect = Detect(folder, out);
+  EXPECT_EQ(detect.exit_code, kExitBadInput) << detect.all();
+  EXPECT_NE(detect.err.find("fake.png"), std::string::npos) << detect.err;
+  EXPECT_NE(detect.err.find("random.jpg"), std::string::npos) << detect.err;
+  EXPECT_NE(detect.err.find("not a readable image"), std::string::npos)
+      << detect.err;
+
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult calibrate = Calibrate(folder, camera);
+  EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
+  EXPECT_NE(calibrate.all().find("fake.png"), std::string::npos)
+      << calibrate.all();
+  EXPECT_FALSE(fs::exists(camera));
+}
+
+// Broken files among good views: each is named with its reason, the good
+// views are still processed, and the calibration is written.
+TEST_F(BadInputTest, BrokenFilesAmongGoodViews) {
+  const fs::path folder = ImagesWithGoodViews("mixed", 5);
+  const cv::Mat view = Render(GoodPoses()[0]);
+  const std::string png = EncodeImage(view, ".png");
+  const std::string jpeg = EncodeImage(view, ".jpg");
+  WriteFile(folder / "truncated.png", png.substr(0, png.size() / 2));
+  WriteFile(folder / "truncated.jpg", jpeg.substr(0, jpeg.size() / 2));
+  WriteFile(folder / "zero.png", "");
+  WriteFile(folder / "one_pixel.png",
+            EncodeImage(cv::Mat(1, 1, CV_8UC1, cv::Scalar(128)), ".png"));
+  cv::Mat noise(480, 640, CV_8UC1);
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  WriteFile(folder / "noise.png", EncodeImage(noise, ".png"));
+
+  const fs::path out = case_dir_ / "detections.yaml";
+  const RunResult detect = Detect(folder, out);
+  EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
+  EXPECT_NE(detect.err.find("truncated.png: truncated PNG"), std::string::npos)
+      << detect.err;
+  EXPECT_NE(detect.err.find("truncated.jpg: truncated JPEG"),
+            std::string::npos)
+      << detect.err;
+  EXPECT_NE(detect.err.find("zero.png: empty file"), std::string::npos)
+      << detect.err;
+  ASSERT_TRUE(fs::exists(out));
+  const auto detections = ReadDetections(out);
+  ASSERT_EQ(detections.size(), 10u);
+  for (int k = 0; k < 5; ++k) {
+    const auto& good = detections.at("view" + std::to_string(k) + ".png");
+    // 88 inner corners, most visible in every view.
+    EXPECT_GT(good.corners, 60) << "view" << k;
+  }
+  EXPECT_EQ(detections.at("one_pixel.png").corners, 0);
+  EXPECT_FALSE(detections.at("one_pixel.png").reason.empty());
+  EXPECT_EQ(detections.at("zero.png").corners, 0);
+  EXPECT_NE(detections.at("zero.png").reason.find("empty"), std::string::npos);
+
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult calibrate = Calibrate(folder, camera);
+  EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
+  const std::string all = calibrate.all();
+  for (const char* name : {"truncated.png", "truncated.jpg", "zero.png",
+                           "one_pixel.png", "noise.png"}) {
+    EXPECT_NE(all.find(name), std::string::npos) << name << "\n" << all;
+  }
+  EXPECT_TRUE(fs::exists(camera)) << all;
+}
+
+// 16-bit and RGBA files are converted and used like the 8-bit views.
+TEST_F(BadInputTest, SixteenBitAndRgbaImages) {
+  const fs::path folder = case_dir_ / "depths";
+  fs::create_directories(folder);
+  for (size_t k = 0; k < GoodPoses().size(); ++k) {
+    const cv::Mat view = Render(GoodPoses()[k]);
+    cv::Mat converted;
+    if (k % 2 == 0) {
+      view.convertTo(converted, CV_16U, 257.0);
+    } else {
+      cv::cvtColor(view, converted, cv::COLOR_GRAY2BGRA);
+    }
+    WriteFile(folder / ("view" + std::to_string(k) + ".png"),
+              EncodeImage(converted, ".png"));
+  }
+  const fs::path out = case_dir_ / "detections.yaml";
+  const RunResult detect = Detect(folder, out);
+  EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
+  const auto detections = ReadDetections(out);
+  ASSERT_EQ(detections.size(), GoodPoses().size());
+  for (const auto& [file, detected] : detections) {
+    EXPECT_GT(detected.corners, 60) << file;
+  }
+
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult calibrate = Calibrate(folder, camera);
+  EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
+  EXPECT_TRUE(fs::exists(camera));
+}
+
+// Two copies of the board in one image: the same ids twice. The program
+// must not crash or report either copy with ids from the other; the other
+// views are still used.
+TEST_F(BadInputTest, TwoBoardsInOneImage) {
+  const fs::path folder = ImagesWithGoodViews("two_boards", 5);
+  const Board board = PuzzleBoard11x8();
+  const cv::Mat left = Render(
+      LookAtBoard(board, 2.4, 0.1, 0.2, Eigen::Vector3d(-0.36, 0.0, 0)));
+  const cv::Mat right = Render(
+      LookAtBoard(board, 2.4, -0.1, -0.2, Eigen::Vector3d(0.36, 0.0, 0)));
+  cv::Mat both = left.clone();
+  right.colRange(320, 640).copyTo(both.colRange(320, 640));
+  WriteFile(folder / "two_boards.png", EncodeImage(both, ".png"));
+
+  const fs::path out = case_dir_ / "detections.yaml";
+  const RunResult detect = Detect(folder, out);
+  EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
+  const auto detections = ReadDetections(out);
+  EXPECT_GT(detections.at("two_boards.png").corners, 60);
+
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult calibrate = Calibrate(folder, camera);
+  EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
+  EXPECT_NE(calibrate.all().find("two_boards.png"), std::string::npos)
+      << calibrate.all();
+  EXPECT_TRUE(fs::exists(camera));
+}
+
+// A 50-megapixel image (mostly constant, so the PNG is small): refused or
+// downscaled with a message, never exhausting memory; the other views go on.
+TEST_F(BadInputTest, FiftyMegapixelImage) {
+  const fs::path folder = ImagesWithGoodViews("huge", 1);
+  cv::Mat huge(5800, 8700, CV_8UC1, cv::Scalar(140));
+  Render(GoodPoses()[0]).copyTo(huge(cv::Rect(100, 100, 640, 480)));
+  WriteFile(folder / "huge.png", EncodeImage(huge, ".png"));
+  huge.release();
+
+  const fs::path out = case_dir_ / "detections.yaml";
+  const RunResult detect = Detect(folder, out);
+  EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
+  const auto detections = ReadDetections(out);
+  EXPECT_GT(detections.at("view0.png").corners, 60);
+  EXPECT_NE(detect.all().find("huge.png"), std::string::npos) << detect.all();
+}
+
+TEST_F(BadInputTest, UnreadablePermissions) {
+  if (geteuid() == 0) {
+    GTEST_SKIP() << "running as root, which reads any file regardless of its "
+                    "permissions";
+  }
+  const fs::path folder = ImagesWithGoodViews("locked", 2);
+  fs::copy_file(folder / "view0.png", folder / "locked.png");
+  fs::permissions(folder / "locked.png", fs::perms::none);
+  const fs::path out = case_dir_ / "detections.yaml";
+  const RunResult detect = Detect(folder, out);
+  fs::permissions(folder / "locked.png", fs::perms::owner_all);
+  EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
+  EXPECT_NE(detect.err.find("locked.png: cannot open"), std::string::npos)
+      << detect.err;
+  const auto detections = ReadDetections(out);
+  EXPECT_GT(detections.at("view1.png").corners, 60);
+
+  const fs::path locked_folder = case_dir_ / "locked_folder";
+  fs::create_directories(locked_folder);
+  fs::permissions(locked_folder, fs::perms::none);
+  const RunResult folder_run = Detect(locked_folder, out);
+  fs::permissions(locked_folder, fs::perms::owner_all);
+  EXPECT_EQ(folder_run.exit_code, kExitBadInput) << folder_run.all();
+  EXPECT_NE(folder_run.err.find(locked_folder.string()), std::string::npos);
+}
+
+// Board files with a missing field, a wrong type, a bad value, unknown type
+// name, not YAML at all, and a missing file: bad input naming the board file.
+TEST_F(BadInputTest, BadBoardFiles) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  const std::vector<std::pair<std::string, std::string>> boards = {
+      {"missing_cols", "type: puzzleboard\nrows: 8\norigin: [0, 0]\n"
+                       "tile_size_m: 0.06\n"},
+      {"text_cols", "type: puzzleboard\ncols: eleven\nrows: 8\n"
+                    "origin: [0, 0]\ntile_size_m: 0.06\n"},
+      {"negative_tile", "type: puzzleboard\ncols: 11\nrows: 8\n"
+                        "origin: [0, 0]\ntile_size_m: -0.06\n"},
+      {"unknown_type", "type: chessboard\ncols: 11\nrows: 8\n"
+                       "tile_size_m: 0.06\n"},
+      {"not_yaml", "{{{ this: is: [not yaml\n"},
+  };
+  for (const auto& [name, text] : boards) {
+    const fs::path board = case_dir_ / (name + ".yaml");
+    WriteFile(board, text);
+    const fs::path camera = case_dir_ / (name + "_camera.yaml");
+    const RunResult run =
+        Run("calibrate --images " + Quote(folder.string()) + " --board " +
+            Quote(board.string()) + " --model pinhole-radtan --out " +
+            Quote(camera.string()));
+    EXPECT_EQ(run.exit_code, kExitBadInput) << name << "\n" << run.all();
+    EXPECT_NE(run.err.find(board.string()), std::string::npos)
+        << name << "\n" << run.err;
+    EXPECT_FALSE(fs::exists(camera)) << name;
+  }
+  const fs::path missing = case_dir_ / "no_board.yaml";
+  const RunResult run =
+      Run("calibrate --images " + Quote(folder.string()) + " --board " +
+          Quote(missing.string()) + " --model pinhole-radtan --out " +
+          Quote((case_dir_ / "camera.yaml").string()));
+  EXPECT_EQ(run.exit_code, kExitBadInput) << run.all();
+  EXPECT_NE(run.err.find(missing.string()), std::string::npos) << run.err;
+}
+
+TEST_F(BadInputTest, UnknownModelName) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult run = Calibrate(folder, camera, "--model fisheye-magic");
+  EXPECT_EQ(run.exit_code, kExitUsage) << run.all();
+  EXPECT_NE(run.err.find("fisheye-magic"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(camera));
+}
+
+// The output goes to a missing folder, below a regular file, or (when not
+// root) into a read-only folder: output error, nothing half-written.
+TEST_F(BadInputTest, UnwritableOutput) {
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  std::vector<fs::path> outputs = {case_dir_ / "missing" / "out.yaml"};
+  WriteFile(case_dir_ / "a_file", "x");
+  outputs.push_back(case_dir_ / "a_file" / "out.yaml");
+  const fs::path read_only = case_dir_ / "read_only";
+  fs::create_directories(read_only);
+  if (geteuid() != 0) {
+    fs::permissions(read_only, fs::perms::owner_read | fs::perms::owner_exec);
+    outputs.push_back(read_only / "out.yaml");
+  }
+  const bool has_calibrate = HasCalibrate();
+  for (const fs::path& out : outputs) {
+    const RunResult detect = Detect(folder, out);
+    EXPECT_EQ(detect.exit_code, kExitOutputError) << out << "\n"
+                                                  << detect.all();
+    EXPECT_NE(detect.err.find(out.string()), std::string::npos)
+        << detect.err;
+    if (has_calibrate) {
+      const RunResult calibrate = Calibrate(folder, out);
+      EXPECT_EQ(calibrate.exit_code, kExitOutputError)
+          << out << "\n" << calibrate.all();
+      EXPECT_NE(calibrate.err.find(out.string()), std::string::npos)
+          << calibrate.err;
+    }
+  }
+  fs::permissions(read_only, fs::perms::owner_all);
+  // No partial output anywhere in the case folder (no temporary files left).
+  for (const std::string& file : FilesUnder(case_dir_)) {
+    EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+    EXPECT_EQ(file.find("out.yaml"), std::string::npos) << file;
+  }
+  if (!has_calibrate) {
+    GTEST_SKIP() << "detect checked; `puzzlecal calibrate` is not part of "
+                    "this build yet";
+  }
+}
+
+// Too few usable views: no result, and no camera file written.
+TEST_F(BadInputTest, TooFewViewsWritesNothing) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("one_view", 1);
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult run = Calibrate(folder, camera);
+  EXPECT_EQ(run.exit_code, kExitNoResult) << run.all();
+  EXPECT_FALSE(fs::exists(camera));
+  for (const std::string& file : FilesUnder(case_dir_)) {
+    EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+  }
+}
+
+}  // namespace
+}  // namespace puzzlecal
