@@ -226,6 +226,7 @@ bool DecodeOptions::Check(std::string* why) const {
   if (!bits.Check(why)) return false;
   if (min_corners < 1) return fail("min_corners must be >= 1");
   if (max_label_extent < 2) return fail("max_label_extent must be >= 2");
+  if (!(max_lattice_deviation > 0.0)) return fail("max_lattice_deviation must be > 0");
   if (min_bits_read < 1) return fail("min_bits_read must be >= 1");
   if (!(min_agreement >= 0.5 && min_agreement <= 1.0)) {
     return fail("min_agreement must be in [0.5, 1]");
@@ -291,8 +292,27 @@ DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
       decoding.reason = why;
       continue;
     }
+    int dropped = lattice.dropped_duplicates + lattice.dropped_invalid;
+    const std::vector<int> outliers =
+        LatticeOutliers(lattice, options.max_lattice_deviation);
+    if (!outliers.empty()) {
+      // Rebuild without the mislabelled corners.
+      GridComponent kept;
+      std::vector<char> is_outlier(lattice.xy.size(), 0);
+      for (int k : outliers) is_outlier[k] = 1;
+      for (size_t k = 0; k < lattice.xy.size(); ++k) {
+        if (is_outlier[k]) continue;
+        kept.corner.push_back(lattice.corner_index[k]);
+        kept.ij.push_back(lattice.label[k]);
+      }
+      dropped += static_cast<int>(outliers.size());
+      if (!BuildLabelLattice(corners, kept, options.max_label_extent, &lattice, &why)) {
+        decoding.reason = why;
+        continue;
+      }
+    }
     decoding.num_corners = static_cast<int>(lattice.xy.size());
-    decoding.corners_dropped = lattice.dropped_duplicates + lattice.dropped_invalid;
+    decoding.corners_dropped = dropped;
     decoding.handedness = LabelHandedness(lattice);
     if (decoding.num_corners < options.min_corners) {
       decoding.reason = Format("only %.0f usable corners (need %.0f)",

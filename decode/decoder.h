@@ -66,6 +66,11 @@ struct DecodeOptions {
   // Components whose labels span more than this along an axis are refused
   // (guards the dense label array). Default 4096; >= 2.
   int max_label_extent = 4096;
+  // Corners off the position their lattice neighbours predict by more than
+  // this fraction of the local edge length are dropped before decoding
+  // (mislabelled corners; see LatticeOutliers). Default 0.3 (perspective at
+  // a 20-degree view and strong fisheye bend lines by < 0.15); > 0.
+  double max_lattice_deviation = 0.3;
   // Rule 1: minimum number of read edge bits. Default 20 (a 3 x 3-tile window
   // holds 24); >= 1.
   int min_bits_read = 20;
@@ -123,7 +128,9 @@ struct ComponentDecoding {
   // checkerboard component got board ids.
   Eigen::Matrix2i rotation = Eigen::Matrix2i::Identity();
   Eigen::Vector2i offset = Eigen::Vector2i::Zero();
-  int corners_dropped = 0;  // corners removed after decoding (bad bits, collisions)
+  // Corners removed: invalid or duplicate labels, off their lattice
+  // neighbours, disagreeing bits, colliding ids.
+  int corners_dropped = 0;
 };
 
 struct DecodeResult {

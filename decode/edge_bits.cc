@@ -146,6 +146,41 @@ bool BuildLabelLattice(const std::vector<Corner>& corners,
   return true;
 }
 
+std::vector<int> LatticeOutliers(const LabelLattice& lattice, double max_deviation) {
+  std::vector<int> outliers;
+  for (size_t k = 0; k < lattice.xy.size(); ++k) {
+    const Eigen::Vector2i a = lattice.label[k];
+    const Eigen::Vector2d& p = lattice.xy[k];
+    int good = 0, bad = 0;
+    for (int axis = 0; axis < 2; ++axis) {
+      const Eigen::Vector2i e = axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1);
+      const int prev = lattice.At(a - e), next = lattice.At(a + e);
+      const int prev2 = lattice.At(a - 2 * e), next2 = lattice.At(a + 2 * e);
+      Eigen::Vector2d predicted;
+      double step;
+      if (prev >= 0 && next >= 0) {
+        predicted = 0.5 * (lattice.xy[prev] + lattice.xy[next]);
+        step = 0.5 * (lattice.xy[next] - lattice.xy[prev]).norm();
+      } else if (prev >= 0 && prev2 >= 0) {
+        predicted = 2.0 * lattice.xy[prev] - lattice.xy[prev2];
+        step = (lattice.xy[prev] - lattice.xy[prev2]).norm();
+      } else if (next >= 0 && next2 >= 0) {
+        predicted = 2.0 * lattice.xy[next] - lattice.xy[next2];
+        step = (lattice.xy[next] - lattice.xy[next2]).norm();
+      } else {
+        continue;
+      }
+      if ((p - predicted).norm() > max_deviation * step) {
+        ++bad;
+      } else {
+        ++good;
+      }
+    }
+    if (bad > good) outliers.push_back(static_cast<int>(k));
+  }
+  return outliers;
+}
+
 int LabelHandedness(const LabelLattice& lattice) {
   int positive = 0, negative = 0;
   for (size_t k = 0; k < lattice.xy.size(); ++k) {

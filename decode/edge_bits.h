@@ -47,6 +47,14 @@ bool BuildLabelLattice(const std::vector<Corner>& corners,
                        const GridComponent& component, int max_extent,
                        LabelLattice* lattice, std::string* why);
 
+// Points whose position contradicts their lattice neighbours (a corner
+// given a wrong label): per lattice axis with both neighbours labelled, the
+// point should lie near their midpoint; with two neighbours on one side, near
+// the linear extrapolation. A prediction is bad when off by more than
+// `max_deviation` times the local edge length; points with more bad than good
+// predictions are returned (indices into lattice.xy).
+std::vector<int> LatticeOutliers(const LabelLattice& lattice, double max_deviation);
+
 // Orientation of the labels in the image: +1 when label axes (i, j) turn like
 // the image axes (x right, y down), which is how a board seen from its printed
 // side maps its (col, row) axes; -1 when the labels are mirrored; 0 when no

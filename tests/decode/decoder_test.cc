@@ -321,6 +321,30 @@ TEST(DecodeBoard, IdsClaimedTwiceAreDropped) {
   EXPECT_EQ(static_cast<int>(result.observation.id.size()), 23 * 16 - 5 * 16);
 }
 
+TEST(DecodeBoard, MislabelledCornerIsDropped) {
+  const Board board = Board23x16();
+  const Render& render = FrontView23x16();
+  // Corner (57, 108) removed; corner (56, 109) wrongly labelled as (57, 108),
+  // a diagonal slip as grid/ can make.
+  TruthGrid grid = OneComponentFromTruth(
+      render.truth, Eigen::Matrix2i::Identity(), {0, 0},
+      [](const Eigen::Vector2i& id) { return id != Eigen::Vector2i(57, 108); });
+  int slipped = -1;
+  for (size_t k = 0; k < grid.corners.size(); ++k) {
+    if (grid.truth_id[k] == Eigen::Vector2i(56, 109)) slipped = static_cast<int>(k);
+  }
+  ASSERT_GE(slipped, 0);
+  grid.components[0].ij[slipped] = Eigen::Vector2i(57, 108);
+  const DecodeResult result = DecodeBoard(board, grid.corners, grid.components, render.image);
+  ASSERT_TRUE(result.decoded) << result.reason;
+  for (size_t k = 0; k < result.observation.id.size(); ++k) {
+    EXPECT_NE(result.corner_index[k], slipped) << "mislabelled corner kept";
+  }
+  EXPECT_EQ(WrongIds(result, grid), 0);
+  EXPECT_GE(result.components[0].corners_dropped, 1);
+  EXPECT_GE(result.observation.id.size(), grid.corners.size() - 3);
+}
+
 TEST(DecodeBoard, CheckerboardSpanningTheBoardGetsBoardIdsUpToSymmetry) {
   Board board;
   board.type = BoardType::kCheckerboard;

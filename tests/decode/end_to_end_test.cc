@@ -93,10 +93,10 @@ TEST(EndToEnd, SmallTilesDecodeCorrectly) {
   const Board board = MakePuzzleBoard(72, 52, 100, 200, 0.01);
   RenderOptions options;
   options.noise_sigma = 0.02;
-  // About 8 px per tile.
+  // About 10 px per tile.
   const Outcome outcome =
       RunPipeline(board, PinholeCamera(1280, 960, 800),
-                  LookAt(board, {135.5, 225.5}, 1.0, 20, 5), options, 3.5);
+                  LookAt(board, {135.5, 225.5}, 0.8, 20, 5), options, 4.0);
   EXPECT_EQ(outcome.wrong_ids, 0);
   EXPECT_EQ(outcome.unmatched, 0);
   EXPECT_GT(outcome.decoded_ids, 0.8 * outcome.visible) << outcome.reason;
