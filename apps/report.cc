@@ -193,6 +193,21 @@ cv::Point Fixed(cv::Point2d p) {
                    static_cast<int>(std::lround(p.y * (1 << kShift))));
 }
 
+// The factor residual arrows are drawn with (options or automatic: the 95th
+// percentile inlier residual becomes 3 % of the image width), and that
+// percentile.
+double ResidualArrowScale(const ReportData& data, const ReportOptions& options,
+                          double* p95_px) {
+  std::vector<double> norms;
+  for (const ResidualSample& s : data.samples) {
+    if (s.inlier) norms.push_back(s.residual.norm());
+  }
+  const double p95 = Percentile(norms, 0.95);
+  if (p95_px) *p95_px = p95;
+  if (options.residual_arrow_scale > 0) return options.residual_arrow_scale;
+  return p95 > 0 ? plot::NiceNumber(0.03 * data.width / p95, true) : 1;
+}
+
 cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
   ImageLayout layout = MakeImageLayout(options.image_plot_width, data.width,
                                        data.height, 3);
@@ -200,15 +215,8 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
   const plot::Frame& frame = layout.frame;
   canvas(frame.area).setTo(cv::Scalar(246, 246, 246));
 
-  std::vector<double> norms;
-  for (const ResidualSample& s : data.samples) {
-    if (s.inlier) norms.push_back(s.residual.norm());
-  }
-  const double p95 = Percentile(norms, 0.95);
-  double arrow_scale = options.residual_arrow_scale;
-  if (!(arrow_scale > 0)) {
-    arrow_scale = p95 > 0 ? plot::NiceNumber(0.03 * data.width / p95, true) : 1;
-  }
+  double p95 = 0;
+  const double arrow_scale = ResidualArrowScale(data, options, &p95);
   // Draw inside the plot area only: arrows of outliers may leave it.
   cv::Mat area = canvas(frame.area);
   const cv::Point2d origin(frame.area.x, frame.area.y);
@@ -339,10 +347,20 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
   const Camera& camera = data.result->camera;
   const bool fisheye = !CameraModelIsPinhole(camera.model);
   ImageLayout layout = MakeImageLayout(options.image_plot_width, data.width,
-                                       data.height, 3);
+                                       data.height, 4);
   cv::Mat& canvas = layout.canvas;
   const plot::Frame& frame = layout.frame;
 
+  // The widest ray angle of any used corner: beyond it the model is
+  // extrapolated.
+  double observed_theta = 0;
+  for (const ResidualSample& s : data.samples) {
+    double shift = 0, angle = 0;
+    if (s.inlier && DistortionShift(camera, s.detected, &shift, &angle)) {
+      observed_theta = std::max(observed_theta, angle);
+    }
+  }
+  const bool have_observed = observed_theta > 0;
   const int step = options.distortion_grid_step_px;
   const int nx = (data.width - 1 + step - 1) / step + 1;
   const int ny = (data.height - 1 + step - 1) / step + 1;
@@ -354,7 +372,10 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
                                   std::min(j * step, data.height - 1));
       double m = std::nan(""), t = std::nan("");
       if (DistortionShift(camera, pixel, &m, &t)) {
-        max_magnitude = std::max(max_magnitude, m);
+        // The colour scale covers the observed field only.
+        if (!have_observed || t <= observed_theta) {
+          max_magnitude = std::max(max_magnitude, m);
+        }
         max_theta = std::max(max_theta, t);
       } else {
         m = t = std::nan("");
@@ -403,7 +424,12 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
         const int index = static_cast<int>(
             std::lround(std::clamp(m / colour_max, 0.0, 1.0) * 255));
         colour = lut_colour.at<cv::Vec3b>(index);
-        // Hatch rays beyond 90 degrees off the axis.
+        // Fade the extrapolated field; hatch rays beyond 90 degrees.
+        if (have_observed && std::isfinite(t) && t > observed_theta) {
+          for (int c = 0; c < 3; ++c) {
+            colour[c] = static_cast<uint8_t>((2 * colour[c] + 3 * 255) / 5);
+          }
+        }
         if (std::isfinite(t) && t > 90 && (u + v) % 10 < 2) {
           colour = cv::Vec3b((colour[0] + 255) / 2, (colour[1] + 255) / 2,
                              (colour[2] + 255) / 2);
@@ -475,14 +501,14 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
         "Distortion: shift from the equidistant fisheye r = f * theta",
         Format("Pixels between where each pixel's ray lands with the model "
                "and with k1..k4 = 0 (same fx fy cx cy); max %.1f px",
-               max_magnitude));
+               max_magnitude) + std::string(have_observed ? " where seen" : ""));
   } else {
     plot::DrawTitle(
         &canvas,
         "Distortion: shift from the distortion-free pinhole",
         Format("Pixels between where each pixel's ray lands with the model "
                "and with no distortion (same fx fy cx cy); max %.1f px",
-               max_magnitude));
+               max_magnitude) + std::string(have_observed ? " where seen" : ""));
   }
   DrawNote(&layout, 0,
            Format("White lines: angle of the pixel's ray from the optical axis "
@@ -495,10 +521,18 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
            Format("Red cross: principal point (%.1f, %.1f). Computed every %d "
                   "px and interpolated.",
                   principal.x(), principal.y(), step));
+  int line = 2;
+  if (have_observed && observed_theta < max_theta) {
+    DrawNote(&layout, line++,
+             Format("Faded: rays beyond %.1f deg, the widest angle of any used "
+                    "corner; the model is extrapolated there (colours scaled "
+                    "to the rest).",
+                    observed_theta));
+  }
   if (num_without_ray > 0) {
-    DrawNote(&layout, 2,
+    DrawNote(&layout, line++,
              "Grey: the model has no ray for these pixels (its distortion "
-             "cannot be inverted there).");
+             "folds back or cannot be inverted there).");
   }
   cv::drawMarker(canvas, frame.ToCanvasPixel(principal.x(), principal.y()),
                  plot::kRed, cv::MARKER_CROSS, 14, 2, cv::LINE_AA);
@@ -508,8 +542,10 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
 cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   cv::Mat canvas(options.chart_height, options.chart_width, CV_8UC3,
                  plot::kWhite);
+  // The histogram, and right of it one bar for everything beyond its range.
+  constexpr int kOverflowWidth = 60;
   plot::Frame frame;
-  frame.area = cv::Rect(90, 80, options.chart_width - 90 - 30,
+  frame.area = cv::Rect(90, 80, options.chart_width - 90 - 30 - kOverflowWidth - 20,
                         options.chart_height - 80 - 70);
   std::vector<double> inlier_norms, outlier_norms;
   for (const ResidualSample& s : data.samples) {
@@ -535,7 +571,7 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   // Expected counts for Gaussian noise of sigma per coordinate: the error
   // length then follows a Rayleigh distribution.
   std::vector<double> expected(bins, 0);
-  int highest = 1;
+  int highest = std::max(1, inliers_beyond + outliers_beyond);
   for (int b = 0; b < bins; ++b) {
     highest = std::max(highest, inliers[b] + outliers[b]);
     if (sigma > 0) {
@@ -584,14 +620,32 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
              "median length %.3f px, 95 %% below %.3f px",
              inlier_norms.size(), outlier_norms.size(), sigma,
              Percentile(inlier_norms, 0.5), Percentile(inlier_norms, 0.95)));
-  if (inliers_beyond + outliers_beyond > 0) {
-    plot::DrawText(&canvas,
-                   Format("not shown: %d used corners and %d outliers beyond "
-                          "%.3g px",
-                          inliers_beyond, outliers_beyond, range),
-                   {frame.area.x + 10, frame.area.y + 22}, plot::kTickScale,
-                   plot::kBlack);
+  // The overflow bar, on the histogram's count scale.
+  const cv::Rect overflow(frame.area.x + frame.area.width + 20, frame.area.y,
+                          kOverflowWidth, frame.area.height);
+  cv::rectangle(canvas, overflow, plot::kBlack, 1);
+  const int base_y = overflow.y + overflow.height;
+  const int inlier_top = frame.ToCanvasPixel(0, inliers_beyond).y;
+  const int outlier_top =
+      frame.ToCanvasPixel(0, inliers_beyond + outliers_beyond).y;
+  if (inliers_beyond > 0) {
+    cv::rectangle(canvas,
+                  cv::Rect(overflow.x + 10, inlier_top, overflow.width - 20,
+                           base_y - inlier_top),
+                  plot::kBlue, cv::FILLED);
   }
+  if (outliers_beyond > 0) {
+    cv::rectangle(canvas,
+                  cv::Rect(overflow.x + 10, outlier_top, overflow.width - 20,
+                           inlier_top - outlier_top),
+                  plot::kRed, cv::FILLED);
+  }
+  plot::DrawText(&canvas, Format("> %.3g", range),
+                 {overflow.x + overflow.width / 2, base_y + 21},
+                 plot::kTickScale, plot::kBlack, Align::kCenter);
+  plot::DrawText(&canvas, Format("%d", inliers_beyond + outliers_beyond),
+                 {overflow.x + overflow.width / 2, outlier_top - 6},
+                 plot::kTickScale, plot::kBlack, Align::kCenter);
   const std::vector<plot::LegendEntry> legend = {
       {plot::LegendEntry::Marker::kBox, plot::kBlue, "used corners"},
       {plot::LegendEntry::Marker::kBox, plot::kRed, "outliers (dropped)"},
@@ -631,6 +685,8 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
   const double bar_width =
       std::max(1.0, 0.75 * frame.area.width / std::max(1, num_views));
   const int label_every = std::max(1, (num_views + 29) / 30);
+  const double bar_pitch =
+      static_cast<double>(frame.area.width) / std::max(1, num_views);
   int num_high = 0, num_unused = 0;
   for (int v = 0; v < num_views; ++v) {
     const cv::Point2d base = frame.ToCanvas(v + 1, 0);
@@ -648,7 +704,9 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
       ++num_unused;
       plot::DrawCross(&canvas, base - cv::Point2d(0, 8), 5, plot::kGrey, 2);
     }
-    if (v % label_every == 0 || v == worst) {
+    const bool crowds_worst =
+        v != worst && worst >= 0 && std::abs(v - worst) * bar_pitch < 34;
+    if ((v % label_every == 0 && !crowds_worst) || v == worst) {
       plot::DrawText(&canvas, Format("%d", data.view_number[v]),
                      {static_cast<int>(std::lround(base.x)),
                       frame.area.y + frame.area.height + 20},
@@ -724,6 +782,9 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
     return cv::Point2d((p.x() + 0.5) * scale - 0.5, (p.y() + 0.5) * scale - 0.5);
   };
   const int radius = 6;
+  double p95 = 0;
+  const double arrow_scale = ResidualArrowScale(data, options, &p95);
+  const cv::Scalar arrow_colour(0, 210, 255);  // yellow
   int inliers = 0, outliers = 0;
   const bool has_pose = v < static_cast<int>(result.cam_from_board.size());
   const Eigen::Isometry3d pose =
@@ -741,12 +802,19 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
     if (data.camera_valid && has_pose &&
         result.camera.Project(pose * view.board_points[i], &projected) &&
         projected.allFinite()) {
-      const cv::Point2d p = to_canvas(projected);
-      if (!inlier) {
-        cv::line(image_area, Fixed(detected), Fixed(p), plot::kRed, 1,
-                 cv::LINE_AA, kShift);
+      // The residual magnified like in residuals.png (outliers cut), then
+      // the true reprojection.
+      Eigen::Vector2d arrow = arrow_scale * (projected - xy);
+      const double cap = std::max(40.0, 3 * p95 * arrow_scale);
+      if (arrow.norm() > cap) arrow *= cap / arrow.norm();
+      const cv::Point2d tip = to_canvas(xy + arrow);
+      if (std::hypot(tip.x - detected.x, tip.y - detected.y) > 1.5) {
+        cv::arrowedLine(image_area, Fixed(detected), Fixed(tip),
+                        inlier ? arrow_colour : plot::kRed, 1, cv::LINE_AA,
+                        kShift, 0.25);
       }
-      plot::DrawCross(&image_area, p, radius - 2, cv::Scalar(200, 0, 200), 1);
+      plot::DrawCross(&image_area, to_canvas(projected), radius - 2,
+                      cv::Scalar(200, 0, 200), 1);
     }
   }
   const std::string name = FileName(data.view_file[v]);
@@ -770,16 +838,21 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
   x += plot::TextSize(used_text, plot::kTickScale).width + 30;
   cv::circle(canvas, {x, y - 5}, 5, plot::kRed, 2, cv::LINE_AA);
   x += 12;
-  const std::string outlier_text = "outlier (line to its reprojection)";
+  const std::string outlier_text = "outlier";
   plot::DrawText(&canvas, outlier_text, {x, y}, plot::kTickScale,
                  plot::kBlack);
   x += plot::TextSize(outlier_text, plot::kTickScale).width + 30;
   plot::DrawCross(&canvas, cv::Point2d(x, y - 5), 5, cv::Scalar(200, 0, 200),
                   1);
+  x += 12;
+  const std::string cross_text = "reprojected by the calibrated model";
+  plot::DrawText(&canvas, cross_text, {x, y}, plot::kTickScale, plot::kBlack);
+  x += plot::TextSize(cross_text, plot::kTickScale).width + 30;
+  cv::arrowedLine(canvas, {x - 6, y - 5}, {x + 22, y - 5}, arrow_colour, 2,
+                  cv::LINE_AA, 0, 0.3);
   plot::DrawText(&canvas,
-                 "reprojected by the calibrated model (should sit in the "
-                 "circle)",
-                 {x + 12, y}, plot::kTickScale, plot::kBlack);
+                 Format("residual x%g (as in residuals.png)", arrow_scale),
+                 {x + 30, y}, plot::kTickScale, plot::kBlack);
   return canvas;
 }
 
@@ -910,8 +983,28 @@ bool DistortionShift(const Camera& camera, const Eigen::Vector2d& pixel,
       !ideal.allFinite()) {
     return false;
   }
+  // Beyond a fold of the distortion (its radial curve turns back) the
+  // undistortion can still converge, to a ray the lens does not see there:
+  // a ray slightly nearer the axis must land nearer the principal point.
+  const double theta = std::atan2(ray.head<2>().norm(), ray.z());
+  if (theta > 1e-6) {
+    const double inner = theta * (1 - 1e-4);
+    const Eigen::Vector2d direction = ray.head<2>().normalized();
+    const Eigen::Vector3d inner_ray(std::sin(inner) * direction.x(),
+                                    std::sin(inner) * direction.y(),
+                                    std::cos(inner));
+    Eigen::Vector2d inner_pixel;
+    const auto& p = camera.params;
+    auto radius = [&](const Eigen::Vector2d& q) {
+      return std::hypot((q.x() - p[2]) / p[0], (q.y() - p[3]) / p[1]);
+    };
+    if (!camera.Project(inner_ray, &inner_pixel) ||
+        !(radius(inner_pixel) < radius(pixel))) {
+      return false;
+    }
+  }
   *shift_px = (ideal - pixel).norm();
-  *ray_angle_deg = std::atan2(ray.head<2>().norm(), ray.z()) / kDeg;
+  *ray_angle_deg = theta / kDeg;
   return true;
 }
 
