@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <set>
 #include <sstream>
 
@@ -482,8 +483,12 @@ bool ParseRandomViews(const YAML::Node& node, FieldReader* r,
 }
 
 void AppendDouble(std::ostringstream* out, double value) {
+  // The shortest of 15 or 17 digits that reads back exactly.
   char text[40];
-  std::snprintf(text, sizeof(text), "%.17g", value);
+  std::snprintf(text, sizeof(text), "%.15g", value);
+  if (std::strtod(text, nullptr) != value) {
+    std::snprintf(text, sizeof(text), "%.17g", value);
+  }
   *out << text;
 }
 
