@@ -361,6 +361,11 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
           std::floor(options.window_fraction_of_neighbor * nearest));
     }
     window = std::clamp(window, options.min_window_px, options.max_window_px);
+    // Near the image border the window shrinks instead of failing.
+    const int room = static_cast<int>(std::floor(std::min(
+                         {c.xy.x(), c.xy.y(), image.cols - 1.0 - c.xy.x(),
+                          image.rows - 1.0 - c.xy.y()}))) - 2;
+    window = std::max(options.min_window_px, std::min(window, room));
     Corner corner;
     corner.xy = c.xy;
     corner.response = c.response;

@@ -16,7 +16,9 @@
 //  5. sub-pixel refinement at full resolution (gradient orthogonality with a
 //     window sized from the distance to the nearest neighbour corner, or the
 //     thesis's squared-grey centroid);
-//  6. orientation = angle of the first Hessian eigenvector.
+//  6. orientation = angle of the first Hessian eigenvector (the one of the
+//     positive eigenvalue: along the diagonal through the bright tiles), in
+//     (-pi/2, pi/2] since an eigenvector has no sign.
 
 #include <string>
 #include <vector>
@@ -92,10 +94,10 @@ struct DetectorOptions {
   SubpixelMethod subpixel = SubpixelMethod::kGradientOrthogonality;
   // Half-size of the refinement window as a fraction of the distance to the
   // nearest other corner (a tile edge); clamped to the two bounds below. > 0.
-  double window_fraction_of_neighbor = 0.5;
+  double window_fraction_of_neighbor = 0.3;
   // Bounds of the window half-size in full-resolution pixels; the upper one is
   // also used for a corner without neighbours. 2 <= min <= max <= 64.
-  int min_window_px = 2;
+  int min_window_px = 4;
   int max_window_px = 12;
   // Newton iterations of the gradient-orthogonality fixed point. >= 1.
   int max_iterations = 6;
@@ -109,9 +111,10 @@ struct DetectorOptions {
   double merge_distance_px = 1.5;
 
   // --- orientation ---
-  // Spacing (full-resolution pixels) of the finite differences giving the
-  // Hessian for the orientation, as a fraction of the refinement window
-  // half-size; at least 1 px. > 0.
+  // Radius (full-resolution pixels) of the circle on which the orientation
+  // is measured (second angular harmonic = Hessian eigenvector at that
+  // scale), as a fraction of the refinement window half-size; at least 1 px.
+  // > 0.
   double orientation_spacing_fraction = 0.5;
 
   // False with a reason when a field is out of range.

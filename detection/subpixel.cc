@@ -206,24 +206,36 @@ Eigen::Vector2d CentroidOfSquaredResponse(const cv::Mat& response, int x,
 }
 
 double HessianOrientation(const cv::Mat& image, const Eigen::Vector2d& xy,
-                          double spacing) {
-  const double d = std::max(spacing, 1.0);
+                          double radius) {
+  const double r = std::max(radius, 1.0);
   const double x = xy.x(), y = xy.y();
-  if (!(x - d >= 0.0 && y - d >= 0.0 && x + d < image.cols - 1.0 &&
-        y + d < image.rows - 1.0)) {
+  if (!(x - r >= 0.0 && y - r >= 0.0 && x + r < image.cols - 1.0 &&
+        y + r < image.rows - 1.0)) {
     return 0.0;
   }
-  const double c2 = 2.0 * SampleBilinear(image, x, y);
-  const double hxx =
-      SampleBilinear(image, x + d, y) + SampleBilinear(image, x - d, y) - c2;
-  const double hyy =
-      SampleBilinear(image, x, y + d) + SampleBilinear(image, x, y - d) - c2;
-  const double hxy = 0.25 * (SampleBilinear(image, x + d, y + d) -
-                             SampleBilinear(image, x - d, y + d) -
-                             SampleBilinear(image, x + d, y - d) +
-                             SampleBilinear(image, x - d, y - d));
-  // Eigenvector of the larger eigenvalue of [[hxx, hxy], [hxy, hyy]].
-  double angle = 0.5 * std::atan2(2.0 * hxy, hxx - hyy);
+  // The second angular harmonic of the grey values on a circle: for a
+  // quadratic saddle its phase is twice the angle of the eigenvector of the
+  // larger Hessian eigenvalue; for a sharp corner it points along the
+  // bisector through the bright tiles at any radius (finite differences at a
+  // few pixels would quantise the angle to the sampling directions).
+  constexpr int kSamples = 32;
+  static const struct Table {
+    double c[kSamples], s[kSamples];
+    Table() {
+      for (int i = 0; i < kSamples; ++i) {
+        c[i] = std::cos(2.0 * M_PI * i / kSamples);
+        s[i] = std::sin(2.0 * M_PI * i / kSamples);
+      }
+    }
+  } table;
+  double re = 0.0, im = 0.0;
+  for (int i = 0; i < kSamples; ++i) {
+    const double v = SampleBilinear(image, x + r * table.c[i], y + r * table.s[i]);
+    const int twice = (2 * i) % kSamples;
+    re += v * table.c[twice];
+    im += v * table.s[twice];
+  }
+  double angle = 0.5 * std::atan2(im, re);
   if (angle <= -M_PI / 2) angle += M_PI;
   return angle;
 }

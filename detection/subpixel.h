@@ -34,12 +34,12 @@ Eigen::Vector2d CentroidOfSquaredResponse(const cv::Mat& response, int x,
                                           int y);
 
 // Angle in (-pi/2, pi/2] of the eigenvector of the larger (positive, at a
-// saddle) eigenvalue of the Hessian of `image` at `xy`, from bilinear
-// finite differences with the given spacing (pixels). It points along the
-// diagonal through the two brighter tiles. Returns 0 when the Hessian cannot
-// be sampled.
+// saddle) eigenvalue of the Hessian of `image` at `xy`, estimated at the
+// scale `radius` (pixels) from the second angular harmonic of the grey values
+// on that circle. It points along the diagonal through the two brighter
+// tiles. Returns 0 when the circle leaves the image.
 double HessianOrientation(const cv::Mat& image, const Eigen::Vector2d& xy,
-                          double spacing);
+                          double radius);
 
 }  // namespace puzzlecal
 
