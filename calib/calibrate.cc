@@ -343,7 +343,7 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     std::vector<bool> staged = fixed;
     for (int k = kDistortionBegin; k < kNumParams; ++k) staged[k] = true;
     Solve<Model>(&state, staged, options, &loss, &outcome);
-    iterations += outcome.summary.iterations.size(); if (getenv("CALIB_DEBUG")) fprintf(stderr, "%s\n", outcome.summary.BriefReport().c_str());
+    iterations += outcome.summary.iterations.size();
     if (!outcome.summary.IsSolutionUsable()) {
       return Fail("the first solve (distortion held at zero) failed: " +
                       outcome.summary.message,
@@ -351,7 +351,7 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     }
   }
   Solve<Model>(&state, fixed, options, &loss, &outcome);
-  iterations += outcome.summary.iterations.size(); if (getenv("CALIB_DEBUG")) fprintf(stderr, "%s\n", outcome.summary.FullReport().c_str());
+  iterations += outcome.summary.iterations.size();
 
   // k-sigma outlier rejection.
   int rounds = 0;
@@ -415,7 +415,7 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     }
     ++rounds;
     Solve<Model>(&state, fixed, options, &loss, &outcome);
-    iterations += outcome.summary.iterations.size(); if (getenv("CALIB_DEBUG")) fprintf(stderr, "%s\n", outcome.summary.BriefReport().c_str());
+    iterations += outcome.summary.iterations.size();
     compute_residuals(&projects);
   }
 
@@ -476,6 +476,12 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     ceres::Covariance::Options covariance_options;
     covariance_options.num_threads =
         options.deterministic ? 1 : options.num_threads;
+    // SuiteSparseQR may thread internally (BLAS), which changes the last
+    // bits from run to run; Eigen's sparse QR is sequential.
+    if (options.deterministic) {
+      covariance_options.sparse_linear_algebra_library_type =
+          ceres::EIGEN_SPARSE;
+    }
     ceres::Covariance covariance(covariance_options);
     std::vector<std::pair<const double*, const double*>> blocks = {
         {state.params.data(), state.params.data()}};

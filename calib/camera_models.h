@@ -111,12 +111,20 @@ struct PinholeDistorted {
       if (!std::isfinite(x) || !std::isfinite(y)) break;
       if (std::hypot(dx, dy) < 1e-14 * (1.0 + std::hypot(x, y))) break;
     }
-    double fx, fy;
+    double fx, fy, fx_dx, fy_dx, fx_dy, fy_dy;
     Distort(params, x, y, &fx, &fy);
+    Distort(params, x + kStep, y, &fx_dx, &fy_dx);
+    Distort(params, x, y + kStep, &fx_dy, &fy_dy);
     status.residual_px =
         std::hypot((fx - xd) * params[0], (fy - yd) * params[1]);
+    // A solution past the fold of the distortion (where the mapping turns
+    // back, Jacobian determinant <= 0) is not the lens' ray for this pixel.
+    const double det = (fx_dx - fx) * (fy_dy - fy) - (fx_dy - fx) * (fy_dx - fy);
+    // The same holds for a solution on the far side of the centre (the
+    // radial factor turned negative).
+    const bool same_side = x * xd + y * yd >= 0;
     status.converged = std::isfinite(status.residual_px) &&
-                       status.residual_px < 1e-6;
+                       status.residual_px < 1e-6 && det > 0 && same_side;
     const double norm = std::sqrt(x * x + y * y + 1.0);
     ray[0] = x / norm;
     ray[1] = y / norm;
@@ -218,8 +226,12 @@ struct KannalaBrandtModel {
     const double f_end = DistortTheta(params, theta) - theta_d;
     status.residual_px =
         std::abs(f_end) * std::max(std::abs(params[0]), std::abs(params[1]));
-    status.converged =
-        std::isfinite(status.residual_px) && status.residual_px < 1e-6;
+    // Past the turning point of theta_d(theta) the solution is not the ray.
+    const double t2 = theta * theta, t4 = t2 * t2, t6 = t4 * t2, t8 = t4 * t4;
+    const double slope = 1.0 + 3.0 * params[4] * t2 + 5.0 * params[5] * t4 +
+                         7.0 * params[6] * t6 + 9.0 * params[7] * t8;
+    status.converged = std::isfinite(status.residual_px) &&
+                       status.residual_px < 1e-6 && slope > 0;
     const double s = std::sin(theta);
     if (theta_d > 0) {
       ray[0] = s * mx / theta_d;

@@ -74,8 +74,8 @@ inline Camera TruthRadtan() {
 // OpenCV's rational model, 1280 x 960.
 inline Camera TruthRational() {
   return MakeCamera(CameraModelId::kPinholeRational, 1280, 960,
-                    {760.0, 761.2, 637.8, 482.6, 0.25, -0.04, 0.0004, 0.0007,
-                     0.002, 0.58, 0.03, -0.004});
+                    {760.0, 761.2, 637.8, 482.6, 0.3, 0.02, 0.0004, 0.0007,
+                     0.0005, 0.52, 0.06, 0.001});
 }
 // A 190 degree fisheye on a 1600 x 1200 sensor: the image circle is cut by
 // the top and bottom edges, the image corners see 114 degrees off the axis.

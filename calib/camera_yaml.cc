@@ -1,0 +1,621 @@
+#include "calib/camera_yaml.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "calib/atomic_file.h"
+
+namespace puzzlecal {
+namespace {
+
+constexpr const char* kPuzzlecalFormatTag = "puzzlecal-camera";
+
+bool Fail(const std::string& message, std::string* error) {
+  if (error != nullptr) *error = message;
+  return false;
+}
+
+// Distortion model names of the other formats, per puzzlecal model.
+const char* RosDistortionModel(CameraModelId id) {
+  switch (id) {
+    case CameraModelId::kPinholeRadtan:
+      return "plumb_bob";
+    case CameraModelId::kPinholeRational:
+      return "rational_polynomial";
+    case CameraModelId::kKannalaBrandt:
+      return "equidistant";
+  }
+  return "plumb_bob";
+}
+
+YAML::Emitter& Flow(YAML::Emitter& out, const std::vector<double>& values) {
+  out << YAML::Flow << YAML::BeginSeq;
+  for (double v : values) out << v;
+  out << YAML::EndSeq;
+  return out;
+}
+
+std::vector<double> CameraMatrix(const Camera& c) {
+  return {c.params[0], 0, c.params[2], 0, c.params[1], c.params[3], 0, 0, 1};
+}
+
+std::vector<double> Distortion(const Camera& c) {
+  return std::vector<double>(c.params.begin() + kDistortionBegin,
+                             c.params.end());
+}
+
+bool CheckCamera(const Camera& camera, std::string* error) {
+  if (static_cast<int>(camera.params.size()) !=
+      CameraModelNumParams(camera.model)) {
+    return Fail(std::string("the camera has ") +
+                    std::to_string(camera.params.size()) + " parameters, " +
+                    CameraModelName(camera.model) + " needs " +
+                    std::to_string(CameraModelNumParams(camera.model)),
+                error);
+  }
+  for (double v : camera.params) {
+    if (!std::isfinite(v)) return Fail("the camera has non-finite parameters", error);
+  }
+  if (camera.width <= 0 || camera.height <= 0) {
+    return Fail("the camera has no image size", error);
+  }
+  return true;
+}
+
+std::string FormatPuzzlecal(const Camera& camera,
+                            const CameraFileStats& stats) {
+  const std::vector<std::string> names = CameraModelParamNames(camera.model);
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "format" << YAML::Value << kPuzzlecalFormatTag;
+  out << YAML::Key << "model" << YAML::Value << CameraModelName(camera.model);
+  out << YAML::Key << "image_width" << YAML::Value << camera.width;
+  out << YAML::Key << "image_height" << YAML::Value << camera.height;
+  out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
+  for (size_t k = 0; k < names.size(); ++k) {
+    out << YAML::Key << names[k] << YAML::Value << camera.params[k];
+  }
+  out << YAML::EndMap;
+  if (stats.has_stats) {
+    if (stats.param_stddev.size() == names.size()) {
+      out << YAML::Key << "parameter_stddev" << YAML::Value << YAML::BeginMap;
+      for (size_t k = 0; k < names.size(); ++k) {
+        out << YAML::Key << names[k] << YAML::Value << stats.param_stddev[k];
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::Key << "rms_px" << YAML::Value << stats.rms_px;
+    out << YAML::Key << "views_used" << YAML::Value << stats.num_views_used;
+    out << YAML::Key << "corners_used" << YAML::Value
+        << stats.num_corners_used;
+    out << YAML::Key << "outliers" << YAML::Value << stats.num_outliers;
+  }
+  out << YAML::EndMap;
+  return std::string("# puzzlecal camera calibration\n") + out.c_str() + "\n";
+}
+
+// OpenCV's FileStorage wants "%YAML:1.0" and its own matrix tag.
+std::string FormatOpenCv(const Camera& camera) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  auto matrix = [&](const char* key, int rows, int cols,
+                    const std::vector<double>& data) {
+    out << YAML::Key << key << YAML::Value << YAML::SecondaryTag("opencv-matrix")
+        << YAML::BeginMap;
+    out << YAML::Key << "rows" << YAML::Value << rows;
+    out << YAML::Key << "cols" << YAML::Value << cols;
+    out << YAML::Key << "dt" << YAML::Value << "d";
+    out << YAML::Key << "data" << YAML::Value;
+    Flow(out, data);
+    out << YAML::EndMap;
+  };
+  out << YAML::BeginMap;
+  out << YAML::Key << "model" << YAML::Value << CameraModelName(camera.model);
+  out << YAML::Key << "image_width" << YAML::Value << camera.width;
+  out << YAML::Key << "image_height" << YAML::Value << camera.height;
+  matrix("camera_matrix", 3, 3, CameraMatrix(camera));
+  const std::vector<double> distortion = Distortion(camera);
+  matrix("distortion_coefficients", 1, static_cast<int>(distortion.size()),
+         distortion);
+  out << YAML::EndMap;
+  return std::string("%YAML:1.0\n---\n") + out.c_str() + "\n";
+}
+
+std::string FormatRos(const Camera& camera) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  auto matrix = [&](const char* key, int rows, int cols,
+                    const std::vector<double>& data) {
+    out << YAML::Key << key << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "rows" << YAML::Value << rows;
+    out << YAML::Key << "cols" << YAML::Value << cols;
+    out << YAML::Key << "data" << YAML::Value;
+    Flow(out, data);
+    out << YAML::EndMap;
+  };
+  const auto& p = camera.params;
+  out << YAML::BeginMap;
+  out << YAML::Key << "image_width" << YAML::Value << camera.width;
+  out << YAML::Key << "image_height" << YAML::Value << camera.height;
+  out << YAML::Key << "camera_name" << YAML::Value << kDefaultCameraName;
+  matrix("camera_matrix", 3, 3, CameraMatrix(camera));
+  out << YAML::Key << "distortion_model" << YAML::Value
+      << RosDistortionModel(camera.model);
+  const std::vector<double> distortion = Distortion(camera);
+  matrix("distortion_coefficients", 1, static_cast<int>(distortion.size()),
+         distortion);
+  matrix("rectification_matrix", 3, 3, {1, 0, 0, 0, 1, 0, 0, 0, 1});
+  matrix("projection_matrix", 3, 4,
+         {p[0], 0, p[2], 0, 0, p[1], p[3], 0, 0, 0, 1, 0});
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+bool FormatKalibr(const Camera& camera, std::string* text,
+                  std::string* error) {
+  const auto& p = camera.params;
+  std::vector<double> coeffs;
+  const char* model = "radtan";
+  switch (camera.model) {
+    case CameraModelId::kPinholeRational:
+      for (int k = 8; k < 12; ++k) {
+        if (p[k] != 0) {
+          return Fail("kalibr has no rational distortion model (k" +
+                          std::to_string(k - 5) + " = " +
+                          std::to_string(p[k]) +
+                          "): write the opencv or ros format, or calibrate "
+                          "pinhole-radtan with k3 fixed",
+                      error);
+        }
+      }
+      [[fallthrough]];
+    case CameraModelId::kPinholeRadtan:
+      if (p[8] != 0) {
+        return Fail("kalibr's radtan model has no k3 (k3 = " +
+                        std::to_string(p[8]) +
+                        "): write the opencv or ros format, or calibrate "
+                        "with k3 fixed",
+                    error);
+      }
+      coeffs = {p[4], p[5], p[6], p[7]};
+      break;
+    case CameraModelId::kKannalaBrandt:
+      model = "equidistant";
+      coeffs = {p[4], p[5], p[6], p[7]};
+      break;
+  }
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap << YAML::Key << "cam0" << YAML::Value
+      << YAML::BeginMap;
+  out << YAML::Key << "camera_model" << YAML::Value << "pinhole";
+  out << YAML::Key << "intrinsics" << YAML::Value;
+  Flow(out, {p[0], p[1], p[2], p[3]});
+  out << YAML::Key << "distortion_model" << YAML::Value << model;
+  out << YAML::Key << "distortion_coeffs" << YAML::Value;
+  Flow(out, coeffs);
+  out << YAML::Key << "resolution" << YAML::Value << YAML::Flow
+      << YAML::BeginSeq << camera.width << camera.height << YAML::EndSeq;
+  out << YAML::EndMap << YAML::EndMap;
+  *text = std::string(out.c_str()) + "\n";
+  return true;
+}
+
+// ---- reading ----
+
+// Field access with messages that name the source and the field.
+class Reader {
+ public:
+  Reader(const std::string& source, std::string* error)
+      : source_(source), error_(error) {}
+
+  bool Fail(const std::string& field, const std::string& what) {
+    if (error_ != nullptr) {
+      *error_ = source_ + ": field '" + field + "': " + what;
+    }
+    return false;
+  }
+
+  bool Get(const YAML::Node& node, const std::string& field,
+           const char* key, YAML::Node* child) {
+    if (!node.IsMap() || !node[key]) return Fail(field, "missing");
+    *child = node[key];
+    return true;
+  }
+
+  template <typename T>
+  bool Scalar(const YAML::Node& node, const std::string& field, T* value) {
+    if (!node.IsScalar()) return Fail(field, "expected a single value");
+    try {
+      *value = node.as<T>();
+    } catch (const YAML::Exception&) {
+      return Fail(field, "cannot read '" + node.Scalar() + "' as a number");
+    }
+    return true;
+  }
+
+  bool Numbers(const YAML::Node& node, const std::string& field,
+               std::vector<double>* values) {
+    if (!node.IsSequence()) return Fail(field, "expected a list of numbers");
+    values->clear();
+    for (size_t i = 0; i < node.size(); ++i) {
+      double v;
+      if (!Scalar(node[i], field + "[" + std::to_string(i) + "]", &v)) {
+        return false;
+      }
+      if (!std::isfinite(v)) {
+        return Fail(field + "[" + std::to_string(i) + "]", "not finite");
+      }
+      values->push_back(v);
+    }
+    return true;
+  }
+
+  // {rows, cols, data} as written by ROS and OpenCV.
+  bool Matrix(const YAML::Node& node, const std::string& field, int rows,
+              int cols, std::vector<double>* data) {
+    YAML::Node child;
+    if (!Get(node, field, "data", &child)) return false;
+    if (!Numbers(child, field + "/data", data)) return false;
+    if (rows > 0 && cols > 0 &&
+        static_cast<int>(data->size()) != rows * cols) {
+      return Fail(field + "/data", "expected " + std::to_string(rows * cols) +
+                                       " numbers, got " +
+                                       std::to_string(data->size()));
+    }
+    return true;
+  }
+
+  bool Size(const YAML::Node& root, Camera* camera) {
+    YAML::Node w, h;
+    if (!Get(root, "image_width", "image_width", &w) ||
+        !Scalar(w, "image_width", &camera->width)) {
+      return false;
+    }
+    if (!Get(root, "image_height", "image_height", &h) ||
+        !Scalar(h, "image_height", &camera->height)) {
+      return false;
+    }
+    if (camera->width <= 0) return Fail("image_width", "must be positive");
+    if (camera->height <= 0) return Fail("image_height", "must be positive");
+    return true;
+  }
+
+  // fx fy cx cy from a row-major 3x3 camera matrix.
+  bool Intrinsics(const std::vector<double>& k, const std::string& field,
+                  Camera* camera) {
+    if (k.size() != 9) return Fail(field, "expected 9 numbers");
+    if (k[1] != 0) return Fail(field, "skew is not supported");
+    if (!(k[0] > 0) || !(k[4] > 0)) {
+      return Fail(field, "focal lengths must be positive");
+    }
+    camera->params[0] = k[0];
+    camera->params[1] = k[4];
+    camera->params[2] = k[2];
+    camera->params[3] = k[5];
+    return true;
+  }
+
+  // Distortion coefficients into camera->params (zero-padded where the
+  // format allows shorter lists).
+  bool SetDistortion(const std::vector<double>& d, const std::string& field,
+                     size_t min_count, Camera* camera) {
+    const size_t count = camera->params.size() - kDistortionBegin;
+    if (d.size() < min_count || d.size() > count) {
+      return Fail(field, std::string("expected ") +
+                             (min_count == count ? std::to_string(count)
+                                                 : std::to_string(min_count) +
+                                                       " to " +
+                                                       std::to_string(count)) +
+                             " coefficients for " +
+                             CameraModelName(camera->model) + ", got " +
+                             std::to_string(d.size()));
+    }
+    for (size_t i = 0; i < d.size(); ++i) {
+      camera->params[kDistortionBegin + i] = d[i];
+    }
+    return true;
+  }
+
+  bool Model(const YAML::Node& node, const std::string& field,
+             CameraModelId* id) {
+    std::string name;
+    if (!Scalar(node, field, &name)) return false;
+    if (!CameraModelIdFromName(name, id)) {
+      return Fail(field, "unknown model '" + name + "' (known: " +
+                             CameraModelNames() + ")");
+    }
+    return true;
+  }
+
+ private:
+  std::string source_;
+  std::string* error_;
+};
+
+void ResetCamera(CameraModelId id, Camera* camera) {
+  camera->model = id;
+  camera->params.assign(CameraModelNumParams(id), 0.0);
+}
+
+bool ParsePuzzlecal(const YAML::Node& root, Reader& r, Camera* camera) {
+  YAML::Node node;
+  CameraModelId id;
+  if (!r.Get(root, "model", "model", &node) || !r.Model(node, "model", &id)) {
+    return false;
+  }
+  ResetCamera(id, camera);
+  if (!r.Size(root, camera)) return false;
+  YAML::Node params;
+  if (!r.Get(root, "parameters", "parameters", &params)) return false;
+  const std::vector<std::string> names = CameraModelParamNames(id);
+  for (size_t k = 0; k < names.size(); ++k) {
+    const std::string field = "parameters/" + names[k];
+    if (!r.Get(params, field, names[k].c_str(), &node) ||
+        !r.Scalar(node, field, &camera->params[k])) {
+      return false;
+    }
+    if (!std::isfinite(camera->params[k])) return r.Fail(field, "not finite");
+  }
+  if (!(camera->params[0] > 0) || !(camera->params[1] > 0)) {
+    return r.Fail("parameters/fx", "focal lengths must be positive");
+  }
+  return true;
+}
+
+bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
+                      Camera* camera) {
+  CameraModelId id = CameraModelId::kPinholeRadtan;
+  YAML::Node node;
+  std::vector<double> k, d;
+  if (!r.Get(root, "camera_matrix", "camera_matrix", &node) ||
+      !r.Matrix(node, "camera_matrix", 3, 3, &k)) {
+    return false;
+  }
+  if (!r.Get(root, "distortion_coefficients", "distortion_coefficients",
+             &node) ||
+      !r.Matrix(node, "distortion_coefficients", 0, 0, &d)) {
+    return false;
+  }
+  if (ros) {
+    std::string model;
+    if (!r.Get(root, "distortion_model", "distortion_model", &node) ||
+        !r.Scalar(node, "distortion_model", &model)) {
+      return false;
+    }
+    if (model == "plumb_bob") {
+      id = CameraModelId::kPinholeRadtan;
+    } else if (model == "rational_polynomial") {
+      id = CameraModelId::kPinholeRational;
+    } else if (model == "equidistant" || model == "fisheye") {
+      id = CameraModelId::kKannalaBrandt;
+    } else {
+      return r.Fail("distortion_model",
+                    "unknown model '" + model +
+                        "' (known: plumb_bob, rational_polynomial, "
+                        "equidistant)");
+    }
+  } else if (root["model"]) {
+    if (!r.Model(root["model"], "model", &id)) return false;
+  } else {
+    // OpenCV's own files carry no model: tell it by the number of
+    // coefficients (4 or 5: plumb_bob, 8: rational).
+    if (d.size() == 8) id = CameraModelId::kPinholeRational;
+    else if (d.size() == 4 || d.size() == 5) id = CameraModelId::kPinholeRadtan;
+    else {
+      return r.Fail("distortion_coefficients",
+                    std::to_string(d.size()) +
+                        " coefficients without a 'model' field (expected 4, "
+                        "5 or 8)");
+    }
+  }
+  ResetCamera(id, camera);
+  if (!r.Size(root, camera)) return false;
+  if (!r.Intrinsics(k, "camera_matrix/data", camera)) return false;
+  const size_t count = camera->params.size() - kDistortionBegin;
+  // plumb_bob may omit k3; the other models need all coefficients.
+  const size_t min_count = id == CameraModelId::kPinholeRadtan ? 4 : count;
+  return r.SetDistortion(d, "distortion_coefficients/data", min_count, camera);
+}
+
+bool ParseKalibr(const YAML::Node& root, Reader& r, Camera* camera) {
+  YAML::Node cam;
+  if (!r.Get(root, "cam0", "cam0", &cam)) return false;
+  YAML::Node node;
+  std::string camera_model, distortion_model;
+  if (!r.Get(cam, "cam0/camera_model", "camera_model", &node) ||
+      !r.Scalar(node, "cam0/camera_model", &camera_model)) {
+    return false;
+  }
+  if (camera_model != "pinhole") {
+    return r.Fail("cam0/camera_model", "only 'pinhole' is supported, got '" +
+                                           camera_model + "'");
+  }
+  if (!r.Get(cam, "cam0/distortion_model", "distortion_model", &node) ||
+      !r.Scalar(node, "cam0/distortion_model", &distortion_model)) {
+    return false;
+  }
+  CameraModelId id;
+  if (distortion_model == "radtan") {
+    id = CameraModelId::kPinholeRadtan;
+  } else if (distortion_model == "equidistant") {
+    id = CameraModelId::kKannalaBrandt;
+  } else {
+    return r.Fail("cam0/distortion_model",
+                  "unknown model '" + distortion_model +
+                      "' (known: radtan, equidistant)");
+  }
+  ResetCamera(id, camera);
+  std::vector<double> intrinsics, coeffs, resolution;
+  if (!r.Get(cam, "cam0/intrinsics", "intrinsics", &node) ||
+      !r.Numbers(node, "cam0/intrinsics", &intrinsics)) {
+    return false;
+  }
+  if (intrinsics.size() != 4) {
+    return r.Fail("cam0/intrinsics", "expected [fu, fv, pu, pv]");
+  }
+  if (!(intrinsics[0] > 0) || !(intrinsics[1] > 0)) {
+    return r.Fail("cam0/intrinsics", "focal lengths must be positive");
+  }
+  for (int k = 0; k < 4; ++k) camera->params[k] = intrinsics[k];
+  if (!r.Get(cam, "cam0/distortion_coeffs", "distortion_coeffs", &node) ||
+      !r.Numbers(node, "cam0/distortion_coeffs", &coeffs)) {
+    return false;
+  }
+  if (coeffs.size() != 4) {
+    return r.Fail("cam0/distortion_coeffs", "expected 4 coefficients, got " +
+                                                std::to_string(coeffs.size()));
+  }
+  for (int k = 0; k < 4; ++k) camera->params[kDistortionBegin + k] = coeffs[k];
+  if (!r.Get(cam, "cam0/resolution", "resolution", &node) ||
+      !r.Numbers(node, "cam0/resolution", &resolution)) {
+    return false;
+  }
+  if (resolution.size() != 2 || !(resolution[0] > 0) ||
+      !(resolution[1] > 0)) {
+    return r.Fail("cam0/resolution", "expected [width, height]");
+  }
+  camera->width = static_cast<int>(resolution[0]);
+  camera->height = static_cast<int>(resolution[1]);
+  return true;
+}
+
+}  // namespace
+
+const char* CameraFileFormatName(CameraFileFormat format) {
+  switch (format) {
+    case CameraFileFormat::kPuzzlecal:
+      return "puzzlecal";
+    case CameraFileFormat::kOpenCv:
+      return "opencv";
+    case CameraFileFormat::kRos:
+      return "ros";
+    case CameraFileFormat::kKalibr:
+      return "kalibr";
+  }
+  return "puzzlecal";
+}
+
+bool CameraFileFormatFromName(const std::string& name,
+                              CameraFileFormat* format) {
+  for (CameraFileFormat candidate :
+       {CameraFileFormat::kPuzzlecal, CameraFileFormat::kOpenCv,
+        CameraFileFormat::kRos, CameraFileFormat::kKalibr}) {
+    if (name == CameraFileFormatName(candidate)) {
+      *format = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
+                      CameraFileFormat format, std::string* text,
+                      std::string* error) {
+  if (!CheckCamera(camera, error)) return false;
+  switch (format) {
+    case CameraFileFormat::kPuzzlecal:
+      *text = FormatPuzzlecal(camera, stats);
+      return true;
+    case CameraFileFormat::kOpenCv:
+      *text = FormatOpenCv(camera);
+      return true;
+    case CameraFileFormat::kRos:
+      *text = FormatRos(camera);
+      return true;
+    case CameraFileFormat::kKalibr:
+      return FormatKalibr(camera, text, error);
+  }
+  return Fail("unknown camera file format", error);
+}
+
+bool WriteCameraFile(const std::string& path, CameraFileFormat format,
+                     const Camera& camera, const CameraFileStats& stats,
+                     std::string* error) {
+  std::string text, why;
+  if (!FormatCameraFile(camera, stats, format, &text, &why)) {
+    return Fail("cannot write '" + path + "' (" +
+                    CameraFileFormatName(format) + " format): " + why,
+                error);
+  }
+  return WriteFileAtomically(path, text, error);
+}
+
+bool WriteCameraFile(const std::string& path, CameraFileFormat format,
+                     const CalibrationResult& result, std::string* error) {
+  CameraFileStats stats;
+  stats.has_stats = true;
+  stats.param_stddev = result.param_stddev;
+  stats.rms_px = result.rms_px;
+  stats.num_views_used = result.num_views_used;
+  stats.num_corners_used = result.num_corners_used;
+  stats.num_outliers = result.num_outliers;
+  return WriteCameraFile(path, format, result.camera, stats, error);
+}
+
+bool ParseCameraFile(const std::string& text, const std::string& source,
+                     Camera* camera, CameraFileFormat* format,
+                     std::string* error) {
+  // yaml-cpp does not know OpenCV's "%YAML:1.0" directive.
+  std::string body = text;
+  bool opencv_header = false;
+  if (body.rfind("%YAML:", 0) == 0) {
+    opencv_header = true;
+    const size_t newline = body.find('\n');
+    body = newline == std::string::npos ? "" : body.substr(newline + 1);
+  }
+  YAML::Node root;
+  try {
+    root = YAML::Load(body);
+  } catch (const YAML::Exception& e) {
+    return Fail(source + ": not valid YAML: " + e.what(), error);
+  }
+  if (!root.IsMap()) {
+    return Fail(source + ": not a camera file (expected a YAML map)", error);
+  }
+  Reader reader(source, error);
+  Camera parsed;
+  CameraFileFormat found;
+  bool ok;
+  try {
+    if (root["format"] || root["parameters"]) {
+      found = CameraFileFormat::kPuzzlecal;
+      ok = ParsePuzzlecal(root, reader, &parsed);
+    } else if (root["cam0"]) {
+      found = CameraFileFormat::kKalibr;
+      ok = ParseKalibr(root, reader, &parsed);
+    } else if (root["distortion_model"]) {
+      found = CameraFileFormat::kRos;
+      ok = ParseOpenCvOrRos(root, reader, /*ros=*/true, &parsed);
+    } else if (opencv_header || root["camera_matrix"]) {
+      found = CameraFileFormat::kOpenCv;
+      ok = ParseOpenCvOrRos(root, reader, /*ros=*/false, &parsed);
+    } else {
+      return Fail(source + ": not a camera file in any known format "
+                  "(puzzlecal, opencv, ros, kalibr): no 'parameters', "
+                  "'camera_matrix' or 'cam0'", error);
+    }
+  } catch (const YAML::Exception& e) {
+    return Fail(source + ": " + e.what(), error);
+  }
+  if (!ok) return false;
+  *camera = parsed;
+  if (format != nullptr) *format = found;
+  return true;
+}
+
+bool ReadCameraFile(const std::string& path, Camera* camera,
+                    std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Fail("cannot open '" + path + "'", error);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return Fail("cannot read '" + path + "'", error);
+  return ParseCameraFile(text.str(), path, camera, nullptr, error);
+}
+
+}  // namespace puzzlecal

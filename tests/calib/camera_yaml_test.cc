@@ -1,0 +1,307 @@
+#include "calib/camera_yaml.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "calib/atomic_file.h"
+
+namespace puzzlecal {
+namespace {
+
+Camera MakeCamera(CameraModelId id) {
+  Camera camera;
+  camera.model = id;
+  camera.width = 1280;
+  camera.height = 960;
+  switch (id) {
+    case CameraModelId::kPinholeRadtan:
+      camera.params = {820.125, 818.5, 642.3, 477.1, -0.28, 0.09, 6e-4, -4e-4,
+                       -0.012};
+      break;
+    case CameraModelId::kPinholeRational:
+      camera.params = {760.0, 761.2, 637.8, 482.6, 0.3,  0.02,
+                       4e-4,  7e-4,  5e-4,  0.52,  0.06, 0.001};
+      break;
+    case CameraModelId::kKannalaBrandt:
+      camera.params = {495.0, 494.2, 801.7, 598.4, 0.02, -0.005, 0.001, -2e-4};
+      break;
+  }
+  return camera;
+}
+
+// A fresh scratch folder per test, removed at the end.
+class CameraYamlTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char pattern[] = "camera_yaml_test_XXXXXX";
+    const std::string base =
+        std::string(::testing::TempDir()) + "/" + pattern;
+    std::vector<char> name(base.begin(), base.end());
+    name.push_back('\0');
+    ASSERT_NE(mkdtemp(name.data()), nullptr);
+    dir_ = name.data();
+  }
+  void TearDown() override {
+    for (const std::string& file : files_) std::remove(file.c_str());
+    rmdir(dir_.c_str());
+  }
+  std::string Path(const std::string& name) {
+    files_.push_back(dir_ + "/" + name);
+    return files_.back();
+  }
+  std::string dir_;
+  std::vector<std::string> files_;
+};
+
+TEST_F(CameraYamlTest, RoundTripsEveryModelThroughEveryLosslessFormat) {
+  for (CameraModelId id : kAllCameraModels) {
+    for (CameraFileFormat format :
+         {CameraFileFormat::kPuzzlecal, CameraFileFormat::kOpenCv,
+          CameraFileFormat::kRos, CameraFileFormat::kKalibr}) {
+      Camera camera = MakeCamera(id);
+      if (format == CameraFileFormat::kKalibr &&
+          id == CameraModelId::kPinholeRadtan) {
+        camera.params[8] = 0;  // kalibr's radtan has no k3
+      }
+      if (format == CameraFileFormat::kKalibr &&
+          id == CameraModelId::kPinholeRational) {
+        continue;  // refused, see below
+      }
+      SCOPED_TRACE(std::string(CameraModelName(id)) + " as " +
+                   CameraFileFormatName(format));
+      const std::string path = Path(std::string(CameraModelName(id)) + "." +
+                                    CameraFileFormatName(format) + ".yaml");
+      std::string error;
+      ASSERT_TRUE(
+          WriteCameraFile(path, format, camera, CameraFileStats(), &error))
+          << error;
+      Camera read;
+      ASSERT_TRUE(ReadCameraFile(path, &read, &error)) << error;
+      EXPECT_EQ(read.model, camera.model);
+      EXPECT_EQ(read.width, camera.width);
+      EXPECT_EQ(read.height, camera.height);
+      ASSERT_EQ(read.params.size(), camera.params.size());
+      for (size_t k = 0; k < camera.params.size(); ++k) {
+        EXPECT_EQ(read.params[k], camera.params[k]) << k;
+      }
+    }
+  }
+}
+
+TEST_F(CameraYamlTest, PuzzlecalFormatCarriesTheStatistics) {
+  CalibrationResult result;
+  result.camera = MakeCamera(CameraModelId::kKannalaBrandt);
+  result.param_stddev = {0.1, 0.2, 0.3, 0.4, 1e-4, 2e-4, 3e-4, 4e-5};
+  result.rms_px = 0.0961;
+  result.num_views_used = 20;
+  result.num_corners_used = 1598;
+  result.num_outliers = 3;
+  const std::string path = Path("camera.yaml");
+  std::string error;
+  ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kPuzzlecal, result,
+                              &error))
+      << error;
+  // Read back with a plain YAML reader: the fields are where they belong.
+  const YAML::Node root = YAML::LoadFile(path);
+  EXPECT_EQ(root["model"].as<std::string>(), "kannala-brandt");
+  EXPECT_EQ(root["image_width"].as<int>(), 1280);
+  EXPECT_EQ(root["image_height"].as<int>(), 960);
+  EXPECT_EQ(root["parameters"]["k2"].as<double>(), -0.005);
+  EXPECT_EQ(root["parameter_stddev"]["cx"].as<double>(), 0.3);
+  EXPECT_EQ(root["rms_px"].as<double>(), 0.0961);
+  EXPECT_EQ(root["views_used"].as<int>(), 20);
+  EXPECT_EQ(root["corners_used"].as<int>(), 1598);
+  EXPECT_EQ(root["outliers"].as<int>(), 3);
+}
+
+TEST_F(CameraYamlTest, OpenCvFormatIsReadableByFileStorage) {
+  for (CameraModelId id : kAllCameraModels) {
+    const Camera camera = MakeCamera(id);
+    const std::string path =
+        Path(std::string("opencv_") + CameraModelName(id) + ".yaml");
+    std::string error;
+    ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kOpenCv, camera,
+                                CameraFileStats(), &error))
+        << error;
+    cv::FileStorage fs(path, cv::FileStorage::READ);
+    ASSERT_TRUE(fs.isOpened());
+    cv::Mat k, d;
+    fs["camera_matrix"] >> k;
+    fs["distortion_coefficients"] >> d;
+    ASSERT_EQ(k.rows, 3);
+    ASSERT_EQ(k.cols, 3);
+    EXPECT_EQ(k.at<double>(0, 0), camera.params[0]);
+    EXPECT_EQ(k.at<double>(1, 1), camera.params[1]);
+    EXPECT_EQ(k.at<double>(0, 2), camera.params[2]);
+    EXPECT_EQ(k.at<double>(1, 2), camera.params[3]);
+    EXPECT_EQ(k.at<double>(2, 2), 1.0);
+    ASSERT_EQ(static_cast<int>(d.total()),
+              CameraModelNumParams(id) - kDistortionBegin);
+    for (int i = 0; i < static_cast<int>(d.total()); ++i) {
+      EXPECT_EQ(d.at<double>(i), camera.params[kDistortionBegin + i]);
+    }
+    EXPECT_EQ(static_cast<int>(fs["image_width"]), camera.width);
+    EXPECT_EQ(static_cast<int>(fs["image_height"]), camera.height);
+    EXPECT_EQ(static_cast<std::string>(fs["model"]), CameraModelName(id));
+  }
+}
+
+TEST_F(CameraYamlTest, ReadsFilesWrittenByOpenCv) {
+  const std::string path = Path("written_by_opencv.yaml");
+  {
+    cv::FileStorage fs(path, cv::FileStorage::WRITE);
+    fs << "image_width" << 640 << "image_height" << 480;
+    fs << "camera_matrix"
+       << (cv::Mat_<double>(3, 3) << 500, 0, 320, 0, 501, 240, 0, 0, 1);
+    fs << "distortion_coefficients"
+       << (cv::Mat_<double>(1, 8) << 0.1, 0.01, 1e-3, 2e-3, 1e-4, 0.2, 0.02,
+           1e-3);
+  }
+  Camera camera;
+  std::string error;
+  ASSERT_TRUE(ReadCameraFile(path, &camera, &error)) << error;
+  EXPECT_EQ(camera.model, CameraModelId::kPinholeRational);
+  EXPECT_EQ(camera.params[1], 501);
+  EXPECT_EQ(camera.params[11], 1e-3);
+  EXPECT_EQ(camera.width, 640);
+}
+
+TEST_F(CameraYamlTest, RosFileHasCameraInfoFields) {
+  const Camera camera = MakeCamera(CameraModelId::kPinholeRational);
+  std::string text, error;
+  ASSERT_TRUE(FormatCameraFile(camera, CameraFileStats(),
+                               CameraFileFormat::kRos, &text, &error));
+  for (const char* field :
+       {"image_width: 1280", "image_height: 960", "camera_name:",
+        "camera_matrix:", "distortion_model: rational_polynomial",
+        "distortion_coefficients:", "rectification_matrix:",
+        "projection_matrix:", "rows: 3", "cols: 4"}) {
+    EXPECT_NE(text.find(field), std::string::npos) << field << "\n" << text;
+  }
+  ASSERT_TRUE(FormatCameraFile(MakeCamera(CameraModelId::kKannalaBrandt),
+                               CameraFileStats(), CameraFileFormat::kRos,
+                               &text, &error));
+  EXPECT_NE(text.find("distortion_model: equidistant"), std::string::npos);
+  ASSERT_TRUE(FormatCameraFile(MakeCamera(CameraModelId::kPinholeRadtan),
+                               CameraFileStats(), CameraFileFormat::kRos,
+                               &text, &error));
+  EXPECT_NE(text.find("distortion_model: plumb_bob"), std::string::npos);
+}
+
+TEST_F(CameraYamlTest, KalibrRefusesLossyWritesAndKeepsTheOldFile) {
+  const std::string path = Path("camchain.yaml");
+  std::string error;
+  ASSERT_TRUE(WriteFileAtomically(path, "old contents\n", &error)) << error;
+  // k3 != 0 has no place in kalibr's radtan.
+  EXPECT_FALSE(WriteCameraFile(path, CameraFileFormat::kKalibr,
+                               MakeCamera(CameraModelId::kPinholeRadtan),
+                               CameraFileStats(), &error));
+  EXPECT_NE(error.find("k3"), std::string::npos) << error;
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_FALSE(WriteCameraFile(path, CameraFileFormat::kKalibr,
+                               MakeCamera(CameraModelId::kPinholeRational),
+                               CameraFileStats(), &error));
+  EXPECT_NE(error.find("rational"), std::string::npos) << error;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "old contents");
+  // The kalibr fields.
+  Camera camera = MakeCamera(CameraModelId::kKannalaBrandt);
+  std::string text;
+  ASSERT_TRUE(FormatCameraFile(camera, CameraFileStats(),
+                               CameraFileFormat::kKalibr, &text, &error));
+  for (const char* field :
+       {"cam0:", "camera_model: pinhole", "intrinsics: [495",
+        "distortion_model: equidistant", "distortion_coeffs: [",
+        "resolution: [1280, 960]"}) {
+    EXPECT_NE(text.find(field), std::string::npos) << field << "\n" << text;
+  }
+}
+
+TEST_F(CameraYamlTest, BadFilesGiveMessagesNamingFileAndField) {
+  struct Case {
+    const char* text;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"format: puzzlecal-camera\nmodel: pinhole-fancy\nimage_width: 10\n"
+       "image_height: 10\nparameters: {}\n",
+       "field 'model': unknown model 'pinhole-fancy'"},
+      {"format: puzzlecal-camera\nmodel: kannala-brandt\nimage_width: 10\n"
+       "image_height: 10\nparameters: {fx: 1, fy: 1, cx: 1, cy: 1, k1: 0, "
+       "k2: 0, k3: 0}\n",
+       "field 'parameters/k4': missing"},
+      {"format: puzzlecal-camera\nmodel: kannala-brandt\nimage_width: ten\n",
+       "field 'image_width': cannot read 'ten'"},
+      {"image_width: 640\nimage_height: 480\ncamera_name: c\n"
+       "camera_matrix: {rows: 3, cols: 3, data: [1, 0, 1, 0, 1, 1]}\n"
+       "distortion_model: plumb_bob\n"
+       "distortion_coefficients: {rows: 1, cols: 5, data: [0, 0, 0, 0, 0]}\n",
+       "field 'camera_matrix/data': expected 9 numbers, got 6"},
+      {"image_width: 640\nimage_height: 480\n"
+       "camera_matrix: {rows: 3, cols: 3, data: [1, 0, 1, 0, 1, 1, 0, 0, 1]}\n"
+       "distortion_model: kb9\n"
+       "distortion_coefficients: {rows: 1, cols: 5, data: [0, 0, 0, 0, 0]}\n",
+       "field 'distortion_model': unknown model 'kb9'"},
+      {"cam0:\n  camera_model: omni\n", "field 'cam0/camera_model'"},
+      {"cam0:\n  camera_model: pinhole\n  distortion_model: radtan\n"
+       "  intrinsics: [1, 1, 1, 1]\n  distortion_coeffs: [0, 0, 0]\n",
+       "field 'cam0/distortion_coeffs': expected 4 coefficients, got 3"},
+      {"just: a map\n", "not a camera file in any known format"},
+      {"[1, 2\n", "not valid YAML"},
+  };
+  for (const Case& c : cases) {
+    Camera camera;
+    std::string error;
+    EXPECT_FALSE(ParseCameraFile(c.text, "cam.yaml", &camera, nullptr, &error))
+        << c.text;
+    EXPECT_NE(error.find("cam.yaml"), std::string::npos) << error;
+    EXPECT_NE(error.find(c.expected), std::string::npos)
+        << "got: " << error << "\nexpected: " << c.expected;
+  }
+  Camera camera;
+  std::string error;
+  EXPECT_FALSE(ReadCameraFile(Path("missing.yaml"), &camera, &error));
+  EXPECT_NE(error.find("missing.yaml"), std::string::npos);
+}
+
+TEST_F(CameraYamlTest, FormatNames) {
+  for (CameraFileFormat format :
+       {CameraFileFormat::kPuzzlecal, CameraFileFormat::kOpenCv,
+        CameraFileFormat::kRos, CameraFileFormat::kKalibr}) {
+    CameraFileFormat parsed;
+    ASSERT_TRUE(CameraFileFormatFromName(CameraFileFormatName(format), &parsed));
+    EXPECT_EQ(parsed, format);
+  }
+  CameraFileFormat parsed;
+  EXPECT_FALSE(CameraFileFormatFromName("json", &parsed));
+}
+
+TEST_F(CameraYamlTest, AtomicWriteReplacesAndReportsFailures) {
+  const std::string path = Path("atomic.txt");
+  std::string error;
+  ASSERT_TRUE(WriteFileAtomically(path, "first", &error)) << error;
+  ASSERT_TRUE(WriteFileAtomically(path, "second", &error)) << error;
+  std::ifstream in(path);
+  std::string contents((std::istreambuf_iterator<char>(in)),
+                       std::istreambuf_iterator<char>());
+  EXPECT_EQ(contents, "second");
+  const std::string bad = dir_ + "/no_such_folder/file.txt";
+  EXPECT_FALSE(WriteFileAtomically(bad, "x", &error));
+  EXPECT_NE(error.find(bad), std::string::npos) << error;
+  EXPECT_NE(error.find("No such file"), std::string::npos) << error;
+  EXPECT_FALSE(WriteFileAtomically(dir_, "x", &error));
+  EXPECT_NE(error.find("folder"), std::string::npos) << error;
+  EXPECT_FALSE(WriteFileAtomically("", "x", &error));
+}
+
+}  // namespace
+}  // namespace puzzlecal
