@@ -251,5 +251,211 @@ TEST(RenderBoardTest, FisheyeEdgesAreExact) {
   EXPECT_LT(error, 0.01) << num_rows;
 }
 
+// Grey of the render at the projection of board point (u, v) (tile units).
+int GreyAtBoardPoint(const cv::Mat& image, const Board& board,
+                     const Camera& camera, const Eigen::Isometry3d& pose,
+                     double u, double v) {
+  Eigen::Vector2d pixel;
+  const Eigen::Vector3d p(u * board.tile_size_m, v * board.tile_size_m, 0);
+  if (!camera.Project(pose * p, &pixel)) return -1;
+  return image.at<uint8_t>(static_cast<int>(std::lround(pixel.y())),
+                           static_cast<int>(std::lround(pixel.x())));
+}
+
+RenderOptions CleanOptions() {
+  RenderOptions options;
+  options.blur_sigma_px = 0.0;
+  options.black_level = 0.0;
+  options.white_level = 1.0;
+  return options;
+}
+
+// Counts tiles and discs whose rendered grey matches the true pattern, with
+// the pattern variant `as_if` applied to the expectation.
+struct PatternAgreement {
+  int tiles = 0, tiles_ok = 0, discs = 0, discs_ok = 0;
+};
+PatternAgreement CheckPattern(const cv::Mat& image, const Board& board,
+                              const Camera& camera,
+                              const Eigen::Isometry3d& pose, bool mirrored,
+                              bool inverted) {
+  PatternAgreement a;
+  const int x0 = board.origin.x(), y0 = board.origin.y();
+  auto expect = [&](bool white) { return (white != inverted) ? 255 : 0; };
+  // Under mirroring, the print at board position u shows the true pattern
+  // at m - u.
+  const double m = 2.0 * x0 + board.cols - 1;
+  auto print_u = [&](double u) { return mirrored ? m - u : u; };
+  for (int y = y0; y + 1 < y0 + board.rows; ++y) {
+    for (int x = x0; x + 1 < x0 + board.cols; ++x) {
+      const double u = x + 0.5, v = y + 0.5;
+      const int tile_x = static_cast<int>(std::floor(print_u(u)));
+      ++a.tiles;
+      a.tiles_ok += GreyAtBoardPoint(image, board, camera, pose, u, v) ==
+                    expect(!PuzzleBoardTileIsBlack(tile_x, y));
+    }
+  }
+  for (int y = y0; y < y0 + board.rows; ++y) {
+    for (int x = x0; x < x0 + board.cols; ++x) {
+      if (y + 1 < y0 + board.rows) {
+        const int px = static_cast<int>(std::lround(print_u(x)));
+        ++a.discs;
+        a.discs_ok += GreyAtBoardPoint(image, board, camera, pose, x, y + 0.5) ==
+                      expect(PuzzleBoardVerticalEdgeBit(px, y) == 1);
+      }
+      if (x + 1 < x0 + board.cols) {
+        const int px = static_cast<int>(std::floor(print_u(x + 0.5)));
+        ++a.discs;
+        a.discs_ok += GreyAtBoardPoint(image, board, camera, pose, x + 0.5, y) ==
+                      expect(PuzzleBoardHorizontalEdgeBit(px, y) == 1);
+      }
+    }
+  }
+  return a;
+}
+
+TEST(RenderBoardTest, TilesAndDiscsShowTheCode) {
+  Board board = PuzzleBoard11x8();
+  board.origin = Eigen::Vector2i(200, 37);
+  const Camera camera = PinholeCamera();
+  const Eigen::Isometry3d pose = LookAtBoard(board, 1.0, 0.2, 0.1);
+  RenderOptions options = CleanOptions();
+  const cv::Mat image = RenderBoard(board, camera, pose, options);
+  ASSERT_FALSE(image.empty());
+  PatternAgreement a = CheckPattern(image, board, camera, pose, false, false);
+  EXPECT_EQ(a.tiles, 70);
+  EXPECT_EQ(a.discs, 11 * 7 + 10 * 8);
+  EXPECT_EQ(a.tiles_ok, a.tiles);
+  EXPECT_EQ(a.discs_ok, a.discs);
+
+  options.variant.inverted = true;
+  a = CheckPattern(RenderBoard(board, camera, pose, options), board, camera,
+                   pose, false, true);
+  EXPECT_EQ(a.tiles_ok, a.tiles);
+  EXPECT_EQ(a.discs_ok, a.discs);
+
+  options.variant.inverted = false;
+  options.variant.mirrored = true;
+  a = CheckPattern(RenderBoard(board, camera, pose, options), board, camera,
+                   pose, true, false);
+  EXPECT_EQ(a.tiles_ok, a.tiles);
+  EXPECT_EQ(a.discs_ok, a.discs);
+
+  // Another code: the tiles stay, about half the discs change.
+  options.variant.mirrored = false;
+  options.variant.random_code_seed = 99;
+  a = CheckPattern(RenderBoard(board, camera, pose, options), board, camera,
+                   pose, false, false);
+  EXPECT_EQ(a.tiles_ok, a.tiles);
+  EXPECT_GT(a.discs - a.discs_ok, a.discs / 4);
+  EXPECT_LT(a.discs - a.discs_ok, 3 * a.discs / 4);
+}
+
+TEST(RenderBoardTest, SameImageForAnyThreadCount) {
+  const Board board = PuzzleBoard11x8();
+  RenderOptions options;
+  options.noise_sigma = 0.05;
+  options.vignetting = 0.3;
+  options.occluders.push_back({Eigen::Vector2d(300, 200), 30, 0.3});
+  const Eigen::Isometry3d pose = LookAtBoard(board, 0.5, 0.3, 0.4);
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(1);
+  const cv::Mat one = RenderBoard(board, FisheyeCamera(), pose, options);
+  cv::setNumThreads(std::max(threads, 2));
+  const cv::Mat many = RenderBoard(board, FisheyeCamera(), pose, options);
+  cv::setNumThreads(threads);
+  ASSERT_FALSE(one.empty());
+  EXPECT_EQ(cv::norm(one, many, cv::NORM_INF), 0.0);
+  options.seed = 2;
+  const cv::Mat other = RenderBoard(board, FisheyeCamera(), pose, options);
+  EXPECT_GT(cv::norm(one, other, cv::NORM_INF), 0.0);  // noise follows seed
+}
+
+TEST(RenderBoardTest, OccludersHideCornersAndPixels) {
+  const Board board = PuzzleBoard11x8();
+  const Camera camera = PinholeCamera();
+  const Eigen::Isometry3d pose = LookAtBoard(board, 0.9, 0.0, 0.0);
+  RenderTruth clear;
+  RenderBoard(board, camera, pose, CleanOptions(), &clear);
+  const TruthCorner& target = clear.corners[3 * 11 + 4];
+  ASSERT_TRUE(target.visible);
+  RenderOptions options = CleanOptions();
+  options.occluders.push_back({target.xy, 25.0, 0.4});
+  RenderTruth truth;
+  RenderSummary summary;
+  const cv::Mat image =
+      RenderBoard(board, camera, pose, options, &truth, &summary);
+  EXPECT_FALSE(truth.corners[3 * 11 + 4].visible);
+  EXPECT_EQ(image.at<uint8_t>(static_cast<int>(target.xy.y()),
+                              static_cast<int>(target.xy.x())),
+            std::lround(0.4 * 255));
+  EXPECT_LT(summary.num_visible_corners, 88);
+  EXPECT_GT(summary.num_visible_corners, 80);
+}
+
+TEST(RenderBoardTest, CornersOutsideTheImageOrBehindAreNotVisible) {
+  const Board board = PuzzleBoard11x8();
+  const Camera camera = PinholeCamera();
+  // Board shifted right: part of it leaves the image.
+  const Eigen::Isometry3d pose =
+      LookAtBoard(board, 0.9, 0.0, 0.0, Eigen::Vector3d(0.35, 0, 0));
+  RenderTruth truth;
+  RenderBoard(board, camera, pose, CleanOptions(), &truth);
+  int inside = 0, outside = 0;
+  for (const TruthCorner& c : truth.corners) {
+    const bool in_image = c.xy.x() >= 0.5 && c.xy.x() <= 638.5;
+    EXPECT_EQ(c.visible, in_image) << c.xy.transpose();
+    (in_image ? inside : outside) += 1;
+  }
+  EXPECT_GT(inside, 10);
+  EXPECT_GT(outside, 10);
+  // Seen from behind: the back of the paper shows no corners.
+  Eigen::Isometry3d behind = LookAtBoard(board, 0.9, M_PI, 0.0);
+  RenderSummary summary;
+  const cv::Mat image =
+      RenderBoard(board, camera, behind, CleanOptions(), &truth, &summary);
+  ASSERT_TRUE(summary.ok);
+  EXPECT_EQ(summary.num_visible_corners, 0);
+  EXPECT_GT(summary.num_pixels_on_board, 1000);
+}
+
+TEST(RenderBoardTest, BadInputGivesAnEmptyImageAndAReason) {
+  const Board board = PuzzleBoard11x8();
+  Camera camera = PinholeCamera();
+  const Eigen::Isometry3d pose = LookAtBoard(board, 0.9, 0.0, 0.0);
+  RenderSummary summary;
+  camera.params.resize(5);
+  EXPECT_TRUE(RenderBoard(board, camera, pose, RenderOptions(), nullptr,
+                          &summary)
+                  .empty());
+  EXPECT_FALSE(summary.ok);
+  EXPECT_NE(summary.reason.find("parameters"), std::string::npos);
+  camera = PinholeCamera();
+  camera.width = 0;
+  EXPECT_TRUE(RenderBoard(board, camera, pose, RenderOptions(), nullptr,
+                          &summary)
+                  .empty());
+  EXPECT_NE(summary.reason.find("size"), std::string::npos);
+  Eigen::Isometry3d nan_pose = pose;
+  nan_pose.translation().x() = std::nan("");
+  EXPECT_TRUE(RenderBoard(board, PinholeCamera(), nan_pose, RenderOptions(),
+                          nullptr, &summary)
+                  .empty());
+  EXPECT_NE(summary.reason.find("cam_from_board"), std::string::npos);
+  RenderOptions options;
+  options.black_level = 0.9;
+  options.white_level = 0.1;
+  EXPECT_TRUE(RenderBoard(board, PinholeCamera(), pose, options, nullptr,
+                          &summary)
+                  .empty());
+  EXPECT_NE(summary.reason.find("black_level"), std::string::npos);
+  Board bad_board = board;
+  bad_board.tile_size_m = -1;
+  EXPECT_TRUE(RenderBoard(bad_board, PinholeCamera(), pose, RenderOptions(),
+                          nullptr, &summary)
+                  .empty());
+  EXPECT_NE(summary.reason.find("tile_size_m"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace puzzlecal
