@@ -2,10 +2,9 @@
 
 #include <filesystem>
 #include <iostream>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"

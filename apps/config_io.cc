@@ -1,12 +1,12 @@
 #include "apps/config_io.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <set>
 #include <sstream>
-
-#include <yaml-cpp/yaml.h>
 
 namespace puzzlecal {
 namespace {
@@ -42,8 +42,8 @@ class FieldReader {
         for (const std::string& name : allowed) {
           names += (names.empty() ? "" : ", ") + name;
         }
-        return Fail(Join(path, key), "unknown field (expected one of: " +
-                                         names + ")");
+        return Fail(Join(path, key),
+                    "unknown field (expected one of: " + names + ")");
       }
     }
     return true;
@@ -62,8 +62,8 @@ class FieldReader {
       if (!node.IsScalar()) throw YAML::Exception(YAML::Mark(), "");
       *out = node.as<int>();
     } catch (const YAML::Exception&) {
-      return Fail(Join(path, key), "must be an integer, got '" +
-                                       Text(node) + "'");
+      return Fail(Join(path, key),
+                  "must be an integer, got '" + Text(node) + "'");
     }
     return true;
   }
@@ -78,8 +78,8 @@ class FieldReader {
       }
       *out = node.as<uint64_t>();
     } catch (const YAML::Exception&) {
-      return Fail(Join(path, key), "must be a non-negative integer, got '" +
-                                       Text(node) + "'");
+      return Fail(Join(path, key),
+                  "must be a non-negative integer, got '" + Text(node) + "'");
     }
     return true;
   }
@@ -93,8 +93,8 @@ class FieldReader {
       if (!node.IsScalar()) throw YAML::Exception(YAML::Mark(), "");
       value = node.as<double>();
     } catch (const YAML::Exception&) {
-      return Fail(Join(path, key), "must be a number, got '" + Text(node) +
-                                       "'");
+      return Fail(Join(path, key),
+                  "must be a number, got '" + Text(node) + "'");
     }
     if (!std::isfinite(value)) {
       return Fail(Join(path, key), "must be a finite number");
@@ -111,8 +111,8 @@ class FieldReader {
       if (!node.IsScalar()) throw YAML::Exception(YAML::Mark(), "");
       *out = node.as<bool>();
     } catch (const YAML::Exception&) {
-      return Fail(Join(path, key), "must be true or false, got '" +
-                                       Text(node) + "'");
+      return Fail(Join(path, key),
+                  "must be true or false, got '" + Text(node) + "'");
     }
     return true;
   }
@@ -193,8 +193,8 @@ bool LoadYaml(const std::string& path, YAML::Node* root, std::string* error) {
   return true;
 }
 
-bool ParseBoard(const YAML::Node& node, const std::string& path,
-                FieldReader* r, Board* board) {
+bool ParseBoard(const YAML::Node& node, const std::string& path, FieldReader* r,
+                Board* board) {
   if (!r->OnlyKeys(node, path,
                    {"type", "cols", "rows", "origin", "tile_size_m"})) {
     return false;
@@ -223,10 +223,9 @@ bool ParseBoard(const YAML::Node& node, const std::string& path,
   std::string why;
   if (!b.Check(&why)) {
     // Board::Check names the field first ("cols and rows must ...").
-    const std::string field =
-        why.rfind("tile_size_m", 0) == 0 ? "tile_size_m"
-        : why.rfind("origin", 0) == 0    ? "origin"
-                                         : "cols/rows";
+    const std::string field = why.rfind("tile_size_m", 0) == 0 ? "tile_size_m"
+                              : why.rfind("origin", 0) == 0    ? "origin"
+                                                               : "cols/rows";
     return r->Fail(FieldReader::Join(path, field), why);
   }
   *board = b;
@@ -251,8 +250,7 @@ bool ParseCamera(const YAML::Node& node, FieldReader* r, Camera* camera) {
   if (!r->String(node, path, "model", true, &model_name)) return false;
   if (!CameraModelIdFromName(model_name, &model)) {
     return r->Fail("camera.model", "unknown model '" + model_name +
-                                       "' (known: " + CameraModelNames() +
-                                       ")");
+                                       "' (known: " + CameraModelNames() + ")");
   }
   if (!r->Int(node, path, "width", true, &width) ||
       !r->Int(node, path, "height", true, &height)) {
@@ -341,8 +339,7 @@ bool ParseRender(const YAML::Node& node, FieldReader* r,
       !r->Double(node, path, "blur_sigma_px", false, &o.blur_sigma_px) ||
       !r->Double(node, path, "black_level", false, &o.black_level) ||
       !r->Double(node, path, "white_level", false, &o.white_level) ||
-      !r->Double(node, path, "background_level", false,
-                 &o.background_level) ||
+      !r->Double(node, path, "background_level", false, &o.background_level) ||
       !r->Double(node, path, "paper_margin_tiles", false,
                  &o.paper_margin_tiles) ||
       !r->Double(node, path, "lighting_gradient", false,
@@ -377,10 +374,10 @@ bool ParseRender(const YAML::Node& node, FieldReader* r,
 
 bool ParseViewPose(const YAML::Node& node, const std::string& path,
                    FieldReader* r, ViewPose* view) {
-  if (!r->OnlyKeys(node, path,
-                   {"target", "distance_m", "view_angle_deg",
-                    "tilt_direction_deg", "roll_deg", "off_axis_deg",
-                    "off_axis_direction_deg"})) {
+  if (!r->OnlyKeys(
+          node, path,
+          {"target", "distance_m", "view_angle_deg", "tilt_direction_deg",
+           "roll_deg", "off_axis_deg", "off_axis_direction_deg"})) {
     return false;
   }
   std::vector<double> target;
@@ -433,8 +430,7 @@ bool ParseViews(const YAML::Node& list, FieldReader* r, const Board& board,
       }
       Eigen::Matrix3d rot;
       for (int k = 0; k < 9; ++k) rot(k / 3, k % 3) = rotation[k];
-      if ((rot.transpose() * rot - Eigen::Matrix3d::Identity()).norm() >
-              1e-6 ||
+      if ((rot.transpose() * rot - Eigen::Matrix3d::Identity()).norm() > 1e-6 ||
           rot.determinant() < 0) {
         return r->Fail(ppath + ".rotation",
                        "must be a rotation matrix (rows, orthonormal, "
@@ -452,15 +448,14 @@ bool ParseViews(const YAML::Node& list, FieldReader* r, const Board& board,
   return true;
 }
 
-bool ParseRandomViews(const YAML::Node& node, FieldReader* r,
-                      RandomViews* rv) {
+bool ParseRandomViews(const YAML::Node& node, FieldReader* r, RandomViews* rv) {
   const std::string path = "random_views";
-  return r->OnlyKeys(node, path,
-                     {"count", "seed", "min_distance_m", "max_distance_m",
-                      "min_view_angle_deg", "max_view_angle_deg",
-                      "max_roll_deg", "max_off_axis_deg",
-                      "target_margin_tiles", "occluders_per_view",
-                      "min_occluder_radius_px", "max_occluder_radius_px"}) &&
+  return r->OnlyKeys(
+             node, path,
+             {"count", "seed", "min_distance_m", "max_distance_m",
+              "min_view_angle_deg", "max_view_angle_deg", "max_roll_deg",
+              "max_off_axis_deg", "target_margin_tiles", "occluders_per_view",
+              "min_occluder_radius_px", "max_occluder_radius_px"}) &&
          r->Int(node, path, "count", true, &rv->count) &&
          r->Uint64(node, path, "seed", true, &rv->seed) &&
          r->Double(node, path, "min_distance_m", false, &rv->min_distance_m) &&
@@ -507,8 +502,8 @@ bool LoadSceneFile(const std::string& path, SceneSpec* scene,
   if (!LoadYaml(path, &root, error)) return false;
   FieldReader r(path, error);
   if (!r.OnlyKeys(root, "",
-                  {"name", "camera", "board", "render", "views",
-                   "random_views", "tilt_series", "tile_size_series"})) {
+                  {"name", "camera", "board", "render", "views", "random_views",
+                   "tilt_series", "tile_size_series"})) {
     return false;
   }
   SceneSpec s;
@@ -628,8 +623,8 @@ std::string SceneTruthYaml(const SceneSpec& scene,
       } else {
         out << ".nan, .nan";
       }
-      out << ", " << c.id.x() << ", " << c.id.y() << ", "
-          << (c.visible ? 1 : 0) << "]\n";
+      out << ", " << c.id.x() << ", " << c.id.y() << ", " << (c.visible ? 1 : 0)
+          << "]\n";
     }
   }
   return out.str();

@@ -6,9 +6,8 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "sim/pixel_rays.h"
 #include "sim/render.h"
@@ -73,8 +72,7 @@ Eigen::Isometry3d Pose(double distance, double angle) {
       Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()).toRotationMatrix();
   // Board 23 x 16 corners of 30 mm at (50, 100): centre the board.
   const Eigen::Vector3d center((50 + 11) * 0.03, (100 + 7.5) * 0.03, 0);
-  pose.translation() =
-      Eigen::Vector3d(0, 0, distance) - pose.linear() * center;
+  pose.translation() = Eigen::Vector3d(0, 0, distance) - pose.linear() * center;
   return pose;
 }
 
@@ -91,8 +89,7 @@ int main() {
 
   Camera pinhole;
   pinhole.model = CameraModelId::kPinholeRadtan;
-  pinhole.params = {1400, 1400, 799.5, 599.5, -0.2, 0.08, 0.0005, -0.0003,
-                    0.0};
+  pinhole.params = {1400, 1400, 799.5, 599.5, -0.2, 0.08, 0.0005, -0.0003, 0.0};
   pinhole.width = 1600;
   pinhole.height = 1200;
   Camera fisheye;

@@ -5,10 +5,9 @@
 // Shared by the renderer (point queries) and the printable-board writer
 // (edge bits and tile colours).
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
-
-#include <Eigen/Core>
 
 #include "decode/board.h"
 #include "decode/puzzleboard_codes.h"

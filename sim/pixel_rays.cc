@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <limits>
-
 #include <opencv2/core.hpp>
 
 namespace puzzlecal {
@@ -42,8 +41,8 @@ double MaxMonotonicRadius(const Camera& camera) {
     for (int i = 1; i <= kSteps; ++i) {
       const double t = M_PI * i / kSteps;
       const double t2 = t * t, t4 = t2 * t2, t6 = t4 * t2, t8 = t4 * t4;
-      const double slope = 1 + 3 * p[4] * t2 + 5 * p[5] * t4 + 7 * p[6] * t6 +
-                           9 * p[7] * t8;
+      const double slope =
+          1 + 3 * p[4] * t2 + 5 * p[5] * t4 + 7 * p[6] * t6 + 9 * p[7] * t8;
       if (!(slope > 0)) return M_PI * (i - 1) / kSteps;
     }
     return M_PI;
@@ -92,17 +91,18 @@ bool PixelRayGrid::Compute(const Camera& camera, std::string* why) {
   cv::parallel_for_(cv::Range(0, grid_h), [&](const cv::Range& range) {
     for (int cy = range.start; cy < range.end; ++cy) {
       for (int cx = 0; cx < grid_w; ++cx) {
-        double* ray = rays_.data() + 3 * (static_cast<size_t>(cy) * grid_w + cx);
+        double* ray =
+            rays_.data() + 3 * (static_cast<size_t>(cy) * grid_w + cx);
         const double pixel[2] = {cx - 0.5, cy - 0.5};
-        const UnprojectStatus status = DispatchCameraModel(
-            camera.model, [&](auto model) {
+        const UnprojectStatus status =
+            DispatchCameraModel(camera.model, [&](auto model) {
               return decltype(model)::Unproject(camera.params.data(), pixel,
                                                 ray);
             });
         if (!status.converged || !std::isfinite(ray[0]) ||
             !std::isfinite(ray[1]) || !std::isfinite(ray[2]) ||
-            !(UndistortedRadius(camera, Eigen::Vector3d(ray[0], ray[1],
-                                                        ray[2])) <
+            !(UndistortedRadius(camera,
+                                Eigen::Vector3d(ray[0], ray[1], ray[2])) <
               max_radius)) {
           ray[0] = ray[1] = ray[2] = std::numeric_limits<double>::quiet_NaN();
           ++invalid_per_row[cy];

@@ -7,10 +7,9 @@
 // between the four corners of their pixel (the error is second order in the
 // pixel size, far below 1e-4 px for real lenses).
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "calib/camera_models.h"
 
@@ -46,8 +45,8 @@ class PixelRayGrid {
   // cy - 0.5), cx in [0, width], cy in [0, height]. NaN where Unproject did
   // not converge or lies beyond MaxMonotonicRadius (fold-over region).
   const double* Ray(int cx, int cy) const {
-    return rays_.data() + 3 * (static_cast<size_t>(cy) * (camera_.width + 1) +
-                               cx);
+    return rays_.data() +
+           3 * (static_cast<size_t>(cy) * (camera_.width + 1) + cx);
   }
   // Number of pixel corners without a ray.
   int num_invalid() const { return num_invalid_; }

@@ -1,14 +1,14 @@
 #include "sim/print_board.h"
 
+#include <cairo-pdf.h>
+#include <cairo.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <vector>
-
-#include <cairo-pdf.h>
-#include <cairo.h>
 
 #include "decode/puzzleboard.h"
 
@@ -57,12 +57,12 @@ void Layout(const Board& board, std::vector<Rect>* black_tiles,
     for (int x = x0; x < x0 + board.cols; ++x) {
       const double cx = (x - x0 + inset) * s, cy = (y - y0 + inset) * s;
       if (y + 1 < y0 + board.rows) {  // vertical edge (x, y) -> (x, y + 1)
-        discs->push_back({cx, cy + 0.5 * s, r,
-                          PuzzleBoardVerticalEdgeBit(x, y) == 1});
+        discs->push_back(
+            {cx, cy + 0.5 * s, r, PuzzleBoardVerticalEdgeBit(x, y) == 1});
       }
       if (x + 1 < x0 + board.cols) {  // horizontal edge (x, y) -> (x + 1, y)
-        discs->push_back({cx + 0.5 * s, cy, r,
-                          PuzzleBoardHorizontalEdgeBit(x, y) == 1});
+        discs->push_back(
+            {cx + 0.5 * s, cy, r, PuzzleBoardHorizontalEdgeBit(x, y) == 1});
       }
     }
   }

@@ -30,8 +30,7 @@ struct PrintOptions {
 };
 
 // Page size of the printed board in millimetres.
-void PrintedPageSizeMm(const Board& board, double* width_mm,
-                       double* height_mm);
+void PrintedPageSizeMm(const Board& board, double* width_mm, double* height_mm);
 
 // Page coordinates (mm from the top-left page corner) of corner `id`.
 void PrintedCornerMm(const Board& board, int col, int row, double* x_mm,

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
 #include <opencv2/imgproc.hpp>
 
 #include "sim/board_pattern.h"
@@ -82,8 +81,9 @@ bool RenderOptions::Check(std::string* why) const {
   }
   if (!IsFiniteRange(black_level, 0.0, 1.0) ||
       !IsFiniteRange(white_level, 0.0, 1.0) || !(black_level < white_level)) {
-    return fail("black_level and white_level must be in [0, 1] with "
-                "black_level < white_level");
+    return fail(
+        "black_level and white_level must be in [0, 1] with "
+        "black_level < white_level");
   }
   if (!IsFiniteRange(background_level, 0.0, 1.0)) {
     return fail("background_level must be in [0, 1]");
@@ -91,7 +91,8 @@ bool RenderOptions::Check(std::string* why) const {
   if (!IsFiniteRange(paper_margin_tiles, 0.0, 1000.0)) {
     return fail("paper_margin_tiles must be in [0, 1000]");
   }
-  if (!(std::isfinite(lighting_gradient) && std::abs(lighting_gradient) < 2.0)) {
+  if (!(std::isfinite(lighting_gradient) &&
+        std::abs(lighting_gradient) < 2.0)) {
     return fail("lighting_gradient must be in (-2, 2)");
   }
   if (!(std::isfinite(vignetting) && vignetting >= 0.0 && vignetting < 1.0)) {
@@ -161,9 +162,9 @@ std::vector<TruthCorner> ProjectBoardCorners(
       const double pixel_angle =
           std::acos(std::clamp(ray_next.dot(point.normalized()), -1.0, 1.0));
       const double angle = std::atan2(point.head<2>().norm(), point.z());
-      visible = std::isfinite(pixel_angle) &&
-                angle + pixel_angle <
-                    0.5 * options.field_of_view_deg * M_PI / 180.0;
+      visible =
+          std::isfinite(pixel_angle) &&
+          angle + pixel_angle < 0.5 * options.field_of_view_deg * M_PI / 180.0;
     }
     for (const Occluder& o : options.occluders) {
       if (visible && (xy - o.center_px).norm() < o.radius_px + 1.0) {
@@ -302,7 +303,8 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
           // Most pixels see one ink only: shade them once. The box of the
           // corner hits is padded for the curvature of distorted pixel
           // footprints.
-          if (row_occluders.empty() || !PixelMayBeOccluded(row_occluders, x, y)) {
+          if (row_occluders.empty() ||
+              !PixelMayBeOccluded(row_occluders, x, y)) {
             Eigen::Vector2d lo = hit[0], hi = hit[0];
             for (int k = 1; k < 4; ++k) {
               lo = lo.cwiseMin(hit[k]);
@@ -366,14 +368,14 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
               continue;
             }
             const double t = -center.z() / d.z();
-            sum += mix_value(pattern.SampleArea(center.x() + t * d.x(),
-                                                center.y() + t * d.y(),
-                                                footprint));
+            sum += mix_value(pattern.SampleArea(
+                center.x() + t * d.x(), center.y() + t * d.y(), footprint));
           }
         }
         out[x] = static_cast<float>(sum * inv_samples);
         if (all_hit) {
-          const Eigen::Vector2d mid = 0.25 * (hit[0] + hit[1] + hit[2] + hit[3]);
+          const Eigen::Vector2d mid =
+              0.25 * (hit[0] + hit[1] + hit[2] + hit[3]);
           if (pattern.Sample(mid.x(), mid.y()) != BoardInk::kNone) {
             ++on_board_per_row[y];
           }
@@ -400,10 +402,9 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
             continue;
           }
           const double angle = std::atan2(mean.head<2>().norm(), mean.z());
-          const double pixel_angle =
-              std::max(std::acos(std::clamp(r0.dot(r3), -1.0, 1.0)) /
-                           std::sqrt(2.0),
-                       1e-12);
+          const double pixel_angle = std::max(
+              std::acos(std::clamp(r0.dot(r3), -1.0, 1.0)) / std::sqrt(2.0),
+              1e-12);
           const double inside =
               std::clamp(0.5 + (max_angle - angle) / pixel_angle, 0.0, 1.0);
           out[x] = static_cast<float>(out[x] * inside);
@@ -456,8 +457,8 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
           }
           v += options.noise_sigma * contrast * normal;
         }
-        out[x] = static_cast<uint8_t>(
-            std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+        out[x] =
+            static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
       }
     }
   });

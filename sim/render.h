@@ -3,13 +3,12 @@
 
 // Rendering a board through a camera model with exact ground truth.
 
-#include <cstdint>
-#include <string>
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <opencv2/core.hpp>
+#include <string>
+#include <vector>
 
 #include "calib/camera_models.h"
 #include "decode/board.h"
@@ -98,19 +97,19 @@ struct TruthCorner {
 
 // The exact geometry behind a render.
 struct RenderTruth {
-  Camera camera;                                       // model, params, size
+  Camera camera;  // model, params, size
   Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
   std::vector<TruthCorner> corners;  // every printed inner corner of the board
 };
 
 // What a render did.
 struct RenderSummary {
-  bool ok = false;      // an image was produced
-  std::string reason;   // why not, naming the offending input
-  int num_visible_corners = 0;   // TruthCorner::visible count
+  bool ok = false;                 // an image was produced
+  std::string reason;              // why not, naming the offending input
+  int num_visible_corners = 0;     // TruthCorner::visible count
   int num_pixels_without_ray = 0;  // pixels the model has no ray for
                                    // (outside a fisheye's image circle)
-  int num_pixels_on_board = 0;   // pixels whose centre sees the paper
+  int num_pixels_on_board = 0;     // pixels whose centre sees the paper
 };
 
 // Renders `board` seen by `camera` from `cam_from_board` into an 8-bit grey

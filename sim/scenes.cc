@@ -39,17 +39,17 @@ std::vector<Occluder> RandomOccluders(const SceneSpec& scene,
   std::vector<Occluder> occluders;
   for (int i = 0; i < r.occluders_per_view; ++i) {
     for (int attempt = 0; attempt < 50; ++attempt) {
-      const double u = Uniform(rng, board.origin.x(),
-                               board.origin.x() + board.cols - 1);
-      const double v = Uniform(rng, board.origin.y(),
-                               board.origin.y() + board.rows - 1);
-      const double radius = Uniform(rng, r.min_occluder_radius_px,
-                                    r.max_occluder_radius_px);
+      const double u =
+          Uniform(rng, board.origin.x(), board.origin.x() + board.cols - 1);
+      const double v =
+          Uniform(rng, board.origin.y(), board.origin.y() + board.rows - 1);
+      const double radius =
+          Uniform(rng, r.min_occluder_radius_px, r.max_occluder_radius_px);
       const double grey = Uniform(rng, 0.2, 0.7);
       Eigen::Vector2d pixel;
       const Eigen::Vector3d point =
-          pose * Eigen::Vector3d(u * board.tile_size_m,
-                                 v * board.tile_size_m, 0.0);
+          pose *
+          Eigen::Vector3d(u * board.tile_size_m, v * board.tile_size_m, 0.0);
       if (!scene.camera.Project(point, &pixel) || !pixel.allFinite() ||
           pixel.x() < 0 || pixel.y() < 0 || pixel.x() > scene.camera.width ||
           pixel.y() > scene.camera.height) {
@@ -89,10 +89,9 @@ Eigen::Isometry3d PoseFromView(const Board& board, const ViewPose& view) {
   board_from_cam.col(0) = x;
   board_from_cam.col(1) = z.cross(x);
   board_from_cam.col(2) = z;
-  board_from_cam =
-      board_from_cam *
-      Eigen::AngleAxisd(view.roll_deg * kDegree, Eigen::Vector3d::UnitZ())
-          .toRotationMatrix();
+  board_from_cam = board_from_cam * Eigen::AngleAxisd(view.roll_deg * kDegree,
+                                                      Eigen::Vector3d::UnitZ())
+                                        .toRotationMatrix();
   // Turn the camera so the target direction becomes `off_axis` from its
   // axis: target_in_cam = Q * e_z, and board_from_cam' = board_from_cam Q^T.
   const double phi = view.off_axis_direction_deg * kDegree;
@@ -138,21 +137,24 @@ bool SceneSpec::Check(std::string* why) const {
     if (!(rv.min_view_angle_deg > 0 &&
           rv.max_view_angle_deg >= rv.min_view_angle_deg &&
           rv.max_view_angle_deg <= 90)) {
-      return fail("random_views: need 0 < min_view_angle_deg <= "
-                  "max_view_angle_deg <= 90");
+      return fail(
+          "random_views: need 0 < min_view_angle_deg <= "
+          "max_view_angle_deg <= 90");
     }
     if (!(Finite(rv.max_roll_deg) && Finite(rv.max_off_axis_deg) &&
           rv.max_off_axis_deg >= 0 && rv.max_off_axis_deg < 180 &&
           Finite(rv.target_margin_tiles))) {
-      return fail("random_views: max_roll_deg, target_margin_tiles must be "
-                  "finite, max_off_axis_deg in [0, 180)");
+      return fail(
+          "random_views: max_roll_deg, target_margin_tiles must be "
+          "finite, max_off_axis_deg in [0, 180)");
     }
     if (rv.occluders_per_view < 0 || rv.occluders_per_view > 100 ||
         !(rv.min_occluder_radius_px >= 0 &&
           rv.max_occluder_radius_px >= rv.min_occluder_radius_px &&
           Finite(rv.max_occluder_radius_px))) {
-      return fail("random_views: occluders_per_view in [0, 100] and "
-                  "0 <= min_occluder_radius_px <= max_occluder_radius_px");
+      return fail(
+          "random_views: occluders_per_view in [0, 100] and "
+          "0 <= min_occluder_radius_px <= max_occluder_radius_px");
     }
   }
   for (double angle : tilt_series.view_angles_deg) {
@@ -176,8 +178,9 @@ bool SceneSpec::Check(std::string* why) const {
   }
   if (views.empty() && rv.count == 0 && tilt_series.view_angles_deg.empty() &&
       tile_size_series.tile_px.empty()) {
-    return fail("the scene has no views (views, random_views, tilt_series "
-                "or tile_size_series)");
+    return fail(
+        "the scene has no views (views, random_views, tilt_series "
+        "or tile_size_series)");
   }
   return true;
 }
@@ -221,7 +224,8 @@ std::vector<SceneViewSpec> SceneViewSpecs(const SceneSpec& scene) {
     view.tilt_direction_deg = scene.tilt_series.tilt_direction_deg;
     SceneViewSpec spec;
     char name[32];
-    std::snprintf(name, sizeof(name), "tilt_%02d", static_cast<int>(std::lround(angle)));
+    std::snprintf(name, sizeof(name), "tilt_%02d",
+                  static_cast<int>(std::lround(angle)));
     spec.name = name;
     spec.cam_from_board = PoseFromView(board, view);
     specs.push_back(spec);
@@ -285,9 +289,15 @@ Camera WidePinholeCamera(int width, int height, double hfov_deg, double k1) {
   Camera camera;
   camera.model = CameraModelId::kPinholeRadtan;
   const double f = 0.5 * width / std::tan(0.5 * hfov_deg * kDegree);
-  camera.params = {f,  f * 1.001, 0.5 * (width - 1) + 0.013 * width,
+  camera.params = {f,
+                   f * 1.001,
+                   0.5 * (width - 1) + 0.013 * width,
                    0.5 * (height - 1) - 0.009 * height,
-                   k1, 0.25 * k1 * k1, 0.0006, -0.0004, 0.0};
+                   k1,
+                   0.25 * k1 * k1,
+                   0.0006,
+                   -0.0004,
+                   0.0};
   camera.width = width;
   camera.height = height;
   return camera;
@@ -302,8 +312,14 @@ Camera FisheyeLensCamera(int width, int height, double fov_deg,
   const double t2 = theta * theta;
   const double radius = 0.5 * circle_fraction * height;
   const double f = radius / (theta * (1.0 + k1 * t2 + k2 * t2 * t2));
-  camera.params = {f, f * 0.998, 0.5 * (width - 1) + 0.004 * width,
-                   0.5 * (height - 1) + 0.006 * height, k1, k2, 0.0, 0.0};
+  camera.params = {f,
+                   f * 0.998,
+                   0.5 * (width - 1) + 0.004 * width,
+                   0.5 * (height - 1) + 0.006 * height,
+                   k1,
+                   k2,
+                   0.0,
+                   0.0};
   camera.width = width;
   camera.height = height;
   return camera;
@@ -469,8 +485,8 @@ SceneSpec DarkFisheyeScene(int width, int height) {
 }
 
 std::vector<std::string> StandardSceneNames() {
-  return {"wide_pinhole",         "strong_fisheye", "tilt_series",
-          "small_tiles",          "fisheye_checkerboard", "dark_fisheye"};
+  return {"wide_pinhole", "strong_fisheye",       "tilt_series",
+          "small_tiles",  "fisheye_checkerboard", "dark_fisheye"};
 }
 
 bool MakeStandardScene(const std::string& name, int width, int height,

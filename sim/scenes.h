@@ -5,13 +5,12 @@
 // truth. The standard scenes (factories below) are what the tests and the
 // configs/scenes/ recipes use.
 
-#include <cstdint>
-#include <string>
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <opencv2/core.hpp>
+#include <string>
+#include <vector>
 
 #include "calib/camera_models.h"
 #include "decode/board.h"
@@ -29,11 +28,11 @@ namespace puzzlecal {
 // direction `off_axis_direction_deg` (0 = right, 90 = down).
 struct ViewPose {
   Eigen::Vector2d target = Eigen::Vector2d::Zero();
-  double distance_m = 1.0;         // > 0
-  double view_angle_deg = 90.0;    // in (0, 90]
+  double distance_m = 1.0;       // > 0
+  double view_angle_deg = 90.0;  // in (0, 90]
   double tilt_direction_deg = 0.0;
   double roll_deg = 0.0;
-  double off_axis_deg = 0.0;       // in [0, 180)
+  double off_axis_deg = 0.0;  // in [0, 180)
   double off_axis_direction_deg = 0.0;
 };
 
@@ -49,18 +48,18 @@ struct SceneViewSpec {
 
 // Random poses: each draws uniformly from the ranges below (degrees, metres).
 struct RandomViews {
-  int count = 0;               // views to draw; 0 = none
-  uint64_t seed = 1;           // same seed, same views
+  int count = 0;                // views to draw; 0 = none
+  uint64_t seed = 1;            // same seed, same views
   double min_distance_m = 0.5;  // camera to target
   double max_distance_m = 1.5;
   double min_view_angle_deg = 40.0;  // angle between ray and board plane
   double max_view_angle_deg = 90.0;
-  double max_roll_deg = 180.0;       // roll in [-max, max]
-  double max_off_axis_deg = 20.0;    // target off the optical axis
+  double max_roll_deg = 180.0;     // roll in [-max, max]
+  double max_off_axis_deg = 20.0;  // target off the optical axis
   // Target drawn from the board's printed area grown by this many tiles on
   // each side (> 0 puts the image border across the board more often).
   double target_margin_tiles = 0.0;
-  int occluders_per_view = 0;        // discs placed over the board
+  int occluders_per_view = 0;  // discs placed over the board
   double min_occluder_radius_px = 10.0;
   double max_occluder_radius_px = 40.0;
 };

@@ -1,12 +1,12 @@
 #include "apps/config_io.h"
 
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 namespace puzzlecal {
 namespace {
@@ -39,8 +39,7 @@ TEST_F(ConfigIoTest, AllShippedBoardFilesLoad) {
     if (entry.path().extension() != ".yaml") continue;
     Board board;
     std::string error;
-    EXPECT_TRUE(LoadBoardFile(entry.path().string(), &board, &error))
-        << error;
+    EXPECT_TRUE(LoadBoardFile(entry.path().string(), &board, &error)) << error;
     ++count;
   }
   EXPECT_GE(count, 4);
@@ -54,8 +53,8 @@ TEST_F(ConfigIoTest, AllShippedBoardFilesLoad) {
   EXPECT_EQ(board.rows, 16);
   EXPECT_EQ(board.origin, Eigen::Vector2i(50, 100));
   EXPECT_DOUBLE_EQ(board.tile_size_m, 0.03);
-  ASSERT_TRUE(LoadBoardFile("configs/boards/deltille_checkerboard_11x8_20mm.yaml",
-                            &board, &error))
+  ASSERT_TRUE(LoadBoardFile(
+      "configs/boards/deltille_checkerboard_11x8_20mm.yaml", &board, &error))
       << error;
   EXPECT_EQ(board.type, BoardType::kCheckerboard);
   EXPECT_EQ(board.cols, 11);
@@ -71,8 +70,7 @@ TEST_F(ConfigIoTest, BrokenBoardFilesNameFileAndField) {
   const std::vector<Case> cases = {
       {"type: puzzle\ncols: 11\nrows: 8\ntile_size_m: 0.06\n", "type"},
       {"cols: 11\nrows: 8\ntile_size_m: 0.06\n", "type"},
-      {"type: puzzleboard\ncols: eleven\nrows: 8\ntile_size_m: 0.06\n",
-       "cols"},
+      {"type: puzzleboard\ncols: eleven\nrows: 8\ntile_size_m: 0.06\n", "cols"},
       {"type: puzzleboard\ncols: 11\ntile_size_m: 0.06\n", "rows"},
       {"type: puzzleboard\ncols: 11\nrows: 8\ntile_size_m: -1\n",
        "tile_size_m"},
@@ -88,8 +86,7 @@ TEST_F(ConfigIoTest, BrokenBoardFilesNameFileAndField) {
        "tile_size_m: 0.06\n",
        "origin"},
       {"type: puzzleboard\ncols: 1\nrows: 8\ntile_size_m: 0.06\n", "cols"},
-      {"type: puzzleboard\ncols: 11\nrows: 8\ntile_size: 0.06\n",
-       "tile_size"},
+      {"type: puzzleboard\ncols: 11\nrows: 8\ntile_size: 0.06\n", "tile_size"},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
     const std::string path =
@@ -122,8 +119,7 @@ TEST_F(ConfigIoTest, ShippedScenesEqualTheirFactories) {
     ++count;
     SceneSpec loaded;
     std::string error;
-    ASSERT_TRUE(LoadSceneFile(entry.path().string(), &loaded, &error))
-        << error;
+    ASSERT_TRUE(LoadSceneFile(entry.path().string(), &loaded, &error)) << error;
     SceneSpec factory;
     ASSERT_TRUE(MakeStandardScene(loaded.name, loaded.camera.width,
                                   loaded.camera.height, &factory))

@@ -1,11 +1,11 @@
 #include "sim/print_board.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "decode/puzzleboard.h"
 
@@ -26,8 +26,8 @@ cv::Mat RenderPng(const Board& board, double dpi) {
   PrintOptions options;
   options.dpi = dpi;
   std::string bytes, why;
-  EXPECT_TRUE(RenderPrintableBoard(board, PrintFormat::kPng, options, &bytes,
-                                   &why))
+  EXPECT_TRUE(
+      RenderPrintableBoard(board, PrintFormat::kPng, options, &bytes, &why))
       << why;
   const std::vector<uchar> buffer(bytes.begin(), bytes.end());
   return cv::imdecode(buffer, cv::IMREAD_GRAYSCALE);
@@ -54,8 +54,7 @@ TEST(PrintBoardTest, PngTilesAndDiscsFollowTheCode) {
   // Tile centres (away from the discs): corner (x, y) + (0.5, 0.5) tiles,
   // including the half border tiles (sampled a quarter tile in).
   for (int y = board.origin.y() - 1; y < board.origin.y() + board.rows; ++y) {
-    for (int x = board.origin.x() - 1; x < board.origin.x() + board.cols;
-         ++x) {
+    for (int x = board.origin.x() - 1; x < board.origin.x() + board.cols; ++x) {
       double cx, cy;
       PrintedCornerMm(board, x, y, &cx, &cy);
       double px = cx + 0.5 * s, py = cy + 0.5 * s;
@@ -113,17 +112,18 @@ TEST(PrintBoardTest, PngTilesAndDiscsFollowTheCode) {
 TEST(PrintBoardTest, SvgAndPdfHaveTheExactPhysicalSize) {
   const Board board = MediumPuzzleBoard();
   std::string svg, pdf, why;
-  ASSERT_TRUE(
-      RenderPrintableBoard(board, PrintFormat::kSvg, PrintOptions(), &svg, &why))
+  ASSERT_TRUE(RenderPrintableBoard(board, PrintFormat::kSvg, PrintOptions(),
+                                   &svg, &why))
       << why;
-  EXPECT_NE(svg.find("width=\"690mm\" height=\"480mm\" viewBox=\"0 0 690 480\""),
-            std::string::npos);
+  EXPECT_NE(
+      svg.find("width=\"690mm\" height=\"480mm\" viewBox=\"0 0 690 480\""),
+      std::string::npos);
   // The first black tile is the top-left half tile T(49, 99): 49 + 99 even.
   EXPECT_NE(svg.find("<rect x=\"0\" y=\"0\" width=\"15\" height=\"15\"/>"),
             std::string::npos);
   EXPECT_NE(svg.find("r=\"5\""), std::string::npos);
-  ASSERT_TRUE(
-      RenderPrintableBoard(board, PrintFormat::kPdf, PrintOptions(), &pdf, &why))
+  ASSERT_TRUE(RenderPrintableBoard(board, PrintFormat::kPdf, PrintOptions(),
+                                   &pdf, &why))
       << why;
   EXPECT_EQ(pdf.rfind("%PDF", 0), 0u);
   // 690 mm = 1955.905... pt, 480 mm = 1360.629... pt.

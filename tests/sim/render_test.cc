@@ -1,13 +1,13 @@
 #include "sim/render.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
-#include <string>
-#include <vector>
-
-#include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "decode/puzzleboard.h"
 
@@ -17,8 +17,8 @@ namespace {
 Camera PinholeCamera() {
   Camera camera;
   camera.model = CameraModelId::kPinholeRadtan;
-  camera.params = {620.0, 615.0, 322.5, 236.0, -0.12, 0.05, 0.0008, -0.0005,
-                   0.0};
+  camera.params = {620.0, 615.0,  322.5,   236.0, -0.12,
+                   0.05,  0.0008, -0.0005, 0.0};
   camera.width = 640;
   camera.height = 480;
   return camera;
@@ -46,10 +46,9 @@ Board PuzzleBoard11x8() {
 
 // Board centre at `distance` in front of the camera, rotated by `angles`
 // (radians about x, then y) about its centre, shifted sideways by `shift`.
-Eigen::Isometry3d LookAtBoard(const Board& board, double distance,
-                              double angle_x, double angle_y,
-                              const Eigen::Vector3d& shift =
-                                  Eigen::Vector3d::Zero()) {
+Eigen::Isometry3d LookAtBoard(
+    const Board& board, double distance, double angle_x, double angle_y,
+    const Eigen::Vector3d& shift = Eigen::Vector3d::Zero()) {
   const Eigen::Vector3d board_center(
       (board.origin.x() + 0.5 * (board.cols - 1)) * board.tile_size_m,
       (board.origin.y() + 0.5 * (board.rows - 1)) * board.tile_size_m, 0.0);
@@ -99,15 +98,15 @@ std::vector<double> CornerSubPixErrors(const cv::Mat& image,
         corner.xy.y() > image.rows - kHalfWindow - 4) {
       continue;
     }
-    std::vector<cv::Point2f> points = {cv::Point2f(
-        static_cast<float>(std::round(corner.xy.x())),
-        static_cast<float>(std::round(corner.xy.y())))};
+    std::vector<cv::Point2f> points = {
+        cv::Point2f(static_cast<float>(std::round(corner.xy.x())),
+                    static_cast<float>(std::round(corner.xy.y())))};
     cv::cornerSubPix(
         image, points, cv::Size(kHalfWindow, kHalfWindow), cv::Size(-1, -1),
         cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 100,
                          1e-4));
-    errors.push_back(std::hypot(points[0].x - corner.xy.x(),
-                                points[0].y - corner.xy.y()));
+    errors.push_back(
+        std::hypot(points[0].x - corner.xy.x(), points[0].y - corner.xy.y()));
   }
   return errors;
 }
@@ -192,8 +191,10 @@ double MaxEdgeIntegralError(const Board& board, const Camera& camera,
       const double tile_px = (bottom - top).norm();
       if (tile_px < 12) continue;
       // Rows through the middle of the edge, away from its corners.
-      const int y_begin = static_cast<int>(std::ceil(top.y() + 0.35 * (bottom.y() - top.y())));
-      const int y_end = static_cast<int>(std::floor(top.y() + 0.65 * (bottom.y() - top.y())));
+      const int y_begin =
+          static_cast<int>(std::ceil(top.y() + 0.35 * (bottom.y() - top.y())));
+      const int y_end =
+          static_cast<int>(std::floor(top.y() + 0.65 * (bottom.y() - top.y())));
       for (int y = y_begin; y <= y_end; ++y) {
         // Edge position on this row: bisection on t along the edge.
         double lo = 0.0, hi = 1.0;
@@ -300,14 +301,16 @@ PatternAgreement CheckPattern(const cv::Mat& image, const Board& board,
       if (y + 1 < y0 + board.rows) {
         const int px = static_cast<int>(std::lround(print_u(x)));
         ++a.discs;
-        a.discs_ok += GreyAtBoardPoint(image, board, camera, pose, x, y + 0.5) ==
-                      expect(PuzzleBoardVerticalEdgeBit(px, y) == 1);
+        a.discs_ok +=
+            GreyAtBoardPoint(image, board, camera, pose, x, y + 0.5) ==
+            expect(PuzzleBoardVerticalEdgeBit(px, y) == 1);
       }
       if (x + 1 < x0 + board.cols) {
         const int px = static_cast<int>(std::floor(print_u(x + 0.5)));
         ++a.discs;
-        a.discs_ok += GreyAtBoardPoint(image, board, camera, pose, x + 0.5, y) ==
-                      expect(PuzzleBoardHorizontalEdgeBit(px, y) == 1);
+        a.discs_ok +=
+            GreyAtBoardPoint(image, board, camera, pose, x + 0.5, y) ==
+            expect(PuzzleBoardHorizontalEdgeBit(px, y) == 1);
       }
     }
   }
@@ -425,16 +428,16 @@ TEST(RenderBoardTest, BadInputGivesAnEmptyImageAndAReason) {
   const Eigen::Isometry3d pose = LookAtBoard(board, 0.9, 0.0, 0.0);
   RenderSummary summary;
   camera.params.resize(5);
-  EXPECT_TRUE(RenderBoard(board, camera, pose, RenderOptions(), nullptr,
-                          &summary)
-                  .empty());
+  EXPECT_TRUE(
+      RenderBoard(board, camera, pose, RenderOptions(), nullptr, &summary)
+          .empty());
   EXPECT_FALSE(summary.ok);
   EXPECT_NE(summary.reason.find("parameters"), std::string::npos);
   camera = PinholeCamera();
   camera.width = 0;
-  EXPECT_TRUE(RenderBoard(board, camera, pose, RenderOptions(), nullptr,
-                          &summary)
-                  .empty());
+  EXPECT_TRUE(
+      RenderBoard(board, camera, pose, RenderOptions(), nullptr, &summary)
+          .empty());
   EXPECT_NE(summary.reason.find("size"), std::string::npos);
   Eigen::Isometry3d nan_pose = pose;
   nan_pose.translation().x() = std::nan("");
@@ -445,9 +448,9 @@ TEST(RenderBoardTest, BadInputGivesAnEmptyImageAndAReason) {
   RenderOptions options;
   options.black_level = 0.9;
   options.white_level = 0.1;
-  EXPECT_TRUE(RenderBoard(board, PinholeCamera(), pose, options, nullptr,
-                          &summary)
-                  .empty());
+  EXPECT_TRUE(
+      RenderBoard(board, PinholeCamera(), pose, options, nullptr, &summary)
+          .empty());
   EXPECT_NE(summary.reason.find("black_level"), std::string::npos);
   Board bad_board = board;
   bad_board.tile_size_m = -1;

@@ -1,10 +1,10 @@
 #include "sim/scenes.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace puzzlecal {
 namespace {
@@ -65,8 +65,8 @@ TEST(ScenesTest, PoseFromViewLooksAtTheTarget) {
   view.off_axis_direction_deg = 180.0;
   pose = PoseFromView(board, view);
   in_cam = pose * target;
-  EXPECT_NEAR(std::atan2(in_cam.head<2>().norm(), in_cam.z()) / kDegree,
-              100.0, 1e-9);
+  EXPECT_NEAR(std::atan2(in_cam.head<2>().norm(), in_cam.z()) / kDegree, 100.0,
+              1e-9);
   EXPECT_LT(in_cam.x(), 0.0);
   EXPECT_NEAR(in_cam.y(), 0.0, 1e-12);
   EXPECT_NEAR(in_cam.norm(), 0.8, 1e-12);
