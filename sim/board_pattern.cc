@@ -110,6 +110,11 @@ InkMix BoardPattern::SampleArea(double u, double v,
     f.row(0) = -f.row(0);
   }
   InkMix mix;
+  // Far off any board (and safe to round to int below).
+  if (!(std::abs(u) < 1e7 && std::abs(v) < 1e7)) {
+    mix.none = 1.0;
+    return mix;
+  }
   const double width_u = std::abs(f(0, 0)) + std::abs(f(0, 1));
   const double width_v = std::abs(f(1, 0)) + std::abs(f(1, 1));
   const double paper = RectCoverage(u, v, paper_, width_u, width_v);
