@@ -42,14 +42,9 @@ Scene MakeScene(int cols, int rows, double tile_px, unsigned seed) {
   const double viewing_angle_deg = 60;
   // Distance so that a frontal tile would be tile_px wide.
   const double distance = focal * tile_m / tile_px;
-  const int width = static_cast<int>((cols + 3) * tile_px) + 40;
-  const int height = static_cast<int>((rows + 3) * tile_px) + 40;
   Camera camera;
   camera.model = CameraModelId::kPinholeRadtan;
-  camera.params = {
-      focal, focal, (width - 1) / 2.0, (height - 1) / 2.0, -0.02, 0, 0, 0, 0};
-  camera.width = width;
-  camera.height = height;
+  camera.params = {focal, focal, 0, 0, -0.02, 0, 0, 0, 0};
   const Eigen::Vector3d centre((cols - 1) * tile_m / 2, (rows - 1) * tile_m / 2,
                                0);
   const Eigen::Matrix3d rotation =
@@ -65,6 +60,23 @@ Scene MakeScene(int cols, int rows, double tile_px, unsigned seed) {
     camera.Project(cam, &pixel);
     return pixel;
   };
+
+  // Principal point and image size so that the whole board (with its
+  // border tiles) is in the image with a 20 px margin.
+  Eigen::Vector2d low(1e18, 1e18), high(-1e18, -1e18);
+  for (int r = -1; r <= rows; ++r) {
+    for (int c = -1; c <= cols; ++c) {
+      const Eigen::Vector2d p = project(c, r);
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    }
+  }
+  camera.params[2] = 20 - low.x();
+  camera.params[3] = 20 - low.y();
+  camera.width = static_cast<int>(high.x() - low.x()) + 40;
+  camera.height = static_cast<int>(high.y() - low.y()) + 40;
+  const int width = camera.width;
+  const int height = camera.height;
 
   Scene scene;
   scene.image = cv::Mat(height, width, CV_8UC1, cv::Scalar(110));
@@ -145,12 +157,14 @@ int main() {
         "\"cpu_median_ms\": %.4f, \"goal_ms\": %.1f, "
         "\"largest_component\": %d, \"components\": %d, "
         "\"neighbors_ms\": %.4f, \"weights_ms\": %.4f, \"kruskal_ms\": %.4f, "
-        "\"cleanup_ms\": %.4f}%s\n",
+        "\"cleanup_ms\": %.4f, \"removed_not_saddle\": %d, "
+        "\"removed_by_prediction\": %d}%s\n",
         scene.corners.size(), size.cols, size.rows, scene.image.cols,
         scene.image.rows, times.front(), times[times.size() / 2],
         cpu_times.front(), cpu_times[cpu_times.size() / 2], size.goal_ms,
         summary.largest_component, summary.num_components, summary.neighbors_ms,
         summary.weights_ms, summary.kruskal_ms, summary.cleanup_ms,
+        summary.num_removed_not_saddle, summary.num_removed_by_prediction,
         s + 1 < std::size(sizes) ? "," : "");
   }
   std::printf("  ]\n}\n");

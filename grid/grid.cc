@@ -68,8 +68,8 @@ bool GridOptions::Check(std::string* why) const {
   if (!(line_prediction_tolerance > 0 &&
         std::isfinite(line_prediction_tolerance)))
     return Fail(why, "line_prediction_tolerance must be finite and > 0");
-  if (!(saddle_sample_fraction > 0 && saddle_sample_fraction < 0.5))
-    return Fail(why, "saddle_sample_fraction must be in (0, 0.5)");
+  if (!(saddle_sample_fraction > 0 && saddle_sample_fraction <= 0.5))
+    return Fail(why, "saddle_sample_fraction must be in (0, 0.5]");
   if (min_component_size < 1)
     return Fail(why, "min_component_size must be >= 1");
   return true;
