@@ -7,12 +7,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
 #include <string>
 #include <vector>
 
 #include <opencv2/calib3d.hpp>
 
 #include "calib/calibrate.h"
+#include "tests/calib/opencv_reference.h"
 #include "tests/calib/synthetic_views.h"
 
 namespace {
@@ -59,43 +62,123 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // argv[1]: repeats per problem size (default 3); argv[2]: largest number
+  // of views to time (default 300).
   const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
+  const int max_views = argc > 2 ? std::atoi(argv[2]) : 300;
   std::printf("{\n  \"timing\": [\n");
   const int view_counts[] = {20, 100, 300};
   const int boards[][2] = {{11, 8}, {23, 16}};
   bool first = true;
-  for (CameraModelId model : {CameraModelId::kPinholeRadtan}) {
+  const CameraModelId model = CameraModelId::kPinholeRadtan;
+  for (bool covariance : {false, true}) {
     for (const auto& board : boards) {
       for (int views : view_counts) {
+        if (views > max_views) continue;
+        CalibrationOptions options;
+        options.compute_covariance = covariance;
         const SyntheticScene scene = Scene(model, views, board[0], board[1]);
         const SyntheticData data = MakeSyntheticData(scene);
-        std::vector<double> times, init_times;
+        std::vector<double> times, cpu_times, init_times;
         CalibrationResult result;
         bool ok = true;
-        for (int r = 0; r < repeats; ++r) {
+        // The largest problems run once: the figures are minutes, not noise.
+        const int runs = data.num_corners > 30000 ? 1 : repeats;
+        for (int r = 0; r < runs; ++r) {
           std::string error;
           const auto start = std::chrono::steady_clock::now();
+          const std::clock_t cpu_start = std::clock();
           ok &= puzzlecal::Calibrate(data.views, model, scene.camera.width,
-                                     scene.camera.height, CalibrationOptions(),
-                                     &result, &error);
+                                     scene.camera.height, options, &result,
+                                     &error);
+          cpu_times.push_back(static_cast<double>(std::clock() - cpu_start) /
+                              CLOCKS_PER_SEC);
           times.push_back(Seconds(start));
           init_times.push_back(result.initialization_seconds);
         }
         std::sort(times.begin(), times.end());
+        std::sort(cpu_times.begin(), cpu_times.end());
         std::sort(init_times.begin(), init_times.end());
-        std::printf("%s    {\"model\": \"%s\", \"views\": %d, \"corners_per_board\": %d, "
-                    "\"corners\": %d, \"ok\": %s, \"best_s\": %.3f, "
-                    "\"median_s\": %.3f, \"init_s\": %.3f, \"iterations\": %d, "
-                    "\"rms_px\": %.4f}",
+        std::printf("%s    {\"model\": \"%s\", \"covariance\": %s, \"views\": %d, "
+                    "\"corners_per_board\": %d, \"corners\": %d, \"ok\": %s, "
+                    "\"runs\": %d, \"best_s\": %.3f, \"median_s\": %.3f, "
+                    "\"best_cpu_s\": %.3f, \"init_s\": %.3f, "
+                    "\"iterations\": %d, \"rms_px\": %.4f}",
                     first ? "" : ",\n", puzzlecal::CameraModelName(model),
-                    views, board[0] * board[1], data.num_corners,
-                    ok ? "true" : "false", times.front(),
-                    times[times.size() / 2], init_times.front(),
-                    result.iterations, result.rms_px);
+                    covariance ? "true" : "false", views, board[0] * board[1],
+                    data.num_corners,
+                    ok ? "true" : "false", runs, times.front(),
+                    times[times.size() / 2], cpu_times.front(),
+                    init_times.front(), result.iterations, result.rms_px);
         first = false;
         std::fflush(stdout);
       }
     }
+  }
+  std::printf("\n  ],\n  \"accuracy\": [\n");
+  // 20 views, sigma = 0.1 px, the scenes of tests/calib/calibrate_test.cc.
+  first = true;
+  for (CameraModelId model :
+       {CameraModelId::kPinholeRadtan, CameraModelId::kPinholeRational,
+        CameraModelId::kKannalaBrandt}) {
+    SyntheticScene scene = Scene(model, 20, 11, 8);
+    scene.tile = 0.03;
+    if (model != CameraModelId::kKannalaBrandt) {
+      scene.min_tilt_deg = 20;
+      scene.max_tilt_deg = 60;
+      scene.min_distance = 0.8;
+      scene.max_distance = 1.6;
+    }
+    const SyntheticData data = MakeSyntheticData(scene);
+    CalibrationResult result;
+    std::string error;
+    const auto start = std::chrono::steady_clock::now();
+    const bool ok = puzzlecal::Calibrate(data.views, model, scene.camera.width,
+                                         scene.camera.height,
+                                         CalibrationOptions(), &result, &error);
+    const double seconds = Seconds(start);
+    int free_params = 6 * result.num_views_used;
+    for (bool fixed : result.param_fixed) free_params += fixed ? 0 : 1;
+    const double floor =
+        scene.noise_px *
+        std::sqrt(1.0 - free_params / (2.0 * result.num_corners_used));
+    const auto& t = scene.camera.params;
+    const auto& p = result.camera.params;
+    const auto cv_start = std::chrono::steady_clock::now();
+    const puzzlecal::testing::OpenCvCalibration cv =
+        puzzlecal::testing::CalibrateWithOpenCv(
+            data.views, model, scene.camera.width, scene.camera.height);
+    const double cv_seconds = Seconds(cv_start);
+    auto row = [&](const char* who, bool converged,
+                   const std::vector<double>& q, double rms_point,
+                   double secs, const std::string& note) {
+      std::printf("%s    {\"model\": \"%s\", \"solver\": \"%s\", "
+                  "\"ok\": %s",
+                  first ? "" : ",\n", puzzlecal::CameraModelName(model), who,
+                  converged ? "true" : "false");
+      first = false;
+      if (converged && q.size() >= 4) {
+        std::printf(", \"dfx_rel_pct\": %.4f, \"dfy_rel_pct\": %.4f, "
+                    "\"dcx_px\": %.3f, \"dcy_px\": %.3f, "
+                    "\"rms_point_px\": %.5f, \"rms_over_floor\": %.4f, "
+                    "\"seconds\": %.3f",
+                    100 * std::abs(q[0] - t[0]) / t[0],
+                    100 * std::abs(q[1] - t[1]) / t[1], std::abs(q[2] - t[2]),
+                    std::abs(q[3] - t[3]), rms_point,
+                    rms_point / std::sqrt(2.0) / floor, secs);
+      }
+      if (!note.empty()) {
+        std::string clean = note;
+        for (char& c : clean) {
+          if (c == '"' || c == '\\' || c == '\n') c = ' ';
+        }
+        std::printf(", \"note\": \"%s\"", clean.c_str());
+      }
+      std::printf("}");
+    };
+    row("puzzlecal", ok, p, result.rms_point_px, seconds, ok ? "" : error);
+    row("opencv", cv.ok, cv.params, cv.rms_point_px, cv_seconds, cv.error);
+    std::fflush(stdout);
   }
   std::printf("\n  ]\n}\n");
   return 0;

@@ -11,6 +11,9 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
 #include "calib/reprojection_error.h"
 
 namespace puzzlecal {
@@ -153,6 +156,85 @@ double OrientationSpreadDeg(const std::vector<Eigen::Isometry3d>& poses,
     }
   }
   return spread * 180.0 / M_PI;
+}
+
+// Covariance of the intrinsics with the poses marginalised out, from the
+// Jacobian at the solution: inverse of the Schur complement
+// S = A - sum_v B_v C_v^-1 B_v' of J'J (A: intrinsics, C_v: pose v). Summed
+// in a fixed order, so the result does not depend on threads. Fixed
+// parameters get zero rows and columns. False when S is singular.
+template <int kNumParams>
+bool MarginalCovariance(ceres::Problem* problem, const Problem* state,
+                        const std::vector<bool>& fixed,
+                        Eigen::Matrix<double, kNumParams, kNumParams>* cov) {
+  std::vector<int> free_index;
+  for (int k = 0; k < kNumParams; ++k) {
+    if (!fixed[k]) free_index.push_back(k);
+  }
+  const int n = static_cast<int>(free_index.size());
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks.push_back(
+      const_cast<double*>(state->params.data()));
+  for (size_t v = 0; v < state->poses.size(); ++v) {
+    if (!state->view_used[v]) continue;
+    evaluate.parameter_blocks.push_back(
+        const_cast<double*>(state->poses[v].data()));
+  }
+  evaluate.num_threads = 1;
+  ceres::CRSMatrix jacobian;
+  if (!problem->Evaluate(evaluate, nullptr, nullptr, nullptr, &jacobian)) {
+    return false;
+  }
+  const int num_poses = static_cast<int>(evaluate.parameter_blocks.size()) - 1;
+  if (jacobian.num_cols != n + kPoseBlockSize * num_poses) return false;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  std::vector<Eigen::MatrixXd> b(num_poses, Eigen::MatrixXd::Zero(n, 6));
+  std::vector<Eigen::Matrix<double, 6, 6>> c(
+      num_poses, Eigen::Matrix<double, 6, 6>::Zero());
+  Eigen::VectorXd j_int(n);
+  Eigen::Matrix<double, 6, 1> j_pose;
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    j_int.setZero();
+    j_pose.setZero();
+    int pose = -1;
+    for (int e = jacobian.rows[row]; e < jacobian.rows[row + 1]; ++e) {
+      const int col = jacobian.cols[e];
+      if (col < n) {
+        j_int(col) = jacobian.values[e];
+      } else {
+        pose = (col - n) / kPoseBlockSize;
+        j_pose((col - n) % kPoseBlockSize) = jacobian.values[e];
+      }
+    }
+    a.noalias() += j_int * j_int.transpose();
+    if (pose >= 0) {
+      b[pose].noalias() += j_int * j_pose.transpose();
+      c[pose].noalias() += j_pose * j_pose.transpose();
+    }
+  }
+  for (int v = 0; v < num_poses; ++v) {
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(c[v]);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
+      return false;
+    }
+    a.noalias() -= b[v] * ldlt.solve(b[v].transpose());
+  }
+  // S is symmetric positive definite unless the intrinsics are
+  // undetermined; refuse to invert a (numerically) singular S.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
+  if (eig.info() != Eigen::Success) return false;
+  const Eigen::VectorXd values = eig.eigenvalues();
+  if (!(values(0) > 1e-14 * values(n - 1))) return false;
+  const Eigen::MatrixXd inverse = eig.eigenvectors() *
+                                  values.cwiseInverse().asDiagonal() *
+                                  eig.eigenvectors().transpose();
+  cov->setZero();
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      (*cov)(free_index[i], free_index[j]) = inverse(i, j);
+    }
+  }
+  return true;
 }
 
 // Fraction of coverage-grid cells that hold at least one corner.
@@ -473,22 +555,26 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
       std::find(fixed.begin(), fixed.end(), false) != fixed.end();
   if (options.compute_covariance && any_free && outcome.problem &&
       2 * corners > free_params && outcome.summary.IsSolutionUsable()) {
-    ceres::Covariance::Options covariance_options;
-    covariance_options.num_threads =
-        options.deterministic ? 1 : options.num_threads;
-    // SuiteSparseQR may thread internally (BLAS), which changes the last
-    // bits from run to run; Eigen's sparse QR is sequential.
+    Eigen::Matrix<double, kNumParams, kNumParams> block;
+    bool ok;
     if (options.deterministic) {
-      covariance_options.sparse_linear_algebra_library_type =
-          ceres::EIGEN_SPARSE;
+      ok = MarginalCovariance(outcome.problem.get(), &state, fixed, &block);
+    } else {
+      // ceres::Covariance (SuiteSparseQR) may thread internally, which
+      // changes the last bits from run to run.
+      ceres::Covariance::Options covariance_options;
+      covariance_options.num_threads = options.num_threads;
+      ceres::Covariance covariance(covariance_options);
+      std::vector<std::pair<const double*, const double*>> blocks = {
+          {state.params.data(), state.params.data()}};
+      Eigen::Matrix<double, kNumParams, kNumParams, Eigen::RowMajor> row_major;
+      ok = covariance.Compute(blocks, outcome.problem.get()) &&
+           covariance.GetCovarianceBlock(state.params.data(),
+                                         state.params.data(),
+                                         row_major.data());
+      block = row_major;
     }
-    ceres::Covariance covariance(covariance_options);
-    std::vector<std::pair<const double*, const double*>> blocks = {
-        {state.params.data(), state.params.data()}};
-    if (covariance.Compute(blocks, outcome.problem.get())) {
-      Eigen::Matrix<double, kNumParams, kNumParams, Eigen::RowMajor> block;
-      covariance.GetCovarianceBlock(state.params.data(), state.params.data(),
-                                    block.data());
+    if (ok) {
       const double variance = sum2 / (2.0 * corners - free_params);
       result->covariance = block * variance;
       for (int k = 0; k < kNumParams; ++k) {
@@ -556,6 +642,16 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
   if (result->orientation_spread_deg < options.min_orientation_spread_deg) {
     return parallel_views(result->orientation_spread_deg);
   }
+  if (result->covariance_ok && !fixed[0] &&
+      !(result->param_stddev[0] <=
+        options.max_focal_relative_stddev * std::abs(state.params[0]))) {
+    return Fail("the views do not determine the focal length (fx = " +
+                    Format("%.1f", state.params[0]) + " +- " +
+                    Format("%.3g", result->param_stddev[0]) +
+                    " px): add views with the board tilted by 30 degrees or "
+                    "more, near the image borders too",
+                error);
+  }
   if (!(result->rms_px <= options.max_rms_px)) {
     return Fail("the reprojection RMS is " + Format("%.2f", result->rms_px) +
                     " px (limit " + Format("%.2f", options.max_rms_px) +
@@ -614,6 +710,9 @@ bool CalibrationOptions::Check(std::string* why) const {
     return Fail("min_coverage must be in [0, 1]", why);
   }
   if (coverage_grid < 1) return Fail("coverage_grid must be >= 1", why);
+  if (!(max_focal_relative_stddev > 0)) {
+    return Fail("max_focal_relative_stddev must be > 0", why);
+  }
   if (!(max_rms_px > 0)) return Fail("max_rms_px must be > 0", why);
   return initialization.Check(why);
 }

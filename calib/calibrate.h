@@ -63,8 +63,10 @@ struct CalibrationOptions {
   // order its threads finish, so a multi-threaded solve can differ in the
   // last bits from run to run.
   int num_threads = 1;
-  // Run Ceres on one thread so that the same input gives the same output,
-  // bit for bit, whatever num_threads says. Default true.
+  // Run Ceres on one thread and compute the covariance with puzzlecal's own
+  // sequential Schur complement (instead of ceres::Covariance, whose
+  // SuiteSparseQR may thread internally) so that the same input gives the
+  // same output, bit for bit, whatever num_threads says. Default true.
   bool deterministic = true;
 
   // A view needs at least this many corners to be used. Default 6.
@@ -77,6 +79,10 @@ struct CalibrationOptions {
   // The corners must touch at least this fraction of the cells of a
   // coverage_grid x coverage_grid grid over the image. Default 0.1.
   double min_coverage = 0.1;
+  // When the covariance is available: a focal length whose standard
+  // deviation exceeds this fraction of its value is a failure (the views
+  // do not determine it). Default 0.05.
+  double max_focal_relative_stddev = 0.05;
   // Cells per image side for the coverage figure. Default 8.
   int coverage_grid = 8;
   // A final RMS above this (pixels, per coordinate) is a failure: the

@@ -306,6 +306,10 @@ TEST(CalibrateTest, MultiThreadedSolveAgreesClosely) {
     EXPECT_NEAR(single.camera.params[k], multi.camera.params[k],
                 1e-3 * single.param_stddev[k])
         << k;
+    // The own Schur-complement covariance against ceres::Covariance.
+    EXPECT_NEAR(single.param_stddev[k], multi.param_stddev[k],
+                1e-4 * single.param_stddev[k])
+        << k;
   }
 }
 
