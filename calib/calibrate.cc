@@ -461,10 +461,14 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
   compute_residuals(&projects);
   while (options.outlier_k > 0 && rounds < options.outlier_iterations &&
          outcome.summary.IsSolutionUsable()) {
+    // sigma from every corner of the used views, not only the current
+    // inliers: the median is robust to the outliers already, and a sigma of
+    // the inliers alone shrinks with every round and trims good corners.
     std::vector<double> magnitudes;
     for (size_t v = 0; v < views.size(); ++v) {
+      if (!state.view_used[v]) continue;
       for (size_t i = 0; i < residuals[v].size(); ++i) {
-        if (state.inlier[v][i]) {
+        if (projects[v][i]) {
           magnitudes.push_back(std::abs(residuals[v][i].x()));
           magnitudes.push_back(std::abs(residuals[v][i].y()));
         }
