@@ -183,37 +183,15 @@ int RunCalibrate() {
       listing.images, board, pipeline_options, threads,
       [&](size_t, const ImageResult& result) { progress.Done(result); });
 
-  // Views: usable images of the size of the first usable one.
   int width = 0, height = 0;
-  std::vector<CalibrationView> views;
-  std::vector<int> view_of_image(images.size(), -1);
+  std::vector<int> view_of_image;
+  const std::vector<CalibrationView> views =
+      MakeCalibrationViews(board, &images, &view_of_image, &width, &height);
   double seconds_load = 0, seconds_detect = 0, seconds_grid_decode = 0;
-  for (size_t i = 0; i < images.size(); ++i) {
-    ImageResult& image = images[i];
+  for (const ImageResult& image : images) {
     seconds_load += image.seconds_load;
     seconds_detect += image.seconds_detect;
     seconds_grid_decode += image.seconds_grid_decode;
-    if (image.outcome != ImageOutcome::kUsable) continue;
-    if (width == 0) {
-      width = image.width;
-      height = image.height;
-    } else if (image.width != width || image.height != height) {
-      image.outcome = ImageOutcome::kSizeMismatch;
-      std::ostringstream reason;
-      reason << image.width << "x" << image.height << " differs from "
-             << width << "x" << height << " of the first usable image";
-      image.reason = reason.str();
-      continue;
-    }
-    CalibrationView view;
-    view.name = fs::path(image.file).filename().string();
-    const BoardObservation& observation = image.decode.observation;
-    for (size_t k = 0; k < observation.id.size(); ++k) {
-      view.board_points.push_back(board.Point(observation.id[k]));
-      view.image_points.push_back(observation.xy[k]);
-    }
-    view_of_image[i] = static_cast<int>(views.size());
-    views.push_back(std::move(view));
   }
 
   const bool any_readable =

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <map>
 #include <mutex>
+#include <filesystem>
+#include <sstream>
 #include <thread>
 
 namespace puzzlecal {
@@ -187,6 +189,40 @@ std::vector<ImageResult> ProcessImageFiles(
   worker();
   for (std::thread& thread : threads) thread.join();
   return results;
+}
+
+std::vector<CalibrationView> MakeCalibrationViews(
+    const Board& board, std::vector<ImageResult>* images,
+    std::vector<int>* view_of_image, int* width, int* height) {
+  *width = 0;
+  *height = 0;
+  std::vector<CalibrationView> views;
+  view_of_image->assign(images->size(), -1);
+  for (size_t i = 0; i < images->size(); ++i) {
+    ImageResult& image = (*images)[i];
+    if (image.outcome != ImageOutcome::kUsable) continue;
+    if (*width == 0) {
+      *width = image.width;
+      *height = image.height;
+    } else if (image.width != *width || image.height != *height) {
+      image.outcome = ImageOutcome::kSizeMismatch;
+      std::ostringstream reason;
+      reason << image.width << "x" << image.height << " differs from "
+             << *width << "x" << *height << " of the first usable image";
+      image.reason = reason.str();
+      continue;
+    }
+    CalibrationView view;
+    view.name = std::filesystem::path(image.file).filename().string();
+    const BoardObservation& observation = image.decode.observation;
+    for (size_t k = 0; k < observation.id.size(); ++k) {
+      view.board_points.push_back(board.Point(observation.id[k]));
+      view.image_points.push_back(observation.xy[k]);
+    }
+    (*view_of_image)[i] = static_cast<int>(views.size());
+    views.push_back(std::move(view));
+  }
+  return views;
 }
 
 }  // namespace puzzlecal

@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "apps/image_io.h"
+#include "calib/calibration_view.h"
 #include "decode/board.h"
 #include "decode/decoder.h"
 #include "detection/corner.h"
@@ -76,6 +77,14 @@ std::vector<ImageResult> ProcessImageFiles(
     const std::vector<std::string>& files, const Board& board,
     const PipelineOptions& options, int num_threads,
     const std::function<void(size_t, const ImageResult&)>& on_done = {});
+
+// The calibration views of a run: one per usable image of the size of the
+// first usable one (images of another size are marked kSizeMismatch).
+// `view_of_image[i]` is the view index of images[i] or -1; `width`/`height`
+// return the image size (0 when no image is usable).
+std::vector<CalibrationView> MakeCalibrationViews(
+    const Board& board, std::vector<ImageResult>* images,
+    std::vector<int>* view_of_image, int* width, int* height);
 
 }  // namespace puzzlecal
 
