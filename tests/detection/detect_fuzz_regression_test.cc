@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fuzz/corpus_replay.h"
 #include "fuzz/detect_case.h"
 
 namespace puzzlecal {
@@ -18,23 +19,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<uint8_t> ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)),
-                              std::istreambuf_iterator<char>());
-}
-
 TEST(DetectFuzzRegressionTest, CorpusKeepsDetectorPromises) {
-  const fs::path corpus = "fuzz/corpus/detect_fuzzer";
-  ASSERT_TRUE(fs::is_directory(corpus))
-      << "run from the repository root (ctest does)";
-  int replayed = 0;
-  for (const auto& entry : fs::directory_iterator(corpus)) {
-    const std::vector<uint8_t> bytes = ReadBytes(entry.path());
-    EXPECT_EQ(fuzz::RunDetectCase(bytes.data(), bytes.size()), "")
-        << entry.path().filename();
-    ++replayed;
-  }
+  const int replayed = fuzz::ReplayCorpus(
+      "fuzz/corpus/detect_fuzzer",
+      [](const std::string& name, const std::vector<uint8_t>& bytes) {
+        EXPECT_EQ(fuzz::RunDetectCase(bytes.data(), bytes.size()), "") << name;
+      });
+  ASSERT_NE(replayed, -1) << "run from the repository root (ctest does)";
   EXPECT_GE(replayed, 5);
 }
 

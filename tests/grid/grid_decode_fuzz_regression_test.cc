@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz/corpus_replay.h"
 #include "fuzz/grid_decode_case.h"
 
 namespace puzzlecal {
@@ -18,23 +19,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<uint8_t> ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)),
-                              std::istreambuf_iterator<char>());
-}
-
 TEST(GridDecodeFuzzRegressionTest, CorpusKeepsGridAndDecodePromises) {
-  const fs::path corpus = "fuzz/corpus/grid_decode_fuzzer";
-  ASSERT_TRUE(fs::is_directory(corpus))
-      << "run from the repository root (ctest does)";
-  int replayed = 0;
-  for (const auto& entry : fs::directory_iterator(corpus)) {
-    const std::vector<uint8_t> bytes = ReadBytes(entry.path());
-    EXPECT_EQ(fuzz::RunGridDecodeCase(bytes.data(), bytes.size()), "")
-        << entry.path().filename();
-    ++replayed;
-  }
+  const int replayed = fuzz::ReplayCorpus(
+      "fuzz/corpus/grid_decode_fuzzer",
+      [](const std::string& name, const std::vector<uint8_t>& bytes) {
+        EXPECT_EQ(fuzz::RunGridDecodeCase(bytes.data(), bytes.size()), "") << name;
+      });
+  ASSERT_NE(replayed, -1) << "run from the repository root (ctest does)";
   EXPECT_GE(replayed, 5);
 }
 
@@ -43,7 +34,7 @@ TEST(GridDecodeFuzzRegressionTest, CorpusKeepsGridAndDecodePromises) {
 // checkerboard decoder must give them the board's 88 ids.
 TEST(GridDecodeFuzzRegressionTest, CleanLatticeSeedIsTheWholeBoard) {
   const std::vector<uint8_t> bytes =
-      ReadBytes("fuzz/corpus/grid_decode_fuzzer/checker_11x8_clean");
+      fuzz::ReadCorpusFile("fuzz/corpus/grid_decode_fuzzer/checker_11x8_clean");
   ASSERT_FALSE(bytes.empty());
   fuzz::ByteReader reader(bytes.data(), bytes.size());
   const Board board = fuzz::BoardFromByte(reader.Byte());
