@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds puzzlecal and calibrates the bundled sample set (testdata/sample:
 # 16 renders of the 23x16 PuzzleBoard through a wide-angle pinhole lens, made
-# by `puzzlecal render --scene configs/scenes/sample.yaml`), then prints the
+# by `puzzlecal render --scene testdata/sample_scene.yaml`), then prints the
 # result next to the truth it was rendered with.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,7 +9,7 @@ scripts/install_deps.sh
 scripts/build.sh build Release
 bin=./build/apps/puzzlecal
 if [ ! -f testdata/sample/truth.yaml ]; then
-  "$bin" render --scene configs/scenes/sample.yaml --out testdata/sample
+  "$bin" render --scene testdata/sample_scene.yaml --out testdata/sample
 fi
 mkdir -p out/demo
 "$bin" calibrate --images testdata/sample \
