@@ -288,7 +288,7 @@ EdgeBitReading ReadEdgeBits(const LabelLattice& lattice, const cv::Mat& image,
       double disc = 0.0;
       if (ok) {
         const double o = options.disc_sample_offset;
-        double s0, s1, s2;
+        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
         ok = sampler.Sample(mid, &s0) && sampler.Sample(mid + o * along, &s1) &&
              sampler.Sample(mid - o * along, &s2);
         disc = (s0 + s1 + s2) / 3.0;
