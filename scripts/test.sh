@@ -4,11 +4,11 @@
 #  2. AddressSanitizer + UBSan build (build-asan/), ctest: any finding fails;
 #  3. the libFuzzer targets (build-fuzz/, clang), each for a bounded time from
 #     its seed corpus (scripts/fuzz.sh; PUZZLECAL_FUZZ_SECONDS per target,
-#     default 30; 0 skips fuzzing).
+#     default 20, so CI stays well inside its time; 0 skips fuzzing).
 # Prints the time of each phase at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-fuzz_seconds="${PUZZLECAL_FUZZ_SECONDS:-30}"
+fuzz_seconds="${PUZZLECAL_FUZZ_SECONDS:-20}"
 timings=()
 phase_start=$SECONDS
 phase_done() {
