@@ -14,10 +14,12 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "calib/camera_models.h"
 #include "decode/board.h"
 #include "detection/detector.h"
+#include "grid/grid.h"
 #include "sim/render.h"
 
 namespace puzzlecal {
@@ -79,6 +81,68 @@ void Measure(const std::string& name, const cv::Mat& image, int runs,
       best.ms_nms, best.ms_filter, best.ms_refine, last ? "" : ",");
 }
 
+// Per deltille photo: corners on the board (inside the convex hull of the
+// largest grid/ component, grown by 0.35 of its median neighbour spacing)
+// and off it. The photos show an 11x8-corner board: 88 corners.
+void DeltillePhotos(const std::string& dir) {
+  std::printf("  \"deltille_fisheye\": [\n");
+  int photos = 0, complete = 0, total_on = 0, total_off = 0;
+  bool first = true;
+  for (int i = 0; i < 256; i += 4) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%04d.png", i);
+    const cv::Mat image = cv::imread(dir + "/" + name, cv::IMREAD_GRAYSCALE);
+    if (image.empty()) continue;
+    DetectorSummary summary;
+    const std::vector<Corner> corners = DetectCorners(image, {}, &summary);
+    const std::vector<GridComponent> components = BuildGrid(corners, image);
+    int on = 0, largest = 0;
+    if (!components.empty()) {
+      const GridComponent& c = components.front();
+      largest = static_cast<int>(c.corner.size());
+      std::vector<cv::Point2f> points;
+      std::vector<double> spacing;
+      for (size_t k = 0; k < c.corner.size(); ++k) {
+        const Eigen::Vector2d& p = corners[c.corner[k]].xy;
+        points.emplace_back(p.x(), p.y());
+        double nearest = 1e30;
+        for (size_t m = 0; m < c.corner.size(); ++m) {
+          if (m != k) {
+            nearest = std::min(nearest, (corners[c.corner[m]].xy - p).norm());
+          }
+        }
+        spacing.push_back(nearest);
+      }
+      std::sort(spacing.begin(), spacing.end());
+      const double grow = spacing.empty() ? 0.0 : 0.35 * spacing[spacing.size() / 2];
+      std::vector<cv::Point2f> hull;
+      if (points.size() >= 3) cv::convexHull(points, hull);
+      for (const Corner& corner : corners) {
+        if (hull.size() >= 3 &&
+            cv::pointPolygonTest(hull, cv::Point2f(corner.xy.x(), corner.xy.y()),
+                                 true) > -grow) {
+          ++on;
+        }
+      }
+    }
+    const int off = static_cast<int>(corners.size()) - on;
+    ++photos;
+    complete += on >= 88 ? 1 : 0;
+    total_on += on;
+    total_off += off;
+    std::printf("%s    {\"photo\": \"%s\", \"corners\": %d, \"on_board\": %d, "
+                "\"off_board\": %d, \"largest_component\": %d, \"ms\": %.1f}",
+                first ? "" : ",\n", name, static_cast<int>(corners.size()), on,
+                off, largest, summary.ms_total);
+    first = false;
+  }
+  std::printf("\n  ],\n  \"deltille_summary\": {\"photos\": %d, "
+              "\"photos_with_88_on_board\": %d, \"mean_on_board\": %.1f, "
+              "\"mean_off_board\": %.1f},\n",
+              photos, complete, photos ? total_on / double(photos) : 0.0,
+              photos ? total_off / double(photos) : 0.0);
+}
+
 }  // namespace
 }  // namespace puzzlecal
 
@@ -98,7 +162,11 @@ int main(int argc, char** argv) {
       break;
     }
   }
-  std::printf("{\n  \"threads\": 1,\n  \"images\": [\n");
+  std::printf("{\n  \"threads\": 1,\n");
+  if (!photo_path.empty()) {
+    DeltillePhotos(photo_path.substr(0, photo_path.rfind('/')));
+  }
+  std::printf("  \"images\": [\n");
   Measure("render_puzzleboard_1600x1200", small, runs, false);
   if (!photo_path.empty()) {
     Measure("deltille_fisheye_0036", cv::imread(photo_path, cv::IMREAD_GRAYSCALE),

@@ -185,6 +185,72 @@ int main(int argc, char** argv) {
       first_cell = false;
     }
   }
+  std::printf("\n  ],\n");
+
+  // Recall per tile size (blur 0.8 px, noise 1 %, PuzzleBoard 11x8, mild
+  // tilt), same defaults throughout; false = detections on the board farther
+  // than 1.5 px from every corner.
+  std::printf("  \"recall_by_tile_px\": [\n");
+  Board puzzle;
+  puzzle.type = BoardType::kPuzzleBoard;
+  puzzle.cols = 11;
+  puzzle.rows = 8;
+  puzzle.tile_size_m = 0.02;
+  bool first_tile = true;
+  for (double tile_px : {4.0, 5.0, 6.0, 8.0, 10.0, 15.0, 25.0, 50.0, 100.0, 200.0}) {
+    int expected = 0, found = 0, false_on_board = 0;
+    for (int v = 0; v < 2; ++v) {
+      const double fx = 1000.0;
+      Camera camera;
+      camera.model = CameraModelId::kPinholeRadtan;
+      camera.width = static_cast<int>(tile_px * 15 + 40);
+      camera.height = static_cast<int>(tile_px * 12 + 40);
+      camera.params = {fx, fx, camera.width / 2.0, camera.height / 2.0, 0, 0, 0, 0, 0};
+      const double z = fx * puzzle.tile_size_m / tile_px;
+      const Eigen::Matrix3d rotation =
+          (Eigen::AngleAxisd(0.3 + 0.5 * v, Eigen::Vector3d::UnitZ()) *
+           Eigen::AngleAxisd(0.15, Eigen::Vector3d::UnitX()))
+              .toRotationMatrix();
+      const Eigen::Vector3d centre((puzzle.cols - 1) * 0.5 * puzzle.tile_size_m,
+                                   (puzzle.rows - 1) * 0.5 * puzzle.tile_size_m, 0);
+      Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
+      cam_from_board.linear() = rotation;
+      cam_from_board.translation() = Eigen::Vector3d(0, 0, z) - rotation * centre;
+      RenderOptions render;
+      render.blur_sigma_px = 0.8;
+      render.noise_sigma = 0.01;
+      render.supersampling = tile_px > 60 ? 2 : 4;
+      render.seed = 7 + v;
+      RenderTruth truth;
+      const cv::Mat image = RenderBoard(puzzle, camera, cam_from_board, render, &truth);
+      if (image.empty()) continue;
+      std::vector<Eigen::Vector2d> truth_xy, found_xy;
+      for (const TruthCorner& t : truth.corners) {
+        if (t.visible && t.xy.x() > 3 && t.xy.y() > 3 &&
+            t.xy.x() < image.cols - 4 && t.xy.y() < image.rows - 4) {
+          truth_xy.push_back(t.xy);
+        }
+      }
+      for (const Corner& c : DetectCorners(image)) found_xy.push_back(c.xy);
+      const double radius = std::max(1.5, std::min(3.0, 0.25 * tile_px));
+      for (const Eigen::Vector2d& t : truth_xy) {
+        double d;
+        ++expected;
+        if (Nearest(found_xy, t, &d) >= 0 && d < radius) ++found;
+      }
+      for (const Eigen::Vector2d& f : found_xy) {
+        double d;
+        Nearest(truth_xy, f, &d);
+        if (d >= radius && d < 1.5 * tile_px) ++false_on_board;
+      }
+    }
+    std::printf("%s    {\"tile_px\": %.0f, \"visible\": %d, \"found\": %d, "
+                "\"recall\": %s, \"false_on_board\": %d}",
+                first_tile ? "" : ",\n", tile_px, expected, found,
+                Num(expected ? double(found) / expected : NAN).c_str(),
+                false_on_board);
+    first_tile = false;
+  }
   std::printf("\n  ]\n}\n");
   return 0;
 }
