@@ -1023,6 +1023,11 @@ std::string FormatWithSigma(double value, double sigma,
 std::string ReportMarkdown(const ReportInput& input,
                            const ReportOptions& options,
                            const std::vector<std::string>& png_files) {
+  if (input.result == nullptr || input.views == nullptr ||
+      input.result->view_used.size() != input.views->size()) {
+    return "# Calibration report\n\nNo consistent calibration result was "
+           "given.\n";
+  }
   const ReportData data = GatherData(input);
   const CalibrationResult& result = *input.result;
   const Camera& camera = result.camera;

@@ -421,6 +421,8 @@ TEST(ReportTest, RefusesBadInputWithAMessage) {
   EXPECT_FALSE(
       WriteReport((dir / "r").string(), input, ReportOptions(), &error));
   EXPECT_NE(error.find("no calibration result"), std::string::npos) << error;
+  EXPECT_NE(ReportMarkdown(input, ReportOptions(), {}).find("No consistent"),
+            std::string::npos);
 
   // A result that does not match the view list.
   CalibrationResult result;
