@@ -1,7 +1,7 @@
 // `puzzlecal calibrate`: a folder of photos in, a camera file (and a report)
 // out.
 
-#include <unistd.h>
+#include <glog/logging.h>
 
 #include <algorithm>
 #include <chrono>
@@ -9,13 +9,11 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <opencv2/core.hpp>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <glog/logging.h>
-#include <opencv2/core.hpp>
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
@@ -42,8 +40,7 @@ constexpr char kUsage[] =
     "non-zero and writes nothing.";
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                       start)
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
       .count();
 }
 
@@ -63,7 +60,8 @@ class Progress {
       return;
     }
     constexpr int kWidth = 30;
-    const int filled = static_cast<int>(kWidth * done_ / std::max<size_t>(1, total_));
+    const int filled =
+        static_cast<int>(kWidth * done_ / std::max<size_t>(1, total_));
     std::cerr << "\r[" << std::string(filled, '#')
               << std::string(kWidth - filled, ' ') << "] " << done_ << "/"
               << total_ << " " << name << std::string(20, ' ');
@@ -75,29 +73,6 @@ class Progress {
   size_t done_ = 0;
   bool terminal_;
 };
-
-// Fails early when the output cannot be written, before any work is done.
-bool CheckOutputPath(const std::string& path, std::string* error) {
-  const fs::path out(path);
-  fs::path folder = out.parent_path();
-  if (folder.empty()) folder = ".";
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec)) {
-    *error = path + ": the output folder " + folder.string() +
-             " does not exist";
-    return false;
-  }
-  if (::access(folder.c_str(), W_OK) != 0) {
-    *error = path + ": the output folder " + folder.string() +
-             " is not writable";
-    return false;
-  }
-  if (fs::is_directory(out, ec)) {
-    *error = path + ": is a folder, expected a file name";
-    return false;
-  }
-  return true;
-}
 
 // One line per input image for the log and the report.
 std::vector<ReportImage> ReportLines(const std::vector<ImageResult>& images,
@@ -173,10 +148,10 @@ int RunCalibrate() {
   // worker holds one image at a time. OpenCV's own threads stay off so the
   // workers do not oversubscribe the cores.
   PipelineOptions pipeline_options;
-  const int threads = FLAGS_threads > 0
-                          ? FLAGS_threads
-                          : static_cast<int>(std::max(
-                                1u, std::thread::hardware_concurrency()));
+  const int threads =
+      FLAGS_threads > 0
+          ? FLAGS_threads
+          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   cv::setNumThreads(1);
   Progress progress(listing.images.size());
   std::vector<ImageResult> images = ProcessImageFiles(
@@ -210,9 +185,9 @@ int RunCalibrate() {
   CalibrationOptions calibration_options;
   CalibrationResult result;
   std::string calibration_error;
-  const bool calibrated = Calibrate(views, model, width, height,
-                                    calibration_options, &result,
-                                    &calibration_error);
+  const bool calibrated =
+      Calibrate(views, model, width, height, calibration_options, &result,
+                &calibration_error);
   const double seconds_calibrate = SecondsSince(calib_start);
 
   const std::vector<ReportImage> report_images =
@@ -238,8 +213,7 @@ int RunCalibrate() {
     input.seconds_total = SecondsSince(run_start);
     input.threads = threads;
     if (!WriteReport(FLAGS_report, input, ReportOptions(), &error)) {
-      std::cerr << "puzzlecal calibrate: report not written: " << error
-                << "\n";
+      std::cerr << "puzzlecal calibrate: report not written: " << error << "\n";
       return kExitOutputError;
     }
   }
@@ -256,9 +230,8 @@ int RunCalibrate() {
   const double seconds_total = SecondsSince(run_start);
   std::cout << result.report << "\n";
   std::cout << "views used: " << result.num_views_used << " of "
-            << images.size() << " images; corners: "
-            << result.num_corners_used << "; RMS " << std::setprecision(4)
-            << result.rms_px << " px\n";
+            << images.size() << " images; corners: " << result.num_corners_used
+            << "; RMS " << std::setprecision(4) << result.rms_px << " px\n";
   std::cout << std::setprecision(3) << "time: " << seconds_total
             << " s wall clock on " << threads
             << " threads; summed over images: image decoding " << seconds_load

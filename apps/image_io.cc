@@ -1,14 +1,15 @@
 #include "apps/image_io.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <system_error>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <system_error>
 
 namespace puzzlecal {
 namespace {
@@ -51,8 +52,8 @@ std::string TruncationReason(const std::vector<unsigned char>& bytes) {
   if (bytes.size() >= 4 &&
       std::equal(kPngMagic.begin(), kPngMagic.end(), bytes.begin())) {
     if (!EndsWith(bytes, kPngEnd, 64)) return "truncated PNG (no IEND chunk)";
-  } else if (bytes.size() >= 2 && std::equal(kJpegMagic.begin(),
-                                             kJpegMagic.end(), bytes.begin())) {
+  } else if (bytes.size() >= 2 &&
+             std::equal(kJpegMagic.begin(), kJpegMagic.end(), bytes.begin())) {
     if (!EndsWith(bytes, kJpegEnd, 64)) {
       return "truncated JPEG (no end-of-image marker)";
     }
@@ -108,8 +109,9 @@ bool ListImages(const std::string& path, ImageListing* listing,
   std::sort(listing->images.begin(), listing->images.end());
   std::sort(listing->skipped.begin(), listing->skipped.end());
   if (listing->images.empty()) {
-    *error = path + ": the folder holds no image files (png, jpg, jpeg, tif, "
-                    "tiff, bmp)";
+    *error = path +
+             ": the folder holds no image files (png, jpg, jpeg, tif, "
+             "tiff, bmp)";
     return false;
   }
   return true;
@@ -190,6 +192,28 @@ bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
     return true;
   }
   single.convertTo(*grey, CV_8U, 255.0 / max_value);
+  return true;
+}
+
+bool CheckOutputPath(const std::string& path, std::string* error) {
+  const fs::path out(path);
+  fs::path folder = out.parent_path();
+  if (folder.empty()) folder = ".";
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) {
+    *error =
+        path + ": the output folder " + folder.string() + " does not exist";
+    return false;
+  }
+  if (::access(folder.c_str(), W_OK) != 0) {
+    *error =
+        path + ": the output folder " + folder.string() + " is not writable";
+    return false;
+  }
+  if (fs::is_directory(out, ec)) {
+    *error = path + ": is a folder, expected a file name";
+    return false;
+  }
   return true;
 }
 

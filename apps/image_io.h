@@ -3,10 +3,9 @@
 
 // Finding and loading the photos of a calibration run.
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace puzzlecal {
 
@@ -37,6 +36,11 @@ struct ImageLoadOptions {
 // unreadable, not an image, truncated, too large, empty).
 bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
                    cv::Mat* grey, std::string* error);
+
+// Fails early when an output file cannot be written, before any work is
+// done: false with a message naming `path` when its folder does not exist or
+// is not writable, or when `path` is a folder.
+bool CheckOutputPath(const std::string& path, std::string* error);
 
 }  // namespace puzzlecal
 

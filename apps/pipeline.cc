@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <map>
 #include <mutex>
-#include <filesystem>
 #include <sstream>
 #include <thread>
 
@@ -13,8 +13,7 @@ namespace puzzlecal {
 namespace {
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                       start)
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
       .count();
 }
 
@@ -119,14 +118,22 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
           options.min_corners) {
     result->seconds_grid_decode = SecondsSince(start);
     result->outcome = ImageOutcome::kNoGrid;
-    result->reason =
-        "no lattice of " + std::to_string(options.min_corners) +
-        " or more consistent corners among " +
-        std::to_string(result->corners.size()) + " detections";
+    result->reason = "no lattice of " + std::to_string(options.min_corners) +
+                     " or more consistent corners among " +
+                     std::to_string(result->corners.size()) + " detections";
     return;
   }
-  result->decode = DecodeBoard(board, result->corners, result->components,
-                               grey, options.decode);
+  if (!options.run_decode) {
+    result->seconds_grid_decode = SecondsSince(start);
+    result->outcome = ImageOutcome::kUsable;
+    result->reason = std::to_string(result->components.size()) +
+                     " lattice components, largest " +
+                     std::to_string(result->components.front().corner.size()) +
+                     " corners (not decoded: no board given)";
+    return;
+  }
+  result->decode = DecodeBoard(board, result->corners, result->components, grey,
+                               options.decode);
   result->seconds_grid_decode = SecondsSince(start);
   if (board.type == BoardType::kPuzzleBoard && !result->decode.decoded) {
     result->outcome = ImageOutcome::kNotDecoded;
@@ -207,8 +214,8 @@ std::vector<CalibrationView> MakeCalibrationViews(
     } else if (image.width != *width || image.height != *height) {
       image.outcome = ImageOutcome::kSizeMismatch;
       std::ostringstream reason;
-      reason << image.width << "x" << image.height << " differs from "
-             << *width << "x" << *height << " of the first usable image";
+      reason << image.width << "x" << image.height << " differs from " << *width
+             << "x" << *height << " of the first usable image";
       image.reason = reason.str();
       continue;
     }

@@ -5,10 +5,9 @@
 // parallel with a bounded number of images in memory.
 
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "apps/image_io.h"
 #include "calib/calibration_view.h"
@@ -23,13 +22,13 @@ namespace puzzlecal {
 
 // What an image yielded.
 enum class ImageOutcome {
-  kUsable,            // enough corners with board ids
-  kUnreadable,        // the file could not be loaded
-  kNoCorners,         // the detector found too few corners
-  kNoGrid,            // no consistent lattice among the corners
-  kNotDecoded,        // PuzzleBoard: no component decoded
-  kTooFewCorners,     // decoded, but fewer corners than a view needs
-  kSizeMismatch,      // image size differs from the first image's
+  kUsable,         // enough corners with board ids
+  kUnreadable,     // the file could not be loaded
+  kNoCorners,      // the detector found too few corners
+  kNoGrid,         // no consistent lattice among the corners
+  kNotDecoded,     // PuzzleBoard: no component decoded
+  kTooFewCorners,  // decoded, but fewer corners than a view needs
+  kSizeMismatch,   // image size differs from the first image's
 };
 
 // "usable", "unreadable", "no corners", ...
@@ -43,6 +42,9 @@ struct PipelineOptions {
   // An image needs at least this many corners with board ids to be a view.
   // Default 6 (a pose has 6 degrees of freedom; fewer cannot constrain it).
   int min_corners = 6;
+  // False: stop after the grid (relative labels in `components`, no board
+  // ids), for `puzzlecal detect` without a board file. Default true.
+  bool run_decode = true;
 
   bool Check(std::string* why = nullptr) const;
 };
@@ -52,16 +54,17 @@ struct ImageResult {
   int width = 0;
   int height = 0;
   ImageOutcome outcome = ImageOutcome::kUnreadable;
-  std::string reason;                      // why not usable, or details
-  std::vector<Corner> corners;             // all detections
-  std::vector<GridComponent> components;   // lattice components
-  DecodeResult decode;                     // ids and per-component decisions
-  double seconds_load = 0;                 // reading and decoding the file
-  double seconds_detect = 0;               // corner detection
-  double seconds_grid_decode = 0;          // grid + decode
+  std::string reason;                     // why not usable, or details
+  std::vector<Corner> corners;            // all detections
+  std::vector<GridComponent> components;  // lattice components
+  DecodeResult decode;                    // ids and per-component decisions
+  double seconds_load = 0;                // reading and decoding the file
+  double seconds_detect = 0;              // corner detection
+  double seconds_grid_decode = 0;         // grid + decode
 };
 
-// Runs detection, grid and decode on a grey image.
+// Runs detection, grid and decode on a grey image (`board` is not read when
+// options.run_decode is false).
 void ProcessGreyImage(const cv::Mat& grey, const Board& board,
                       const PipelineOptions& options, ImageResult* result);
 

@@ -6,10 +6,13 @@
 // The images are rendered here (sim/render.h) into a temporary folder; the
 // program is the one built beside this test (<build>/apps/puzzlecal).
 
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -17,16 +20,12 @@
 #include <fstream>
 #include <iterator>
 #include <map>
-#include <sstream>
-#include <string>
-#include <vector>
-
-#include <Eigen/Geometry>
-#include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <yaml-cpp/yaml.h>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "apps/subcommand.h"
 #include "calib/camera_models.h"
@@ -132,8 +131,8 @@ cv::Mat Render(const Eigen::Isometry3d& pose, RenderTruth* truth = nullptr) {
   options.blur_sigma_px = 0.8;
   options.noise_sigma = 0.01;
   RenderSummary summary;
-  cv::Mat image = RenderBoard(PuzzleBoard11x8(), PinholeCamera(), pose,
-                              options, truth, &summary);
+  cv::Mat image = RenderBoard(PuzzleBoard11x8(), PinholeCamera(), pose, options,
+                              truth, &summary);
   EXPECT_TRUE(summary.ok) << summary.reason;
   return image;
 }
@@ -217,7 +216,8 @@ class BadInputTest : public ::testing::Test {
                                 Quote(err.string()) + " </dev/null";
     const int status = std::system(command.c_str());
     RunResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.exit_code =
+        WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     result.out = ReadFile(out);
     result.err = ReadFile(err);
     fs::remove(out);
@@ -269,8 +269,8 @@ class BadInputTest : public ::testing::Test {
 
 fs::path* BadInputTest::root_ = nullptr;
 
-#define SKIP_WITHOUT_CALIBRATE()                                          \
-  if (!HasCalibrate()) {                                                  \
+#define SKIP_WITHOUT_CALIBRATE()                                           \
+  if (!HasCalibrate()) {                                                   \
     GTEST_SKIP() << "`puzzlecal calibrate` is not part of this build yet"; \
   }
 
@@ -330,6 +330,7 @@ TEST_F(BadInputTest, FolderOfNonImages) {
   EXPECT_NE(detect.err.find("random.jpg"), std::string::npos) << detect.err;
   EXPECT_NE(detect.err.find("not a readable image"), std::string::npos)
       << detect.err;
+  EXPECT_FALSE(fs::exists(out)) << "nothing readable: no detections file";
 
   SKIP_WITHOUT_CALIBRATE();
   const fs::path camera = case_dir_ / "camera.yaml";
@@ -338,6 +339,113 @@ TEST_F(BadInputTest, FolderOfNonImages) {
   EXPECT_NE(calibrate.all().find("fake.png"), std::string::npos)
       << calibrate.all();
   EXPECT_FALSE(fs::exists(camera));
+}
+
+// `detect --board` on a good view beside a broken file: the broken file is
+// named with its reason, and every labelled corner of the good view carries
+// the truth id of the printed corner under it (absolute ids, decoded).
+// Without --board the same corners come with relative labels that differ from
+// the truth ids by one lattice transform per component.
+TEST_F(BadInputTest, DetectWritesTruthIdsOfAGoodView) {
+  const fs::path folder = case_dir_ / "detect";
+  fs::create_directories(folder);
+  RenderTruth truth;
+  WriteFile(folder / "view.png",
+            EncodeImage(Render(GoodPoses()[1], &truth), ".png"));
+  WriteFile(folder / "zero.png", "");
+  const fs::path out = case_dir_ / "detections.yaml";
+
+  // Truth id of the visible corner within 1 px of (x, y), or (-1, -1).
+  auto truth_id = [&](double x, double y) {
+    for (const TruthCorner& corner : truth.corners) {
+      if (corner.visible && (corner.xy - Eigen::Vector2d(x, y)).norm() < 1.0) {
+        return corner.id;
+      }
+    }
+    return Eigen::Vector2i(-1, -1);
+  };
+  int visible = 0;
+  for (const TruthCorner& corner : truth.corners) visible += corner.visible;
+  ASSERT_GT(visible, 40);
+
+  for (const bool with_board : {true, false}) {
+    SCOPED_TRACE(with_board ? "with --board" : "without --board");
+    const RunResult detect =
+        Run("detect --images " + Quote(folder.string()) + " --out " +
+            Quote(out.string()) +
+            (with_board ? " --board " + Quote(BoardFile().string()) : ""));
+    ASSERT_EQ(detect.exit_code, kExitOk) << detect.all();
+    EXPECT_NE(detect.err.find("zero.png"), std::string::npos) << detect.err;
+    const YAML::Node root = YAML::LoadFile(out.string());
+    ASSERT_EQ(root["images"].size(), 2u);
+    const YAML::Node broken = root["images"][1];
+    EXPECT_EQ(fs::path(broken["file"].as<std::string>()).filename(),
+              "zero.png");
+    EXPECT_FALSE(broken["reason"].as<std::string>().empty());
+    EXPECT_EQ(broken["corners"].size(), 0u);
+
+    const YAML::Node view = root["images"][0];
+    EXPECT_EQ(view["width"].as<int>(), truth.camera.width);
+    EXPECT_EQ(view["decoded"].as<bool>(), with_board)
+        << view["reason"].as<std::string>();
+    // Per component: the offset truth id - label, which must be one value per
+    // component when decoded (identity map) and, without a board, one per
+    // component under the component's own rotation/reflection, checked
+    // through the label differences of corner pairs.
+    std::map<int, std::vector<std::pair<Eigen::Vector2i, Eigen::Vector2i>>>
+        labels_by_component;  // component -> (label, truth id)
+    int labelled = 0;
+    for (const YAML::Node& row : view["corners"]) {
+      ASSERT_EQ(row.size(), 5u);
+      const int component = row[4].as<int>();
+      if (component < 0) continue;
+      const Eigen::Vector2i label(row[2].as<int>(), row[3].as<int>());
+      const Eigen::Vector2i id =
+          truth_id(row[0].as<double>(), row[1].as<double>());
+      ASSERT_GE(id.x(), 0) << "labelled corner off the board at "
+                           << row[0].as<double>() << ", "
+                           << row[1].as<double>();
+      if (with_board) {
+        EXPECT_EQ(label, id) << "component " << component;
+      }
+      labels_by_component[component].push_back({label, id});
+      ++labelled;
+    }
+    EXPECT_GE(labelled, 0.95 * visible);
+    for (const auto& [component, pairs] : labels_by_component) {
+      // Relative labels: the lattice transform taking label differences to
+      // id differences is fixed by the first pair of non-collinear steps;
+      // every other pair must follow it.
+      const auto& [label0, id0] = pairs.front();
+      std::vector<Eigen::Vector2i> dl, di;
+      for (const auto& [label, id] : pairs) {
+        dl.push_back(label - label0);
+        di.push_back(id - id0);
+      }
+      Eigen::Matrix2i m = Eigen::Matrix2i::Zero();
+      bool found = false;
+      for (size_t a = 0; a < dl.size() && !found; ++a) {
+        for (size_t b = a + 1; b < dl.size() && !found; ++b) {
+          Eigen::Matrix2i l;
+          l << dl[a], dl[b];
+          const int det = l.determinant();
+          if (det != 1 && det != -1) continue;
+          Eigen::Matrix2i d;
+          d << di[a], di[b];
+          // m * l = d, l unimodular: m = d * l^-1 (integer).
+          Eigen::Matrix2i l_inverse;
+          l_inverse << l(1, 1), -l(0, 1), -l(1, 0), l(0, 0);
+          m = d * l_inverse * det;
+          found = true;
+        }
+      }
+      ASSERT_TRUE(found) << "component " << component;
+      EXPECT_EQ(std::abs(m.determinant()), 1) << m;
+      for (size_t k = 0; k < dl.size(); ++k) {
+        EXPECT_EQ(m * dl[k], di[k]) << "component " << component;
+      }
+    }
+  }
 }
 
 // Broken files among good views: each is named with its reason, the good
@@ -362,8 +470,7 @@ TEST_F(BadInputTest, BrokenFilesAmongGoodViews) {
   EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
   EXPECT_NE(detect.err.find("truncated.png: truncated PNG"), std::string::npos)
       << detect.err;
-  EXPECT_NE(detect.err.find("truncated.jpg: truncated JPEG"),
-            std::string::npos)
+  EXPECT_NE(detect.err.find("truncated.jpg: truncated JPEG"), std::string::npos)
       << detect.err;
   EXPECT_NE(detect.err.find("zero.png: empty file"), std::string::npos)
       << detect.err;
@@ -429,8 +536,8 @@ TEST_F(BadInputTest, SixteenBitAndRgbaImages) {
 TEST_F(BadInputTest, TwoBoardsInOneImage) {
   const fs::path folder = ImagesWithGoodViews("two_boards", 5);
   const Board board = PuzzleBoard11x8();
-  const cv::Mat left = Render(
-      LookAtBoard(board, 2.4, 0.1, 0.2, Eigen::Vector3d(-0.36, 0.0, 0)));
+  const cv::Mat left =
+      Render(LookAtBoard(board, 2.4, 0.1, 0.2, Eigen::Vector3d(-0.36, 0.0, 0)));
   const cv::Mat right = Render(
       LookAtBoard(board, 2.4, -0.1, -0.2, Eigen::Vector3d(0.36, 0.0, 0)));
   cv::Mat both = left.clone();
@@ -501,14 +608,18 @@ TEST_F(BadInputTest, BadBoardFiles) {
   SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const std::vector<std::pair<std::string, std::string>> boards = {
-      {"missing_cols", "type: puzzleboard\nrows: 8\norigin: [0, 0]\n"
-                       "tile_size_m: 0.06\n"},
-      {"text_cols", "type: puzzleboard\ncols: eleven\nrows: 8\n"
-                    "origin: [0, 0]\ntile_size_m: 0.06\n"},
-      {"negative_tile", "type: puzzleboard\ncols: 11\nrows: 8\n"
-                        "origin: [0, 0]\ntile_size_m: -0.06\n"},
-      {"unknown_type", "type: chessboard\ncols: 11\nrows: 8\n"
-                       "tile_size_m: 0.06\n"},
+      {"missing_cols",
+       "type: puzzleboard\nrows: 8\norigin: [0, 0]\n"
+       "tile_size_m: 0.06\n"},
+      {"text_cols",
+       "type: puzzleboard\ncols: eleven\nrows: 8\n"
+       "origin: [0, 0]\ntile_size_m: 0.06\n"},
+      {"negative_tile",
+       "type: puzzleboard\ncols: 11\nrows: 8\n"
+       "origin: [0, 0]\ntile_size_m: -0.06\n"},
+      {"unknown_type",
+       "type: chessboard\ncols: 11\nrows: 8\n"
+       "tile_size_m: 0.06\n"},
       {"not_yaml", "{{{ this: is: [not yaml\n"},
   };
   for (const auto& [name, text] : boards) {
@@ -520,8 +631,8 @@ TEST_F(BadInputTest, BadBoardFiles) {
             Quote(board.string()) + " --model pinhole-radtan --out " +
             Quote(camera.string()));
     EXPECT_EQ(run.exit_code, kExitBadInput) << name << "\n" << run.all();
-    EXPECT_NE(run.err.find(board.string()), std::string::npos)
-        << name << "\n" << run.err;
+    EXPECT_NE(run.err.find(board.string()), std::string::npos) << name << "\n"
+                                                               << run.err;
     EXPECT_FALSE(fs::exists(camera)) << name;
   }
   const fs::path missing = case_dir_ / "no_board.yaml";
@@ -561,12 +672,11 @@ TEST_F(BadInputTest, UnwritableOutput) {
     const RunResult detect = Detect(folder, out);
     EXPECT_EQ(detect.exit_code, kExitOutputError) << out << "\n"
                                                   << detect.all();
-    EXPECT_NE(detect.err.find(out.string()), std::string::npos)
-        << detect.err;
+    EXPECT_NE(detect.err.find(out.string()), std::string::npos) << detect.err;
     if (has_calibrate) {
       const RunResult calibrate = Calibrate(folder, out);
-      EXPECT_EQ(calibrate.exit_code, kExitOutputError)
-          << out << "\n" << calibrate.all();
+      EXPECT_EQ(calibrate.exit_code, kExitOutputError) << out << "\n"
+                                                       << calibrate.all();
       EXPECT_NE(calibrate.err.find(out.string()), std::string::npos)
           << calibrate.err;
     }
