@@ -350,6 +350,60 @@ int main() {
     std::printf("  },\n");
   }
 
+  // --- What the code itself allows: every k x k-tile window of the 72x52
+  // board read without error, searched like a component (any rotation of
+  // the labels' handedness, tile colour known). margin 0: another in-board
+  // position matches every bit (no decoder can tell them apart); margin 1:
+  // one misread bit away from ambiguity (DecodeOptions::min_margin refuses
+  // these). ---
+  {
+    const Board board = MakePuzzleBoard(72, 52, 100, 200, 0.01);
+    std::printf("  \"code_limit_72x52\": {");
+    for (int k = 3; k <= 4; ++k) {
+      int windows = 0, margin0 = 0, margin1 = 0, wrong_best = 0;
+      for (int y0 = board.origin.y(); y0 + k < board.origin.y() + board.rows;
+           ++y0) {
+        for (int x0 = board.origin.x(); x0 + k < board.origin.x() + board.cols;
+             ++x0) {
+          LabelToBoard truth;
+          truth.offset = Eigen::Vector2i(x0, y0);
+          std::vector<LabelEdgeVote> votes;
+          for (int j = 0; j <= k; ++j) {
+            for (int i = 0; i <= k; ++i) {
+              const Eigen::Vector2i from(i, j);
+              if (i < k)
+                votes.push_back({from, 0, BoardBitOfLabelEdge(truth, from, 0)});
+              if (j < k)
+                votes.push_back({from, 1, BoardBitOfLabelEdge(truth, from, 1)});
+            }
+          }
+          const PositionSearchResult search = SearchPuzzleBoardPosition(
+              votes, Eigen::Vector2i::Zero(), Eigen::Vector2i(k, k), +1,
+              (x0 + y0) & 1, board);
+          ++windows;
+          const int margin = (search.best_score - search.second_score) / 2;
+          if (margin <= 0) {
+            ++margin0;
+          } else if (margin == 1) {
+            ++margin1;
+          }
+          if (margin > 0 && (search.best.rotation != truth.rotation ||
+                             !SameIdMod501(search.best.offset, truth.offset))) {
+            ++wrong_best;
+          }
+        }
+      }
+      std::printf(
+          "%s\"%dx%d\": {\"windows\": %d, \"margin_0_fraction\": %.4f, "
+          "\"margin_1_fraction\": %.4f, \"margin_ge_2_fraction\": %.4f, "
+          "\"unique_best_not_true\": %d}",
+          k == 3 ? "" : ", ", k, k, windows, double(margin0) / windows,
+          double(margin1) / windows,
+          double(windows - margin0 - margin1) / windows, wrong_best);
+    }
+    std::printf("},\n");
+  }
+
   // --- Refusal: other codes, mirrored, inverted, plain checkerboard. ---
   {
     const Board board = MakePuzzleBoard(23, 16, 50, 100, 0.03);
