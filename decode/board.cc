@@ -73,4 +73,15 @@ std::vector<Eigen::Vector2i> Board::AllIds() const {
   return ids;
 }
 
+Board MakeBoard(BoardType type, int cols, int rows,
+                const Eigen::Vector2i& origin, double tile_size_m) {
+  Board board;
+  board.type = type;
+  board.cols = cols;
+  board.rows = rows;
+  board.origin = origin;
+  board.tile_size_m = tile_size_m;
+  return board;
+}
+
 }  // namespace puzzlecal

@@ -1,10 +1,9 @@
 #ifndef PUZZLECAL_DECODE_BOARD_H_
 #define PUZZLECAL_DECODE_BOARD_H_
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace puzzlecal {
 
@@ -44,6 +43,12 @@ struct Board {
   // All printed corner ids, row-major (row, then col).
   std::vector<Eigen::Vector2i> AllIds() const;
 };
+
+// A board of `type` with cols x rows inner corners starting at `origin`
+// (a checkerboard's origin is (0, 0)) and tiles of `tile_size_m` metres. Not
+// checked: call Board::Check on boards that come from outside the program.
+Board MakeBoard(BoardType type, int cols, int rows,
+                const Eigen::Vector2i& origin, double tile_size_m);
 
 // An image's view of a board: absolute corner ids and their pixel positions.
 struct BoardObservation {

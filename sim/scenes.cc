@@ -328,13 +328,8 @@ Camera FisheyeLensCamera(int width, int height, double fov_deg,
 namespace {
 
 Board PuzzleBoard23x16() {
-  Board board;
-  board.type = BoardType::kPuzzleBoard;
-  board.cols = 23;
-  board.rows = 16;
-  board.origin = Eigen::Vector2i(50, 100);
-  board.tile_size_m = 0.03;
-  return board;
+  return MakeBoard(BoardType::kPuzzleBoard, 23, 16, Eigen::Vector2i(50, 100),
+                   0.03);
 }
 
 }  // namespace

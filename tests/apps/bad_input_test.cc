@@ -89,12 +89,8 @@ std::vector<std::string> FilesUnder(const fs::path& folder) {
 }
 
 Board PuzzleBoard11x8() {
-  Board board;
-  board.type = BoardType::kPuzzleBoard;
-  board.cols = 11;
-  board.rows = 8;
-  board.origin = Eigen::Vector2i(0, 0);
-  board.tile_size_m = 0.06;
+  Board board =
+      MakeBoard(BoardType::kPuzzleBoard, 11, 8, Eigen::Vector2i(0, 0), 0.06);
   return board;
 }
 

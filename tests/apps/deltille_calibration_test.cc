@@ -2,12 +2,12 @@
 // an 11x8-inner-corner checkerboard with 20 mm tiles; corners reach about
 // 114 degrees off the optical axis). Skips when the data is absent.
 
+#include <gtest/gtest.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "apps/config_io.h"
 #include "apps/image_io.h"
@@ -40,8 +40,9 @@ struct DeltilleRun {
 DeltilleRun CalibrateFiles(const std::vector<std::string>& files) {
   DeltilleRun run;
   Board board;
-  EXPECT_TRUE(LoadBoardFile("configs/boards/deltille_checkerboard_11x8_20mm.yaml",
-                            &board, &run.error))
+  EXPECT_TRUE(
+      LoadBoardFile("configs/boards/deltille_checkerboard_11x8_20mm.yaml",
+                    &board, &run.error))
       << run.error;
   std::vector<ImageResult> images =
       ProcessImageFiles(files, board, PipelineOptions(), 0);

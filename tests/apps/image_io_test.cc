@@ -1,14 +1,13 @@
 #include "apps/image_io.h"
 
-#include <filesystem>
-#include <fstream>
-#include <string>
-
+#include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <gtest/gtest.h>
+#include <filesystem>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 namespace puzzlecal {
 namespace {
@@ -119,11 +118,11 @@ TEST_F(ImageIoTest, RefusesBadFilesWithTheReason) {
     const char* file;
     const char* reason;
   };
-  for (const Case& c : {Case{"truncated.png", "truncated PNG"},
-                        Case{"truncated.jpg", "truncated JPEG"},
-                        Case{"zero.png", "empty file"},
-                        Case{"text.png", "not a readable image"},
-                        Case{"absent.png", "cannot open"}}) {
+  for (const Case& c :
+       {Case{"truncated.png", "truncated PNG"},
+        Case{"truncated.jpg", "truncated JPEG"}, Case{"zero.png", "empty file"},
+        Case{"text.png", "not a readable image"},
+        Case{"absent.png", "cannot open"}}) {
     cv::Mat grey;
     std::string error;
     EXPECT_FALSE(LoadGreyImage(Path(c.file), {}, &grey, &error)) << c.file;

@@ -3,16 +3,15 @@
 
 #include "apps/pipeline.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "sim/render.h"
 #include "tests/decode/truth_components.h"
@@ -41,8 +40,9 @@ class PipelineTest : public ::testing::Test {
                      const Eigen::Isometry3d& cam_from_board,
                      const RenderOptions& options = RenderOptions()) {
     RenderTruth truth;
-    const cv::Mat image = RenderBoard(render_board, PinholeCamera(640, 480, 520),
-                                      cam_from_board, options, &truth);
+    const cv::Mat image =
+        RenderBoard(render_board, PinholeCamera(640, 480, 520), cam_from_board,
+                    options, &truth);
     cv::imwrite((dir_ / name).string(), image);
     files_.push_back((dir_ / name).string());
     return truth;
@@ -63,12 +63,15 @@ Eigen::Vector2i TruthIdAt(const RenderTruth& truth, const Eigen::Vector2d& xy) {
 TEST_F(PipelineTest, PuzzleBoardViewsGetTruthIdsAndBadFilesAReason) {
   const Board board = MakePuzzleBoard(23, 16, 50, 100, 0.03);
   std::map<std::string, RenderTruth> truth;
-  truth["a.png"] = Render("a.png", board, LookAt(board, {61, 107.5}, 0.9, 20, 5));
-  truth["b.png"] = Render("b.png", board, LookAt(board, {55, 104}, 0.5, 35, -20));
+  truth["a.png"] =
+      Render("a.png", board, LookAt(board, {61, 107.5}, 0.9, 20, 5));
+  truth["b.png"] =
+      Render("b.png", board, LookAt(board, {55, 104}, 0.5, 35, -20));
   std::ofstream((dir_ / "c.png").string()) << "not a png";
   files_.push_back((dir_ / "c.png").string());
   // A blank image: no corners.
-  cv::imwrite((dir_ / "d.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(128)));
+  cv::imwrite((dir_ / "d.png").string(),
+              cv::Mat(480, 640, CV_8UC1, cv::Scalar(128)));
   files_.push_back((dir_ / "d.png").string());
 
   PipelineOptions options;
@@ -87,7 +90,8 @@ TEST_F(PipelineTest, PuzzleBoardViewsGetTruthIdsAndBadFilesAReason) {
     }
   }
   EXPECT_EQ(results[2].outcome, ImageOutcome::kUnreadable);
-  EXPECT_NE(results[2].reason.find("c.png"), std::string::npos) << results[2].reason;
+  EXPECT_NE(results[2].reason.find("c.png"), std::string::npos)
+      << results[2].reason;
   EXPECT_EQ(results[3].outcome, ImageOutcome::kNoCorners);
 }
 
@@ -98,31 +102,33 @@ TEST_F(PipelineTest, ResultsDoNotDependOnTheThreadCount) {
            LookAt(board, {5, 3.5}, 1.0 + 0.1 * v, 10.0 * v, 15.0 * v));
   }
   const PipelineOptions options;
-  const std::vector<ImageResult> one = ProcessImageFiles(files_, board, options, 1);
-  const std::vector<ImageResult> three = ProcessImageFiles(files_, board, options, 3);
+  const std::vector<ImageResult> one =
+      ProcessImageFiles(files_, board, options, 1);
+  const std::vector<ImageResult> three =
+      ProcessImageFiles(files_, board, options, 3);
   ASSERT_EQ(one.size(), three.size());
   for (size_t i = 0; i < one.size(); ++i) {
     EXPECT_EQ(one[i].file, three[i].file);
     EXPECT_EQ(one[i].outcome, three[i].outcome);
-    ASSERT_EQ(one[i].decode.observation.id.size(), three[i].decode.observation.id.size());
+    ASSERT_EQ(one[i].decode.observation.id.size(),
+              three[i].decode.observation.id.size());
     for (size_t k = 0; k < one[i].decode.observation.id.size(); ++k) {
-      EXPECT_EQ(one[i].decode.observation.id[k], three[i].decode.observation.id[k]);
-      EXPECT_EQ(one[i].decode.observation.xy[k], three[i].decode.observation.xy[k]);
+      EXPECT_EQ(one[i].decode.observation.id[k],
+                three[i].decode.observation.id[k]);
+      EXPECT_EQ(one[i].decode.observation.xy[k],
+                three[i].decode.observation.xy[k]);
     }
   }
 }
 
 TEST_F(PipelineTest, CheckerboardViewKeepsOneConsistentComponent) {
-  Board board;
-  board.type = BoardType::kCheckerboard;
-  board.cols = 11;
-  board.rows = 8;
-  board.tile_size_m = 0.02;
+  Board board =
+      MakeBoard(BoardType::kCheckerboard, 11, 8, Eigen::Vector2i::Zero(), 0.02);
   // Cut by the image border: a partial view, labels stay relative.
   RenderOptions render_options;
-  const RenderTruth truth = Render("partial.png", board,
-                                   LookAt(board, {1.5, 3.5}, 0.25, 20, 10),
-                                   render_options);
+  const RenderTruth truth =
+      Render("partial.png", board, LookAt(board, {1.5, 3.5}, 0.25, 20, 10),
+             render_options);
   int visible = 0;
   for (const TruthCorner& c : truth.corners) visible += c.visible;
   ASSERT_LT(visible, board.NumCorners());

@@ -1,18 +1,18 @@
 #include "apps/report.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "calib/calibrate.h"
 #include "calib/camera_models.h"
@@ -27,8 +27,8 @@ namespace fs = std::filesystem;
 
 // A fresh folder under the test temp dir.
 fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) /
-                       ("puzzlecal_report_test_" + name);
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / ("puzzlecal_report_test_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -59,11 +59,8 @@ cv::Size PngSize(const fs::path& path) {
 }
 
 Board CheckerBoard(double tile) {
-  Board board;
-  board.type = BoardType::kCheckerboard;
-  board.cols = 11;
-  board.rows = 8;
-  board.tile_size_m = tile;
+  Board board =
+      MakeBoard(BoardType::kCheckerboard, 11, 8, Eigen::Vector2i::Zero(), tile);
   return board;
 }
 
@@ -118,10 +115,9 @@ void MakeRun(const testing::SyntheticScene& scene, const fs::path& image_dir,
     run->input.images.push_back(image);
   }
   CalibrationOptions options;
-  run->calibrated =
-      Calibrate(run->data.views, scene.camera.model, scene.camera.width,
-                scene.camera.height, options, &run->result,
-                &run->calibrate_error);
+  run->calibrated = Calibrate(run->data.views, scene.camera.model,
+                              scene.camera.width, scene.camera.height, options,
+                              &run->result, &run->calibrate_error);
   run->input.result = &run->result;
   run->input.views = &run->data.views;
   run->input.calibration_ok = run->calibrated;
@@ -150,7 +146,8 @@ testing::SyntheticScene SmallRadtanScene() {
 std::map<std::string, std::pair<std::string, std::string>> ParamTable(
     const std::string& markdown) {
   std::map<std::string, std::pair<std::string, std::string>> table;
-  const std::regex row(R"(\| (\w+) \| (-?[0-9.e+-]+) \| ([0-9.a-z/]+) \| (px)? \|)");
+  const std::regex row(
+      R"(\| (\w+) \| (-?[0-9.e+-]+) \| ([0-9.a-z/]+) \| (px)? \|)");
   for (std::sregex_iterator it(markdown.begin(), markdown.end(), row), end;
        it != end; ++it) {
     table[(*it)[1]] = {(*it)[2], (*it)[3]};
@@ -177,8 +174,8 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   std::string error;
   ReportSummary summary;
   const fs::path report_dir = dir / "report" / "nested";
-  ASSERT_TRUE(WriteReport(report_dir.string(), run.input, options, &error,
-                          &summary))
+  ASSERT_TRUE(
+      WriteReport(report_dir.string(), run.input, options, &error, &summary))
       << error;
   EXPECT_TRUE(summary.warnings.empty()) << summary.warnings.front();
 
@@ -209,8 +206,8 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   int most_outliers = -1, max_outliers = 0;
   for (int v : by_rms) {
     const auto& inlier = run.result.inlier[v];
-    const int outliers = static_cast<int>(
-        std::count(inlier.begin(), inlier.end(), false));
+    const int outliers =
+        static_cast<int>(std::count(inlier.begin(), inlier.end(), false));
     if (outliers > max_outliers) {
       max_outliers = outliers;
       most_outliers = v;
@@ -218,9 +215,8 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   }
   ASSERT_GE(most_outliers, 0);
   ASSERT_NE(most_outliers, by_rms[0]) << "pick a scene where they differ";
-  const std::vector<int> expected_overlays = {by_rms[0], most_outliers,
-                                              by_rms.end()[-1],
-                                              by_rms.end()[-2]};
+  const std::vector<int> expected_overlays = {
+      by_rms[0], most_outliers, by_rms.end()[-1], by_rms.end()[-2]};
   int overlays = 0;
   for (const std::string& file : summary.files) {
     if (file.rfind("overlay_", 0) == 0) ++overlays;
@@ -273,8 +269,8 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   EXPECT_NE(markdown.find(rms), std::string::npos) << rms;
   for (size_t i = 0; i < run.input.images.size(); ++i) {
     const ReportImage& image = run.input.images[i];
-    const std::string line = "| " + std::to_string(i + 1) + " | " +
-                             image.file + " | " + image.outcome + " | " +
+    const std::string line = "| " + std::to_string(i + 1) + " | " + image.file +
+                             " | " + image.outcome + " | " +
                              std::to_string(image.corners_detected) + " | ";
     EXPECT_NE(markdown.find(line), std::string::npos) << line;
   }
@@ -322,8 +318,8 @@ TEST(ReportTest, FisheyeRunWithMissingImagesStillWritesEverything) {
   options.num_overlays = 1;
   std::string error;
   ReportSummary summary;
-  ASSERT_TRUE(WriteReport((dir / "report").string(), run.input, options,
-                          &error, &summary))
+  ASSERT_TRUE(WriteReport((dir / "report").string(), run.input, options, &error,
+                          &summary))
       << error;
   // The overlay image is missing: drawn on grey, with a warning naming it.
   ASSERT_EQ(summary.warnings.size(), 1u);
@@ -363,10 +359,12 @@ TEST(ReportTest, DistortionShiftAgreesWithOpenCv) {
     // OpenCV's fisheye model (which divides by z) is valid.
     const std::vector<Eigen::Vector2d> pixels =
         camera.model == CameraModelId::kPinholeRadtan
-            ? std::vector<Eigen::Vector2d>{{40, 40}, {600, 60}, {320, 240},
+            ? std::vector<Eigen::Vector2d>{{40, 40},
+                                           {600, 60},
+                                           {320, 240},
                                            {150, 400}}
-            : std::vector<Eigen::Vector2d>{{150, 200}, {600, 40}, {420, 310},
-                                           {650, 450}};
+            : std::vector<Eigen::Vector2d>{
+                  {150, 200}, {600, 40}, {420, 310}, {650, 450}};
     for (const Eigen::Vector2d& pixel : pixels) {
       double shift = 0, angle = 0;
       ASSERT_TRUE(DistortionShift(camera, pixel, &shift, &angle));
@@ -378,7 +376,8 @@ TEST(ReportTest, DistortionShiftAgreesWithOpenCv) {
                             cv::noArray(), cv::noArray(),
                             cv::TermCriteria(cv::TermCriteria::COUNT, 100, 0));
         ideal = Eigen::Vector2d(p[0] * out[0].x + p[2], p[1] * out[0].y + p[3]);
-        EXPECT_NEAR(angle, std::atan(std::hypot(out[0].x, out[0].y)) * 180 / M_PI,
+        EXPECT_NEAR(angle,
+                    std::atan(std::hypot(out[0].x, out[0].y)) * 180 / M_PI,
                     1e-4);
       } else {
         cv::fisheye::undistortPoints(
@@ -398,8 +397,8 @@ TEST(ReportTest, DistortionShiftAgreesWithOpenCv) {
   }
   // No ray for a non-finite pixel.
   double shift = 0, angle = 0;
-  EXPECT_FALSE(DistortionShift(radtan, Eigen::Vector2d(std::nan(""), 3),
-                               &shift, &angle));
+  EXPECT_FALSE(DistortionShift(radtan, Eigen::Vector2d(std::nan(""), 3), &shift,
+                               &angle));
 }
 
 TEST(ReportTest, FormatWithSigmaKeepsThreeDigitsOfSigma) {
@@ -449,8 +448,8 @@ TEST(ReportTest, RefusesBadInputWithAMessage) {
   EXPECT_FALSE(WriteReport((dir / "r").string(), input, options, &error));
 
   // An empty calibration (no views, default camera) still gives a summary.
-  ASSERT_TRUE(WriteReport((dir / "empty").string(), input, ReportOptions(),
-                          &error))
+  ASSERT_TRUE(
+      WriteReport((dir / "empty").string(), input, ReportOptions(), &error))
       << error;
   EXPECT_TRUE(fs::exists(dir / "empty" / "summary.md"));
   RemoveUnlessKept(dir);

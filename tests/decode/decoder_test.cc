@@ -4,13 +4,13 @@
 
 #include "decode/decoder.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
 #include <random>
 #include <set>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "decode/puzzleboard.h"
 #include "tests/decode/truth_components.h"
@@ -39,7 +39,8 @@ Render RenderView(const Board& board, const Camera& camera,
   options.noise_sigma = noise;
   options.variant = variant;
   Render render;
-  render.image = RenderBoard(board, camera, cam_from_board, options, &render.truth);
+  render.image =
+      RenderBoard(board, camera, cam_from_board, options, &render.truth);
   return render;
 }
 
@@ -61,7 +62,8 @@ const Render& FrontView23x16() {
 int WrongIds(const DecodeResult& result, const TruthGrid& grid) {
   int wrong = 0;
   for (size_t k = 0; k < result.observation.id.size(); ++k) {
-    if (result.observation.id[k] != grid.truth_id[result.corner_index[k]]) ++wrong;
+    if (result.observation.id[k] != grid.truth_id[result.corner_index[k]])
+      ++wrong;
   }
   return wrong;
 }
@@ -95,8 +97,8 @@ TEST(DecodeBoard, FullViewDecodesUnderEveryLabelTransform) {
   const Board board = Board23x16();
   const Render render = FrontView23x16();
   for (const Eigen::Matrix2i& label_from_id : AllLabelTransforms()) {
-    const TruthGrid grid =
-        OneComponentFromTruth(render.truth, label_from_id, Eigen::Vector2i(-7, 31));
+    const TruthGrid grid = OneComponentFromTruth(render.truth, label_from_id,
+                                                 Eigen::Vector2i(-7, 31));
     ASSERT_EQ(grid.corners.size(), 368u);
     const DecodeResult result =
         DecodeBoard(board, grid.corners, grid.components, render.image);
@@ -146,12 +148,14 @@ TEST(DecodeBoard, StrongFisheyeAndSteepTiltDecodeWithoutWrongIds) {
 }
 
 // Every (k+1)x(k+1)-corner window of the render that is fully visible.
-TruthGrid WindowGrid(const RenderTruth& truth, int x0, int y0, int k, std::mt19937* rng) {
-  return OneComponentFromTruth(
-      truth, RandomSignedPermutation(rng), Eigen::Vector2i(11, -4),
-      [=](const Eigen::Vector2i& id) {
-        return id.x() >= x0 && id.x() <= x0 + k && id.y() >= y0 && id.y() <= y0 + k;
-      });
+TruthGrid WindowGrid(const RenderTruth& truth, int x0, int y0, int k,
+                     std::mt19937* rng) {
+  return OneComponentFromTruth(truth, RandomSignedPermutation(rng),
+                               Eigen::Vector2i(11, -4),
+                               [=](const Eigen::Vector2i& id) {
+                                 return id.x() >= x0 && id.x() <= x0 + k &&
+                                        id.y() >= y0 && id.y() <= y0 + k;
+                               });
 }
 
 TEST(DecodeBoard, SmallWindowsOfSixPixelTilesDecodeWithoutWrongIds) {
@@ -160,7 +164,8 @@ TEST(DecodeBoard, SmallWindowsOfSixPixelTilesDecodeWithoutWrongIds) {
   const double tile_px = 6.0;
   const Render render = RenderView(
       board, PinholeCamera(1280, 960, 800),
-      LookAt(board, {135.5, 225.5}, 800 * board.tile_size_m / tile_px, 15, 5), {}, 0.03);
+      LookAt(board, {135.5, 225.5}, 800 * board.tile_size_m / tile_px, 15, 5),
+      {}, 0.03);
   std::mt19937 rng(7);
   for (int k : {3, 4}) {
     int trials = 0, decoded = 0;
@@ -184,8 +189,9 @@ TEST(DecodeBoard, SmallWindowsOfSixPixelTilesDecodeWithoutWrongIds) {
 
 TEST(DecodeBoard, FlippedBitsAreCorrectedOrRefusedNeverWrong) {
   const Board board = MakePuzzleBoard(72, 52, 100, 200, 0.01);
-  const Render render = RenderView(board, PinholeCamera(1280, 960, 800),
-                                   LookAt(board, {135.5, 225.5}, 0.8, 10, 0), {}, 0.0);
+  const Render render =
+      RenderView(board, PinholeCamera(1280, 960, 800),
+                 LookAt(board, {135.5, 225.5}, 0.8, 10, 0), {}, 0.0);
   const DecodeOptions options;
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
@@ -193,13 +199,14 @@ TEST(DecodeBoard, FlippedBitsAreCorrectedOrRefusedNeverWrong) {
     int decoded = 0, trials = 0;
     for (int trial = 0; trial < 60; ++trial) {
       const int k = 7;
-      const TruthGrid grid =
-          WindowGrid(render.truth, 101 + (trial * 7) % 60, 201 + (trial * 5) % 40, k, &rng);
+      const TruthGrid grid = WindowGrid(render.truth, 101 + (trial * 7) % 60,
+                                        201 + (trial * 5) % 40, k, &rng);
       LabelLattice lattice;
       std::string why;
       ASSERT_TRUE(BuildLabelLattice(grid.corners, grid.components[0],
                                     options.max_label_extent, &lattice, &why));
-      EdgeBitReading reading = ReadEdgeBits(lattice, render.image, options.bits);
+      EdgeBitReading reading =
+          ReadEdgeBits(lattice, render.image, options.bits);
       ASSERT_EQ(reading.num_read, 2 * k * (k + 1));
       for (EdgeBit& edge : reading.edges) {
         if (uniform(rng) < flip_rate) edge.confidence = -edge.confidence;
@@ -209,13 +216,15 @@ TEST(DecodeBoard, FlippedBitsAreCorrectedOrRefusedNeverWrong) {
       LabelToBoard map;
       std::vector<char> keep;
       ++trials;
-      if (!DecodeComponentBits(lattice, reading, board, options, &decoding, &map, &keep)) {
+      if (!DecodeComponentBits(lattice, reading, board, options, &decoding,
+                               &map, &keep)) {
         EXPECT_FALSE(decoding.reason.empty());
         continue;
       }
       ++decoded;
       for (size_t p = 0; p < lattice.xy.size(); ++p) {
-        EXPECT_EQ(map.Apply(lattice.label[p]), grid.truth_id[lattice.corner_index[p]]);
+        EXPECT_EQ(map.Apply(lattice.label[p]),
+                  grid.truth_id[lattice.corner_index[p]]);
       }
     }
     // bench_decode: 7x7 windows decode 100 % at 10 % and ~65 % at 20 %.
@@ -247,7 +256,8 @@ TEST(DecodeBoard, OtherCodesMirroredInvertedAndPlainPrintsAreRefused) {
       // Not decoded: relative labels of every corner are still there.
       EXPECT_EQ(result.observation.id.size(), grid.corners.size());
       if (v == 2) {
-        EXPECT_NE(result.reason.find("mirrored"), std::string::npos) << result.reason;
+        EXPECT_NE(result.reason.find("mirrored"), std::string::npos)
+            << result.reason;
         EXPECT_GT(result.components[0].mirrored_agreement, 0.95);
       }
       if (v == 3) {
@@ -261,9 +271,10 @@ TEST(DecodeBoard, OtherCodesMirroredInvertedAndPlainPrintsAreRefused) {
   plain.origin = Eigen::Vector2i::Zero();
   const Render render = RenderView(plain, PinholeCamera(1280, 960, 800),
                                    LookAt(plain, {11, 7.5}, 1.0, 20, 10));
-  TruthGrid grid = OneComponentFromTruth(render.truth, Eigen::Matrix2i::Identity(),
-                                         Eigen::Vector2i(0, 0));
-  const DecodeResult result = DecodeBoard(board, grid.corners, grid.components, render.image);
+  TruthGrid grid = OneComponentFromTruth(
+      render.truth, Eigen::Matrix2i::Identity(), Eigen::Vector2i(0, 0));
+  const DecodeResult result =
+      DecodeBoard(board, grid.corners, grid.components, render.image);
   EXPECT_FALSE(result.decoded);
   EXPECT_NE(result.reason.find("readable"), std::string::npos) << result.reason;
   EXPECT_LT(result.components[0].bits_read, 0.05 * result.components[0].edges);
@@ -285,8 +296,10 @@ TEST(DecodeBoard, ComponentsSplitByAnOccluderAreJoined) {
     both.truth_id.push_back(right.truth_id[k]);
   }
   both.components.push_back(right.components[0]);
-  for (int& index : both.components[1].corner) index += static_cast<int>(left.corners.size());
-  const DecodeResult result = DecodeBoard(board, both.corners, both.components, render.image);
+  for (int& index : both.components[1].corner)
+    index += static_cast<int>(left.corners.size());
+  const DecodeResult result =
+      DecodeBoard(board, both.corners, both.components, render.image);
   ASSERT_TRUE(result.decoded) << result.reason;
   ASSERT_TRUE(result.components[0].decoded) << result.components[0].reason;
   ASSERT_TRUE(result.components[1].decoded) << result.components[1].reason;
@@ -300,8 +313,9 @@ TEST(DecodeBoard, IdsClaimedTwiceAreDropped) {
   const Board board = Board23x16();
   const Render render = FrontView23x16();
   // Two overlapping components: columns <= 62 and >= 58 share 5 columns.
-  TruthGrid a = OneComponentFromTruth(render.truth, Eigen::Matrix2i::Identity(), {0, 0},
-                                      [](const Eigen::Vector2i& id) { return id.x() <= 62; });
+  TruthGrid a = OneComponentFromTruth(
+      render.truth, Eigen::Matrix2i::Identity(), {0, 0},
+      [](const Eigen::Vector2i& id) { return id.x() <= 62; });
   const TruthGrid b = OneComponentFromTruth(
       render.truth, Eigen::Matrix2i::Identity(), {0, 0},
       [](const Eigen::Vector2i& id) { return id.x() >= 58; });
@@ -310,7 +324,8 @@ TEST(DecodeBoard, IdsClaimedTwiceAreDropped) {
   a.truth_id.insert(a.truth_id.end(), b.truth_id.begin(), b.truth_id.end());
   a.components.push_back(b.components[0]);
   for (int& index : a.components[1].corner) index += offset;
-  const DecodeResult result = DecodeBoard(board, a.corners, a.components, render.image);
+  const DecodeResult result =
+      DecodeBoard(board, a.corners, a.components, render.image);
   ASSERT_TRUE(result.decoded) << result.reason;
   std::set<std::pair<int, int>> ids;
   for (const Eigen::Vector2i& id : result.observation.id) {
@@ -331,11 +346,13 @@ TEST(DecodeBoard, MislabelledCornerIsDropped) {
       [](const Eigen::Vector2i& id) { return id != Eigen::Vector2i(57, 108); });
   int slipped = -1;
   for (size_t k = 0; k < grid.corners.size(); ++k) {
-    if (grid.truth_id[k] == Eigen::Vector2i(56, 109)) slipped = static_cast<int>(k);
+    if (grid.truth_id[k] == Eigen::Vector2i(56, 109))
+      slipped = static_cast<int>(k);
   }
   ASSERT_GE(slipped, 0);
   grid.components[0].ij[slipped] = Eigen::Vector2i(57, 108);
-  const DecodeResult result = DecodeBoard(board, grid.corners, grid.components, render.image);
+  const DecodeResult result =
+      DecodeBoard(board, grid.corners, grid.components, render.image);
   ASSERT_TRUE(result.decoded) << result.reason;
   for (size_t k = 0; k < result.observation.id.size(); ++k) {
     EXPECT_NE(result.corner_index[k], slipped) << "mislabelled corner kept";
@@ -346,18 +363,17 @@ TEST(DecodeBoard, MislabelledCornerIsDropped) {
 }
 
 TEST(DecodeBoard, CheckerboardSpanningTheBoardGetsBoardIdsUpToSymmetry) {
-  Board board;
-  board.type = BoardType::kCheckerboard;
-  board.cols = 11;
-  board.rows = 8;
-  board.tile_size_m = 0.02;
+  Board board =
+      MakeBoard(BoardType::kCheckerboard, 11, 8, Eigen::Vector2i::Zero(), 0.02);
   const Render render = RenderView(board, PinholeCamera(1280, 960, 800),
                                    LookAt(board, {5, 3.5}, 0.5, 25, 100));
   std::mt19937 rng(17);
   for (const Eigen::Matrix2i& label_from_id : AllLabelTransforms()) {
-    const TruthGrid grid = OneComponentFromTruth(render.truth, label_from_id, {40, -3});
+    const TruthGrid grid =
+        OneComponentFromTruth(render.truth, label_from_id, {40, -3});
     ASSERT_EQ(grid.corners.size(), 88u);
-    const DecodeResult result = DecodeBoard(board, grid.corners, grid.components, cv::Mat());
+    const DecodeResult result =
+        DecodeBoard(board, grid.corners, grid.components, cv::Mat());
     ASSERT_TRUE(result.decoded) << result.reason;
     EXPECT_TRUE(result.absolute_ids);
     // Either every id is the truth id or every id is its 180-degree twin.
@@ -375,7 +391,8 @@ TEST(DecodeBoard, CheckerboardSpanningTheBoardGetsBoardIdsUpToSymmetry) {
   const TruthGrid partial = OneComponentFromTruth(
       render.truth, LabelRotations(-1)[3], {5, 5},
       [](const Eigen::Vector2i& id) { return id.x() >= 2 && id.y() >= 1; });
-  const DecodeResult result = DecodeBoard(board, partial.corners, partial.components, cv::Mat());
+  const DecodeResult result =
+      DecodeBoard(board, partial.corners, partial.components, cv::Mat());
   EXPECT_FALSE(result.decoded);
   EXPECT_FALSE(result.absolute_ids);
   ASSERT_EQ(result.observation.id.size(), partial.corners.size());
@@ -400,11 +417,14 @@ TEST(DecodeBoard, CheckerboardSpanningTheBoardGetsBoardIdsUpToSymmetry) {
 TEST(DecodeBoard, BadInputGivesReasonsNotCrashes) {
   const Board board = Board23x16();
   const Render render = FrontView23x16();
-  TruthGrid grid = OneComponentFromTruth(render.truth, Eigen::Matrix2i::Identity(), {0, 0});
+  TruthGrid grid =
+      OneComponentFromTruth(render.truth, Eigen::Matrix2i::Identity(), {0, 0});
   // Empty image.
-  DecodeResult result = DecodeBoard(board, grid.corners, grid.components, cv::Mat());
+  DecodeResult result =
+      DecodeBoard(board, grid.corners, grid.components, cv::Mat());
   EXPECT_FALSE(result.decoded);
-  EXPECT_NE(result.reason.find("empty image"), std::string::npos) << result.reason;
+  EXPECT_NE(result.reason.find("empty image"), std::string::npos)
+      << result.reason;
   // No components.
   result = DecodeBoard(board, grid.corners, {}, render.image);
   EXPECT_FALSE(result.decoded);
@@ -426,8 +446,9 @@ TEST(DecodeBoard, BadInputGivesReasonsNotCrashes) {
   EXPECT_EQ(WrongIds(result, broken), 0);
   EXPECT_LE(result.observation.id.size(), grid.corners.size() - 6);
   // A single row of corners has no second lattice direction.
-  TruthGrid row = OneComponentFromTruth(render.truth, Eigen::Matrix2i::Identity(), {0, 0},
-                                        [](const Eigen::Vector2i& id) { return id.y() == 104; });
+  TruthGrid row = OneComponentFromTruth(
+      render.truth, Eigen::Matrix2i::Identity(), {0, 0},
+      [](const Eigen::Vector2i& id) { return id.y() == 104; });
   result = DecodeBoard(board, row.corners, row.components, render.image);
   EXPECT_FALSE(result.decoded);
   EXPECT_FALSE(result.components[0].reason.empty());
@@ -443,10 +464,12 @@ TEST(DecodeBoard, SameInputSameOutput) {
   const Board board = Board23x16();
   const Render render = FrontView23x16();
   std::mt19937 rng(3);
-  const TruthGrid grid =
-      OneComponentFromTruth(render.truth, RandomSignedPermutation(&rng), {2, 9});
-  const DecodeResult a = DecodeBoard(board, grid.corners, grid.components, render.image);
-  const DecodeResult b = DecodeBoard(board, grid.corners, grid.components, render.image);
+  const TruthGrid grid = OneComponentFromTruth(
+      render.truth, RandomSignedPermutation(&rng), {2, 9});
+  const DecodeResult a =
+      DecodeBoard(board, grid.corners, grid.components, render.image);
+  const DecodeResult b =
+      DecodeBoard(board, grid.corners, grid.components, render.image);
   ASSERT_EQ(a.observation.id.size(), b.observation.id.size());
   for (size_t k = 0; k < a.observation.id.size(); ++k) {
     EXPECT_EQ(a.observation.id[k], b.observation.id[k]);

@@ -1,10 +1,10 @@
 // DetectCorners -> BuildGrid -> DecodeBoard on sim/ renders: every decoded id
 // must be the truth id of the corner at that position.
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "decode/decoder.h"
 #include "detection/detector.h"
@@ -23,7 +23,7 @@ struct Outcome {
   int decoded_ids = 0;
   int wrong_ids = 0;  // id differs from the nearest truth corner's
   int unmatched = 0;  // no truth corner within `match_px` (a spurious corner)
-  int visible = 0;        // visible truth corners
+  int visible = 0;    // visible truth corners
   std::string reason;
 };
 
@@ -33,13 +33,15 @@ Outcome RunPipeline(const Board& board, const Camera& camera,
                     const Eigen::Isometry3d& cam_from_board,
                     const RenderOptions& render_options, double match_px) {
   RenderTruth truth;
-  const cv::Mat image = RenderBoard(board, camera, cam_from_board, render_options, &truth);
+  const cv::Mat image =
+      RenderBoard(board, camera, cam_from_board, render_options, &truth);
   const std::vector<Corner> corners = DetectCorners(image);
   const std::vector<GridComponent> components = BuildGrid(corners, image);
   const DecodeResult result = DecodeBoard(board, corners, components, image);
   Outcome outcome;
   outcome.reason = result.reason;
-  for (const TruthCorner& c : truth.corners) outcome.visible += c.visible ? 1 : 0;
+  for (const TruthCorner& c : truth.corners)
+    outcome.visible += c.visible ? 1 : 0;
   if (!result.decoded) return outcome;
   for (size_t k = 0; k < result.observation.id.size(); ++k) {
     ++outcome.decoded_ids;
@@ -70,8 +72,9 @@ TEST(EndToEnd, PinholeViewWithOccluderDecodesCorrectly) {
   occluder.center_px = Eigen::Vector2d(640, 480);
   occluder.radius_px = 70;
   options.occluders.push_back(occluder);
-  const Outcome outcome = RunPipeline(board, PinholeCamera(1280, 960, 800),
-                                      LookAt(board, {61, 107.5}, 1.0, 25, 10), options, 8.0);
+  const Outcome outcome =
+      RunPipeline(board, PinholeCamera(1280, 960, 800),
+                  LookAt(board, {61, 107.5}, 1.0, 25, 10), options, 8.0);
   EXPECT_EQ(outcome.wrong_ids, 0);
   EXPECT_EQ(outcome.unmatched, 0);
   EXPECT_GT(outcome.decoded_ids, 0.9 * outcome.visible) << outcome.reason;
@@ -81,9 +84,9 @@ TEST(EndToEnd, FisheyeViewDecodesCorrectly) {
   const Board board = MakePuzzleBoard(23, 16, 50, 100, 0.03);
   RenderOptions options;
   options.noise_sigma = 0.02;
-  const Outcome outcome =
-      RunPipeline(board, FisheyeCamera(1280, 960, 330, -0.02),
-                  LookAt(board, {61, 107.5}, 0.55, 40, 30, {0.12, -0.08}), options, 6.0);
+  const Outcome outcome = RunPipeline(
+      board, FisheyeCamera(1280, 960, 330, -0.02),
+      LookAt(board, {61, 107.5}, 0.55, 40, 30, {0.12, -0.08}), options, 6.0);
   EXPECT_EQ(outcome.wrong_ids, 0);
   EXPECT_EQ(outcome.unmatched, 0);
   EXPECT_GT(outcome.decoded_ids, 0.8 * outcome.visible) << outcome.reason;
@@ -107,8 +110,9 @@ TEST(EndToEnd, MirroredPrintIsRefused) {
   RenderOptions options;
   options.noise_sigma = 0.02;
   options.variant.mirrored = true;
-  const Outcome outcome = RunPipeline(board, PinholeCamera(1280, 960, 800),
-                                      LookAt(board, {61, 107.5}, 1.0, 25, 10), options, 8.0);
+  const Outcome outcome =
+      RunPipeline(board, PinholeCamera(1280, 960, 800),
+                  LookAt(board, {61, 107.5}, 1.0, 25, 10), options, 8.0);
   EXPECT_EQ(outcome.decoded_ids, 0) << "mirrored print accepted";
   EXPECT_FALSE(outcome.reason.empty());
 }

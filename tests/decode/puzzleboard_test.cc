@@ -3,6 +3,8 @@
 
 #include "decode/puzzleboard.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -12,8 +14,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "decode/board.h"
 #include "decode/puzzleboard_codes.h"
@@ -58,11 +58,13 @@ TEST(PuzzleBoardCodes, EmbeddedTablesMatchPublishedCodesFile) {
       const int expected = bits[col] == '1' ? 1 : 0;
       ASSERT_TRUE(bits[col] == '0' || bits[col] == '1') << line;
       if (name[0] == 'A') {
-        EXPECT_EQ(PuzzleBoardCodeABit(row, col), expected) << name << " " << col;
+        EXPECT_EQ(PuzzleBoardCodeABit(row, col), expected)
+            << name << " " << col;
         EXPECT_EQ(kPuzzleBoardCodeA[row][col], bits[col]) << name << " " << col;
       } else {
         ASSERT_EQ(name[0], 'B') << line;
-        EXPECT_EQ(PuzzleBoardCodeBBit(row, col), expected) << name << " " << col;
+        EXPECT_EQ(PuzzleBoardCodeBBit(row, col), expected)
+            << name << " " << col;
         EXPECT_EQ(kPuzzleBoardCodeB[row][col], bits[col]) << name << " " << col;
       }
     }
@@ -147,7 +149,9 @@ Window Rotate90(const Window& w) {
 // 2k(k+1) bits (+1 colour bit when `with_colour`), packed; k <= 5.
 uint64_t Key(const Window& w, bool with_colour) {
   uint64_t key = 0;
-  auto push = [&key](int bit) { key = (key << 1) | static_cast<uint64_t>(bit); };
+  auto push = [&key](int bit) {
+    key = (key << 1) | static_cast<uint64_t>(bit);
+  };
   for (const auto& column : w.v) {
     for (int bit : column) push(bit);
   }
@@ -162,7 +166,8 @@ std::vector<uint64_t> SortedKeys(int k, bool with_colour) {
   std::vector<uint64_t> keys;
   keys.reserve(kN * kN);
   for (int x = 0; x < kN; ++x) {
-    for (int y = 0; y < kN; ++y) keys.push_back(Key(ReadWindow(x, y, k), with_colour));
+    for (int y = 0; y < kN; ++y)
+      keys.push_back(Key(ReadWindow(x, y, k), with_colour));
   }
   std::sort(keys.begin(), keys.end());
   return keys;
@@ -179,7 +184,8 @@ double FractionUniqueUpToRotation(int k, bool with_colour) {
       bool ambiguous = false;
       for (int turn = 1; turn < 4 && !ambiguous; ++turn) {
         w = Rotate90(w);
-        ambiguous = std::binary_search(keys.begin(), keys.end(), Key(w, with_colour));
+        ambiguous =
+            std::binary_search(keys.begin(), keys.end(), Key(w, with_colour));
       }
       if (!ambiguous) ++unique;
     }

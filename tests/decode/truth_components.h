@@ -5,14 +5,13 @@
 // and grid components built from that truth with labels that mimic grid/
 // (an unknown rotation/reflection and offset of the board ids).
 
-#include <cmath>
-#include <functional>
-#include <random>
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
+#include <functional>
 #include <opencv2/core.hpp>
+#include <random>
+#include <vector>
 
 #include "calib/camera_models.h"
 #include "decode/board.h"
@@ -23,14 +22,10 @@
 namespace puzzlecal {
 namespace decode_testing {
 
-inline Board MakePuzzleBoard(int cols, int rows, int x0, int y0, double tile_m) {
-  Board board;
-  board.type = BoardType::kPuzzleBoard;
-  board.cols = cols;
-  board.rows = rows;
-  board.origin = Eigen::Vector2i(x0, y0);
-  board.tile_size_m = tile_m;
-  return board;
+inline Board MakePuzzleBoard(int cols, int rows, int x0, int y0,
+                             double tile_m) {
+  return MakeBoard(BoardType::kPuzzleBoard, cols, rows, Eigen::Vector2i(x0, y0),
+                   tile_m);
 }
 
 inline Camera PinholeCamera(int width, int height, double f) {
@@ -56,10 +51,10 @@ inline Camera FisheyeCamera(int width, int height, double f, double k1 = 0.0) {
 // `distance_m`, with the board tilted by `tilt_deg` about its x axis, turned
 // by `roll_deg` about the optical axis and shifted by `shift_m` in the image
 // plane.
-inline Eigen::Isometry3d LookAt(const Board& board, const Eigen::Vector2d& target_id,
-                                double distance_m, double tilt_deg,
-                                double roll_deg = 0.0,
-                                const Eigen::Vector2d& shift_m = Eigen::Vector2d::Zero()) {
+inline Eigen::Isometry3d LookAt(
+    const Board& board, const Eigen::Vector2d& target_id, double distance_m,
+    double tilt_deg, double roll_deg = 0.0,
+    const Eigen::Vector2d& shift_m = Eigen::Vector2d::Zero()) {
   const double deg = M_PI / 180.0;
   const Eigen::Matrix3d rotation =
       (Eigen::AngleAxisd(roll_deg * deg, Eigen::Vector3d::UnitZ()) *
@@ -112,7 +107,8 @@ inline TruthGrid OneComponentFromTruth(
     if (!c.visible || (keep && !keep(c.id))) continue;
     Corner corner;
     corner.xy = c.xy;
-    if (position_noise_px > 0) corner.xy += Eigen::Vector2d(noise(rng), noise(rng));
+    if (position_noise_px > 0)
+      corner.xy += Eigen::Vector2d(noise(rng), noise(rng));
     grid.components[0].corner.push_back(static_cast<int>(grid.corners.size()));
     grid.components[0].ij.push_back(label_from_id * c.id + label_offset);
     grid.corners.push_back(corner);

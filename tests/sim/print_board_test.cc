@@ -13,13 +13,8 @@ namespace puzzlecal {
 namespace {
 
 Board MediumPuzzleBoard() {
-  Board board;
-  board.type = BoardType::kPuzzleBoard;
-  board.cols = 23;
-  board.rows = 16;
-  board.origin = Eigen::Vector2i(50, 100);
-  board.tile_size_m = 0.03;
-  return board;
+  return MakeBoard(BoardType::kPuzzleBoard, 23, 16, Eigen::Vector2i(50, 100),
+                   0.03);
 }
 
 cv::Mat RenderPng(const Board& board, double dpi) {
@@ -131,11 +126,8 @@ TEST(PrintBoardTest, SvgAndPdfHaveTheExactPhysicalSize) {
 }
 
 TEST(PrintBoardTest, CheckerboardPageHasFullBorderTiles) {
-  Board board;
-  board.type = BoardType::kCheckerboard;
-  board.cols = 11;
-  board.rows = 8;
-  board.tile_size_m = 0.02;
+  Board board =
+      MakeBoard(BoardType::kCheckerboard, 11, 8, Eigen::Vector2i::Zero(), 0.02);
   double w, h;
   PrintedPageSizeMm(board, &w, &h);
   EXPECT_DOUBLE_EQ(w, 240.0);

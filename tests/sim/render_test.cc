@@ -35,12 +35,8 @@ Camera FisheyeCamera() {
 }
 
 Board PuzzleBoard11x8() {
-  Board board;
-  board.type = BoardType::kPuzzleBoard;
-  board.cols = 11;
-  board.rows = 8;
-  board.origin = Eigen::Vector2i(0, 0);
-  board.tile_size_m = 0.06;
+  Board board =
+      MakeBoard(BoardType::kPuzzleBoard, 11, 8, Eigen::Vector2i(0, 0), 0.06);
   return board;
 }
 
@@ -226,11 +222,8 @@ double MaxEdgeIntegralError(const Board& board, const Camera& camera,
 }
 
 Board Checkerboard11x8() {
-  Board board;
-  board.type = BoardType::kCheckerboard;
-  board.cols = 11;
-  board.rows = 8;
-  board.tile_size_m = 0.06;
+  Board board =
+      MakeBoard(BoardType::kCheckerboard, 11, 8, Eigen::Vector2i::Zero(), 0.06);
   return board;
 }
 
