@@ -1,25 +1,27 @@
 // Sub-pixel accuracy of the corner detector against sim/ truth, side by side
 // with cv::cornerSubPix (started from the detector's integer peaks) and
-// cv::findChessboardCornersSB, over blur x noise. Prints JSON.
+// cv::findChessboardCornersSB, over blur x noise; recall per tile size; the
+// error tail (p50/p90/p99) on demo-like PuzzleBoard renders per refinement
+// method. Prints JSON.
 //
 // Usage: bench_detection_accuracy [views_per_cell]
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <string>
-#include <vector>
-
-#include <Eigen/Geometry>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "calib/camera_models.h"
 #include "decode/board.h"
 #include "detection/detector.h"
 #include "sim/render.h"
+#include "sim/scenes.h"
 
 namespace puzzlecal {
 namespace {
@@ -39,8 +41,8 @@ struct ErrorStats {
 };
 
 // Nearest point of `points` to `p`, its distance in *distance; -1 if none.
-int Nearest(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& p,
-            double* distance) {
+int Nearest(const std::vector<Eigen::Vector2d>& points,
+            const Eigen::Vector2d& p, double* distance) {
   int best = -1;
   double best_d = INFINITY;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -52,6 +54,12 @@ int Nearest(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& p
   }
   *distance = best_d;
   return best;
+}
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(q * v.size()))];
 }
 
 std::string Num(double v) {
@@ -77,13 +85,15 @@ int main(int argc, char** argv) {
   board.rows = 8;
   board.tile_size_m = 0.02;
 
-  std::printf("{\n  \"board\": \"checkerboard 11x8 corners\",\n"
-              "  \"views_per_cell\": %d,\n  \"tiles_px\": \"20..60\",\n"
-              "  \"cells\": [\n", views);
+  std::printf(
+      "{\n  \"board\": \"checkerboard 11x8 corners\",\n"
+      "  \"views_per_cell\": %d,\n  \"tiles_px\": \"20..60\",\n"
+      "  \"cells\": [\n",
+      views);
   bool first_cell = true;
   for (double blur : blurs) {
     for (double noise : noises) {
-      ErrorStats ours, centroid, subpix, sb;
+      ErrorStats ours, centroid, gradient, subpix, sb;
       int sb_views = 0;
       for (int v = 0; v < views; ++v) {
         // Tile size 20..60 px, a rotation about the optical axis and a tilt.
@@ -93,8 +103,15 @@ int main(int argc, char** argv) {
         camera.model = CameraModelId::kPinholeRadtan;
         camera.width = static_cast<int>(tile_px * 15);
         camera.height = static_cast<int>(tile_px * 12);
-        camera.params = {fx, fx, camera.width / 2.0 - 0.3,
-                         camera.height / 2.0 + 0.2, 0, 0, 0, 0, 0};
+        camera.params = {fx,
+                         fx,
+                         camera.width / 2.0 - 0.3,
+                         camera.height / 2.0 + 0.2,
+                         0,
+                         0,
+                         0,
+                         0,
+                         0};
         const double z = fx * board.tile_size_m / tile_px;
         Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
         const Eigen::Matrix3d rotation =
@@ -106,7 +123,8 @@ int main(int argc, char** argv) {
                                      (board.rows - 1) * 0.5 * board.tile_size_m,
                                      0.0);
         cam_from_board.linear() = rotation;
-        cam_from_board.translation() = Eigen::Vector3d(0, 0, z) - rotation * centre;
+        cam_from_board.translation() =
+            Eigen::Vector3d(0, 0, z) - rotation * centre;
         RenderOptions render;
         render.blur_sigma_px = blur;
         render.noise_sigma = noise;
@@ -131,13 +149,21 @@ int main(int argc, char** argv) {
         };
         DetectorOptions options;
         std::vector<Eigen::Vector2d> found;
-        for (const Corner& c : DetectCorners(image, options)) found.push_back(c.xy);
+        for (const Corner& c : DetectCorners(image, options))
+          found.push_back(c.xy);
         score(found, &ours);
 
         options.subpixel = SubpixelMethod::kCentroid;
         found.clear();
-        for (const Corner& c : DetectCorners(image, options)) found.push_back(c.xy);
+        for (const Corner& c : DetectCorners(image, options))
+          found.push_back(c.xy);
         score(found, &centroid);
+
+        options.subpixel = SubpixelMethod::kGradientOrthogonality;
+        found.clear();
+        for (const Corner& c : DetectCorners(image, options))
+          found.push_back(c.xy);
+        score(found, &gradient);
 
         // cornerSubPix from the detector's integer peaks, the window size the
         // detector picks (half the tile, at most 12 px).
@@ -150,13 +176,12 @@ int main(int argc, char** argv) {
           }
         }
         if (!start.empty()) {
-          const int window = std::clamp(
-              static_cast<int>(std::floor(0.5 * tile_px)), 2, 12);
-          cv::cornerSubPix(image, start, cv::Size(window, window),
-                           cv::Size(-1, -1),
-                           cv::TermCriteria(cv::TermCriteria::EPS +
-                                                cv::TermCriteria::COUNT,
-                                            50, 0.001));
+          const int window =
+              std::clamp(static_cast<int>(std::floor(0.5 * tile_px)), 2, 12);
+          cv::cornerSubPix(
+              image, start, cv::Size(window, window), cv::Size(-1, -1),
+              cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
+                               50, 0.001));
         }
         found.clear();
         for (const cv::Point2f& p : start) found.emplace_back(p.x, p.y);
@@ -172,15 +197,17 @@ int main(int argc, char** argv) {
           score(found, &sb);
         }
       }
-      std::printf("%s    {\"blur_px\": %.1f, \"noise\": %.2f, "
-                  "\"ours_rms_px\": %s, \"ours_recall\": %s, "
-                  "\"thesis_centroid_rms_px\": %s, "
-                  "\"cornersubpix_rms_px\": %s, \"sb_rms_px\": %s, "
-                  "\"sb_views_found\": %d, \"views\": %d}",
-                  first_cell ? "" : ",\n", blur, noise, Num(ours.Rms()).c_str(),
-                  Num(ours.Recall()).c_str(), Num(centroid.Rms()).c_str(),
-                  Num(subpix.Rms()).c_str(), Num(sb.Rms()).c_str(), sb_views,
-                  views);
+      std::printf(
+          "%s    {\"blur_px\": %.1f, \"noise\": %.2f, "
+          "\"ours_rms_px\": %s, \"ours_recall\": %s, "
+          "\"thesis_centroid_rms_px\": %s, "
+          "\"gradient_orthogonality_rms_px\": %s, "
+          "\"cornersubpix_rms_px\": %s, \"sb_rms_px\": %s, "
+          "\"sb_views_found\": %d, \"views\": %d}",
+          first_cell ? "" : ",\n", blur, noise, Num(ours.Rms()).c_str(),
+          Num(ours.Recall()).c_str(), Num(centroid.Rms()).c_str(),
+          Num(gradient.Rms()).c_str(), Num(subpix.Rms()).c_str(),
+          Num(sb.Rms()).c_str(), sb_views, views);
       std::fflush(stdout);
       first_cell = false;
     }
@@ -197,7 +224,8 @@ int main(int argc, char** argv) {
   puzzle.rows = 8;
   puzzle.tile_size_m = 0.02;
   bool first_tile = true;
-  for (double tile_px : {4.0, 5.0, 6.0, 8.0, 10.0, 15.0, 25.0, 50.0, 100.0, 200.0}) {
+  for (double tile_px :
+       {4.0, 5.0, 6.0, 8.0, 10.0, 15.0, 25.0, 50.0, 100.0, 200.0}) {
     int expected = 0, found = 0, false_on_board = 0;
     for (int v = 0; v < 2; ++v) {
       const double fx = 1000.0;
@@ -205,24 +233,28 @@ int main(int argc, char** argv) {
       camera.model = CameraModelId::kPinholeRadtan;
       camera.width = static_cast<int>(tile_px * 15 + 40);
       camera.height = static_cast<int>(tile_px * 12 + 40);
-      camera.params = {fx, fx, camera.width / 2.0, camera.height / 2.0, 0, 0, 0, 0, 0};
+      camera.params = {fx, fx, camera.width / 2.0, camera.height / 2.0, 0, 0, 0,
+                       0,  0};
       const double z = fx * puzzle.tile_size_m / tile_px;
       const Eigen::Matrix3d rotation =
           (Eigen::AngleAxisd(0.3 + 0.5 * v, Eigen::Vector3d::UnitZ()) *
            Eigen::AngleAxisd(0.15, Eigen::Vector3d::UnitX()))
               .toRotationMatrix();
       const Eigen::Vector3d centre((puzzle.cols - 1) * 0.5 * puzzle.tile_size_m,
-                                   (puzzle.rows - 1) * 0.5 * puzzle.tile_size_m, 0);
+                                   (puzzle.rows - 1) * 0.5 * puzzle.tile_size_m,
+                                   0);
       Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
       cam_from_board.linear() = rotation;
-      cam_from_board.translation() = Eigen::Vector3d(0, 0, z) - rotation * centre;
+      cam_from_board.translation() =
+          Eigen::Vector3d(0, 0, z) - rotation * centre;
       RenderOptions render;
       render.blur_sigma_px = 0.8;
       render.noise_sigma = 0.01;
       render.supersampling = tile_px > 60 ? 2 : 4;
       render.seed = 7 + v;
       RenderTruth truth;
-      const cv::Mat image = RenderBoard(puzzle, camera, cam_from_board, render, &truth);
+      const cv::Mat image =
+          RenderBoard(puzzle, camera, cam_from_board, render, &truth);
       if (image.empty()) continue;
       std::vector<Eigen::Vector2d> truth_xy, found_xy;
       for (const TruthCorner& t : truth.corners) {
@@ -244,12 +276,110 @@ int main(int argc, char** argv) {
         if (d >= radius && d < 1.5 * tile_px) ++false_on_board;
       }
     }
-    std::printf("%s    {\"tile_px\": %.0f, \"visible\": %d, \"found\": %d, "
-                "\"recall\": %s, \"false_on_board\": %d}",
-                first_tile ? "" : ",\n", tile_px, expected, found,
-                Num(expected ? double(found) / expected : NAN).c_str(),
-                false_on_board);
+    std::printf(
+        "%s    {\"tile_px\": %.0f, \"visible\": %d, \"found\": %d, "
+        "\"recall\": %s, \"false_on_board\": %d}",
+        first_tile ? "" : ",\n", tile_px, expected, found,
+        Num(expected ? double(found) / expected : NAN).c_str(), false_on_board);
     first_tile = false;
+  }
+  std::printf("\n  ],\n");
+
+  // Error tail on demo-like PuzzleBoard renders (the bundled sample set's
+  // recipe: 90-degree wide pinhole with barrel distortion, 23x16 board,
+  // blur 0.8 px, noise 2 %, 16 random views): error against truth per
+  // corner with tiles >= 8 px, per refinement method, and by local tile
+  // size (PuzzleBoard discs start a third of a tile from each corner).
+  SceneSpec scene;
+  scene.name = "sample";
+  scene.camera = WidePinholeCamera(800, 600, 90.0, -0.2);
+  scene.board.type = BoardType::kPuzzleBoard;
+  scene.board.cols = 23;
+  scene.board.rows = 16;
+  scene.board.origin = Eigen::Vector2i(50, 100);
+  scene.board.tile_size_m = 0.03;
+  scene.render.blur_sigma_px = 0.8;
+  scene.render.noise_sigma = 0.02;
+  scene.render.lighting_gradient = 0.2;
+  scene.render.vignetting = 0.2;
+  RandomViews& rv = scene.random_views;
+  rv.count = 16;
+  rv.seed = 5;
+  rv.min_distance_m = 0.35;
+  rv.max_distance_m = 0.8;
+  rv.min_view_angle_deg = 35;
+  rv.max_view_angle_deg = 85;
+  rv.max_roll_deg = 45;
+  rv.max_off_axis_deg = 35;
+  rv.target_margin_tiles = 3;
+  rv.occluders_per_view = 1;
+  rv.min_occluder_radius_px = 20;
+  rv.max_occluder_radius_px = 45;
+  std::string why;
+  const std::vector<SceneView> scene_views = RenderScene(scene, &why);
+  std::printf("  \"puzzleboard_demo_error\": [\n");
+  const std::pair<const char*, SubpixelMethod> methods[] = {
+      {"saddle_fit", SubpixelMethod::kSaddleFit},
+      {"gradient_orthogonality", SubpixelMethod::kGradientOrthogonality},
+      {"thesis_centroid", SubpixelMethod::kCentroid}};
+  bool first_method = true;
+  for (const auto& [method_name, method] : methods) {
+    DetectorOptions options;
+    options.subpixel = method;
+    std::vector<double> errors;
+    std::vector<double> by_tile[4];  // 8-12, 12-16, 16-24, >= 24 px
+    int expected = 0;
+    for (const SceneView& view : scene_views) {
+      std::vector<Eigen::Vector2d> found_xy;
+      for (const Corner& c : DetectCorners(view.image, options)) {
+        found_xy.push_back(c.xy);
+      }
+      const std::vector<TruthCorner>& t = view.truth.corners;
+      for (const TruthCorner& corner : t) {
+        if (!corner.visible || corner.xy.x() < 3 || corner.xy.y() < 3 ||
+            corner.xy.x() > view.image.cols - 4 ||
+            corner.xy.y() > view.image.rows - 4) {
+          continue;
+        }
+        double tile = INFINITY;
+        for (const TruthCorner& other : t) {
+          const Eigen::Vector2i d = other.id - corner.id;
+          if (std::abs(d.x()) + std::abs(d.y()) == 1 &&
+              std::isfinite(other.xy.x())) {
+            tile = std::min(tile, (other.xy - corner.xy).norm());
+          }
+        }
+        if (!(tile >= 8.0)) continue;
+        ++expected;
+        double d;
+        if (Nearest(found_xy, corner.xy, &d) < 0 ||
+            d >= std::max(1.5, std::min(3.0, 0.25 * tile))) {
+          continue;
+        }
+        errors.push_back(d);
+        by_tile[tile < 12 ? 0 : tile < 16 ? 1 : tile < 24 ? 2 : 3].push_back(d);
+      }
+    }
+    std::printf(
+        "%s    {\"method\": \"%s\", \"views\": %d, \"corners\": %d, "
+        "\"found\": %d, \"p50_px\": %s, \"p90_px\": %s, "
+        "\"p99_px\": %s, \"by_tile_px\": [",
+        first_method ? "" : ",\n", method_name,
+        static_cast<int>(scene_views.size()), expected,
+        static_cast<int>(errors.size()), Num(Percentile(errors, 0.5)).c_str(),
+        Num(Percentile(errors, 0.9)).c_str(),
+        Num(Percentile(errors, 0.99)).c_str());
+    const char* bins[] = {"8-12", "12-16", "16-24", ">=24"};
+    for (int b = 0; b < 4; ++b) {
+      std::printf(
+          "%s{\"tile_px\": \"%s\", \"n\": %d, \"p50_px\": %s, "
+          "\"p90_px\": %s}",
+          b ? ", " : "", bins[b], static_cast<int>(by_tile[b].size()),
+          Num(Percentile(by_tile[b], 0.5)).c_str(),
+          Num(Percentile(by_tile[b], 0.9)).c_str());
+    }
+    std::printf("]}");
+    first_method = false;
   }
   std::printf("\n  ]\n}\n");
   return 0;

@@ -10,10 +10,10 @@ bool PassesCornerMask(const cv::Mat& image, int x, int y) {
     return false;
   }
   // The 16 points of the 5x5 ring in angular order, starting at (2, 0).
-  static const int kRing[16][2] = {{2, 0},   {2, 1},   {2, 2},   {1, 2},
-                                   {0, 2},   {-1, 2},  {-2, 2},  {-2, 1},
-                                   {-2, 0},  {-2, -1}, {-2, -2}, {-1, -2},
-                                   {0, -2},  {1, -2},  {2, -2},  {2, -1}};
+  static const int kRing[16][2] = {{2, 0},  {2, 1},   {2, 2},   {1, 2},
+                                   {0, 2},  {-1, 2},  {-2, 2},  {-2, 1},
+                                   {-2, 0}, {-2, -1}, {-2, -2}, {-1, -2},
+                                   {0, -2}, {1, -2},  {2, -2},  {2, -1}};
   float v[16];
   for (int i = 0; i < 16; ++i) {
     v[i] = image.ptr<float>(y + kRing[i][1])[x + kRing[i][0]];
@@ -32,8 +32,8 @@ bool PassesCornerMask(const cv::Mat& image, int x, int y) {
   return junction > edge;
 }
 
-RingMeasure MeasureRing(const cv::Mat& image, double x, double y,
-                        double radius, int samples) {
+RingMeasure MeasureRing(const cv::Mat& image, double x, double y, double radius,
+                        int samples) {
   RingMeasure m;
   samples = std::clamp(samples / 4 * 4, 8, 64);
   if (!(x - radius >= 0.0 && y - radius >= 0.0 &&
@@ -74,6 +74,10 @@ RingMeasure MeasureRing(const cv::Mat& image, double x, double y,
   // Second-harmonic amplitude of the symmetric part (cos 2a, sin 2a).
   const double amplitude = 2.0 * std::hypot(re2, im2) / half;
   m.contrast = 2.0 * amplitude;
+  m.centre_offset =
+      m.contrast > 0.0
+          ? std::abs(SampleBilinear(image, x, y) - mean) / m.contrast
+          : 1e9;
   m.asymmetry = even_energy > 0.0 ? std::sqrt(odd_energy / even_energy) : 1e9;
   m.second_harmonic_share =
       even_energy > 0.0 ? 0.5 * amplitude * amplitude / (even_energy / half)

@@ -29,16 +29,20 @@ inline float SampleBilinear(const cv::Mat& image, double x, double y) {
 
 // Measurements of the grey values on a circle around a candidate.
 struct RingMeasure {
-  bool inside = false;      // the ring fitted into the image
-  double contrast = 0.0;    // peak-to-peak amplitude of the 2nd harmonic
-  double asymmetry = 0.0;   // rms(antisymmetric) / rms(symmetric part)
+  bool inside = false;     // the ring fitted into the image
+  double contrast = 0.0;   // peak-to-peak amplitude of the 2nd harmonic
+  double asymmetry = 0.0;  // rms(antisymmetric) / rms(symmetric part)
   double second_harmonic_share = 0.0;  // of the symmetric part's energy
+  // |grey at the centre - ring mean| / contrast: 0 at a checkerboard corner
+  // (point symmetry puts the centre half-way between dark and bright), large
+  // in a bright or dark tile between two structures of the other colour.
+  double centre_offset = 0.0;
 };
 
 // Samples `samples` (a multiple of 4, at most 64) points on the circle of
 // `radius` around (x, y) of `image` (CV_32FC1, bilinear).
-RingMeasure MeasureRing(const cv::Mat& image, double x, double y,
-                        double radius, int samples);
+RingMeasure MeasureRing(const cv::Mat& image, double x, double y, double radius,
+                        int samples);
 
 }  // namespace puzzlecal
 

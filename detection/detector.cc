@@ -1,13 +1,12 @@
 #include "detection/detector.h"
 
 #include <algorithm>
-#include <ctime>
 #include <cmath>
+#include <ctime>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <unordered_map>
-
-#include <opencv2/imgproc.hpp>
 
 #include "detection/corner_filters.h"
 #include "detection/hessian_response.h"
@@ -45,23 +44,43 @@ bool DetectorOptions::Check(std::string* why) const {
   if (ring_samples < 8 || ring_samples > 64 || ring_samples % 4 != 0) {
     return fail("ring_samples must be a multiple of 4 in [8, 64]");
   }
-  if (!(min_ring_contrast >= 0.0)) return fail("min_ring_contrast must be >= 0");
-  if (!(max_ring_asymmetry > 0.0)) return fail("max_ring_asymmetry must be > 0");
+  if (!(min_ring_contrast >= 0.0))
+    return fail("min_ring_contrast must be >= 0");
+  if (!(max_ring_asymmetry > 0.0))
+    return fail("max_ring_asymmetry must be > 0");
   if (!(min_ring_second_harmonic >= 0.0 && min_ring_second_harmonic <= 1.0)) {
     return fail("min_ring_second_harmonic must be in [0, 1]");
   }
-  if (!(window_fraction_of_neighbor > 0.0 && window_fraction_of_neighbor <= 1.0)) {
+  if (!(ring_noise_factor >= 0.0 && std::isfinite(ring_noise_factor))) {
+    return fail("ring_noise_factor must be >= 0");
+  }
+  if (!(max_ring_centre_offset > 0.0)) {
+    return fail("max_ring_centre_offset must be > 0");
+  }
+  if (!(window_fraction_of_neighbor > 0.0 &&
+        window_fraction_of_neighbor <= 1.0)) {
     return fail("window_fraction_of_neighbor must be in (0, 1]");
   }
-  if (min_window_px < 2 || max_window_px > 64 || min_window_px > max_window_px) {
+  if (min_window_px < 2 || max_window_px > 64 ||
+      min_window_px > max_window_px) {
     return fail("need 2 <= min_window_px <= max_window_px <= 64");
+  }
+  if (!(saddle_sigma_fraction > 0.0 && saddle_sigma_fraction <= 1.0)) {
+    return fail("saddle_sigma_fraction must be in (0, 1]");
+  }
+  if (!(min_saddle_sigma_px >= 0.5 &&
+        min_saddle_sigma_px <= max_saddle_sigma_px &&
+        max_saddle_sigma_px <= 16.0)) {
+    return fail("need 0.5 <= min_saddle_sigma_px <= max_saddle_sigma_px <= 16");
   }
   if (max_iterations < 1 || max_iterations > 100) {
     return fail("max_iterations must be in [1, 100]");
   }
   if (!(convergence_px > 0.0)) return fail("convergence_px must be > 0");
-  if (!(max_shift_fraction > 0.0)) return fail("max_shift_fraction must be > 0");
-  if (!(merge_distance_px >= 0.0)) return fail("merge_distance_px must be >= 0");
+  if (!(max_shift_fraction > 0.0))
+    return fail("max_shift_fraction must be > 0");
+  if (!(merge_distance_px >= 0.0))
+    return fail("merge_distance_px must be >= 0");
   if (!(orientation_spacing_fraction > 0.0)) {
     return fail("orientation_spacing_fraction must be > 0");
   }
@@ -96,14 +115,16 @@ struct Workspace {
 // Picks the one-channel, finite version of the input and the grey value
 // that maps to 1.0. Returns false with a reason for unsupported types.
 bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
-                  const cv::Mat** single, double* normalizer, std::string* why) {
+                  const cv::Mat** single, double* normalizer,
+                  std::string* why) {
   if (image.channels() == 1) {
     *single = &image;
   } else if ((image.channels() == 3 || image.channels() == 4) &&
              (image.depth() == CV_8U || image.depth() == CV_16U ||
               image.depth() == CV_32F)) {
-    cv::cvtColor(image, ws->single,
-                 image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+    cv::cvtColor(
+        image, ws->single,
+        image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
     *single = &ws->single;
   } else {
     *why = "unsupported number of channels";
@@ -145,6 +166,46 @@ bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
   return true;
 }
 
+// Robust standard deviation of the pixel noise of `image` (one channel):
+// 1.4826 times the median absolute difference between a pixel and the mean
+// of its four neighbours (scaled to unit gain for white noise), sampled
+// every `step` pixels. Edges and corners are a small share of the samples.
+template <typename Pixel>
+double NoiseSigmaOf(const cv::Mat& image, int step,
+                    std::vector<float>* scratch) {
+  scratch->clear();
+  for (int y = 1 + step / 2; y < image.rows - 1; y += step) {
+    const Pixel* up = image.ptr<Pixel>(y - 1);
+    const Pixel* row = image.ptr<Pixel>(y);
+    const Pixel* down = image.ptr<Pixel>(y + 1);
+    for (int x = 1 + step / 2; x < image.cols - 1; x += step) {
+      scratch->push_back(std::abs(
+          static_cast<float>(row[x]) -
+          0.25f *
+              (static_cast<float>(row[x - 1]) + static_cast<float>(row[x + 1]) +
+               static_cast<float>(up[x]) + static_cast<float>(down[x]))));
+    }
+  }
+  if (scratch->empty()) return 0.0;
+  auto middle = scratch->begin() + scratch->size() / 2;
+  std::nth_element(scratch->begin(), middle, scratch->end());
+  // For white noise of sigma n the difference has sigma n sqrt(1.25).
+  return 1.4826 * *middle / std::sqrt(1.25);
+}
+
+double NoiseSigma(const cv::Mat& image, int step, std::vector<float>* scratch) {
+  switch (image.depth()) {
+    case CV_8U:
+      return NoiseSigmaOf<uint8_t>(image, step, scratch);
+    case CV_16U:
+      return NoiseSigmaOf<uint16_t>(image, step, scratch);
+    case CV_32F:
+      return NoiseSigmaOf<float>(image, step, scratch);
+    default:
+      return 0.0;
+  }
+}
+
 // A verified candidate in full-resolution pixels.
 struct Candidate {
   Eigen::Vector2d xy;  // full-resolution position (before refinement)
@@ -181,9 +242,7 @@ class PointGrid {
   }
 
  private:
-  int CellOf(double v) const {
-    return static_cast<int>(std::floor(v / cell_));
-  }
+  int CellOf(double v) const { return static_cast<int>(std::floor(v / cell_)); }
   int64_t Key(const Eigen::Vector2d& p) const {
     return static_cast<int64_t>(CellOf(p.y())) * (cols_ + 2) + CellOf(p.x());
   }
@@ -251,13 +310,19 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
   }
   int levels = 1;
   for (int l = 1; l < options.num_levels; ++l) {
-    if (blurred[l - 1].cols < 2 * kMinSide || blurred[l - 1].rows < 2 * kMinSide) {
+    if (blurred[l - 1].cols < 2 * kMinSide ||
+        blurred[l - 1].rows < 2 * kMinSide) {
       break;
     }
     cv::pyrDown(blurred[l - 1], blurred[l], cv::Size(), cv::BORDER_REPLICATE);
     levels = l + 1;
   }
   s.levels_used = std::max(0, levels - options.first_level);
+  // Pixel noise of the input, grey normalised to [0, 1].
+  const double noise = options.ring_noise_factor > 0.0
+                           ? NoiseSigma(*single, 7, &ws.scratch) / s.normalizer
+                           : 0.0;
+  s.noise_sigma = noise;
   s.ms_preprocess = MsSince(t);
 
   // --- per level: response, threshold, NMS, filters ---
@@ -267,8 +332,8 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
   std::vector<ResponsePeak> peaks;
   for (int l = options.first_level; l < levels; ++l) {
     t = Clock::now();
-    ComputeSaddleResponse(blurred[l], static_cast<float>(options.trace_weight_k),
-                          &response);
+    ComputeSaddleResponse(
+        blurred[l], static_cast<float>(options.trace_weight_k), &response);
     s.ms_response += MsSince(t);
 
     t = Clock::now();
@@ -280,14 +345,16 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
     }
     if (l == options.first_level) s.threshold = threshold;
     peaks.clear();
-    s.candidates += FindResponsePeaks(response,
-                                      static_cast<float>(threshold * threshold),
-                                      options.nms_radius_px, &peaks);
+    s.candidates +=
+        FindResponsePeaks(response, static_cast<float>(threshold * threshold),
+                          options.nms_radius_px, &peaks);
     s.after_nms += static_cast<int>(peaks.size());
     s.ms_nms += MsSince(t);
 
     t = Clock::now();
     const double scale = std::ldexp(1.0, l);
+    const double min_contrast =
+        std::max(options.min_ring_contrast, options.ring_noise_factor * noise);
     for (const ResponsePeak& peak : peaks) {
       if (options.use_corner_mask &&
           !PassesCornerMask(blurred[l], peak.x, peak.y)) {
@@ -298,9 +365,10 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
         const RingMeasure ring =
             MeasureRing(blurred[l], peak.x, peak.y, options.ring_radius_px,
                         options.ring_samples);
-        if (!ring.inside || ring.contrast < options.min_ring_contrast ||
+        if (!ring.inside || ring.contrast < min_contrast ||
             ring.asymmetry > options.max_ring_asymmetry ||
-            ring.second_harmonic_share < options.min_ring_second_harmonic) {
+            ring.second_harmonic_share < options.min_ring_second_harmonic ||
+            ring.centre_offset > options.max_ring_centre_offset) {
           continue;
         }
       }
@@ -325,8 +393,7 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
   {
     PointGrid grid(8.0 * options.nms_radius_px, image.cols, image.rows);
     for (const Candidate& c : candidates) {  // already ordered by level
-      const double radius =
-          std::ldexp(1.0, c.level) * options.nms_radius_px;
+      const double radius = std::ldexp(1.0, c.level) * options.nms_radius_px;
       bool taken = false;
       grid.ForNear(c.xy, radius, [&](int index) {
         if ((merged[index].xy - c.xy).norm() <= radius) taken = true;
@@ -364,7 +431,8 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
     // Near the image border the window shrinks instead of failing.
     const int room = static_cast<int>(std::floor(std::min(
                          {c.xy.x(), c.xy.y(), image.cols - 1.0 - c.xy.x(),
-                          image.rows - 1.0 - c.xy.y()}))) - 2;
+                          image.rows - 1.0 - c.xy.y()}))) -
+                     2;
     window = std::max(options.min_window_px, std::min(window, room));
     Corner corner;
     corner.xy = c.xy;
@@ -373,9 +441,28 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
       const GradientRefineResult r = RefineByGradientOrthogonality(
           blurred[0], c.xy, window, options.max_iterations,
           options.convergence_px);
-      if (!r.ok || (r.xy - c.xy).norm() >
-                       options.max_shift_fraction * window +
-                           std::ldexp(0.5, c.level)) {
+      if (!r.ok || (r.xy - c.xy).norm() > options.max_shift_fraction * window +
+                                              std::ldexp(0.5, c.level)) {
+        ++s.refine_failed;
+        continue;
+      }
+      corner.xy = r.xy;
+    } else if (options.subpixel == SubpixelMethod::kSaddleFit) {
+      double sigma = options.max_saddle_sigma_px;
+      if (std::isfinite(nearest)) {
+        sigma = options.saddle_sigma_fraction * nearest;
+      }
+      sigma = std::clamp(sigma, options.min_saddle_sigma_px,
+                         options.max_saddle_sigma_px);
+      // Near the image border the window shrinks instead of failing.
+      sigma = std::max(options.min_saddle_sigma_px,
+                       std::min(sigma, (room + 1.0) / 3.0));
+      // On the input grey values: the detector's blur would carry the
+      // structures around a corner (PuzzleBoard discs) closer to it.
+      const SaddleRefineResult r = RefineBySaddleFit(
+          *single, c.xy, sigma, options.max_iterations, options.convergence_px,
+          options.max_shift_fraction * window + std::ldexp(0.5, c.level));
+      if (!r.ok) {
         ++s.refine_failed;
         continue;
       }

@@ -20,10 +20,9 @@
 //     positive eigenvalue: along the diagonal through the bright tiles), in
 //     (-pi/2, pi/2] since an eigenvector has no sign.
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "detection/corner.h"
 
@@ -32,7 +31,8 @@ namespace puzzlecal {
 enum class SubpixelMethod {
   kNone,      // integer peak positions (at the detection level, scaled)
   kCentroid,  // the thesis: squared-response centroid over the 3x3 peak
-  kGradientOrthogonality,  // edge-gradient least squares, iterated (default)
+  kGradientOrthogonality,  // edge-gradient least squares, iterated
+  kSaddleFit,  // quadratic fit of the grey values, Gaussian window (default)
 };
 
 struct DetectorOptions {
@@ -89,9 +89,17 @@ struct DetectorOptions {
   // Minimum share of the symmetric ring energy in the second harmonic (0.81
   // for an ideal square-wave corner, lower for blobs and lines). In [0, 1].
   double min_ring_second_harmonic = 0.5;
+  // Maximum |centre grey - ring mean| / ring contrast (0 at a corner). Drops
+  // saddle-like spots inside a tile between two PuzzleBoard discs. > 0.
+  double max_ring_centre_offset = 0.35;
+  // The ring contrast must also exceed this multiple of the pixel noise of
+  // the input (robust estimate from differences to the 4-neighbour mean,
+  // grey normalised like the image): faint saddle-shaped noise inside
+  // bright tiles stays out. >= 0; 0 off.
+  double ring_noise_factor = 2.0;
 
   // --- sub-pixel refinement (always at full resolution) ---
-  SubpixelMethod subpixel = SubpixelMethod::kGradientOrthogonality;
+  SubpixelMethod subpixel = SubpixelMethod::kSaddleFit;
   // Half-size of the refinement window as a fraction of the distance to the
   // nearest other corner (a tile edge); clamped to the two bounds below. > 0.
   double window_fraction_of_neighbor = 0.3;
@@ -99,6 +107,15 @@ struct DetectorOptions {
   // also used for a corner without neighbours. 2 <= min <= max <= 64.
   int min_window_px = 4;
   int max_window_px = 12;
+  // Saddle fit (on the input grey values, not the blurred ones): standard
+  // deviation of its Gaussian window as a fraction of the distance to the
+  // nearest other corner, in (0, 1], clamped to the two bounds below
+  // (full-resolution pixels, 0.5 <= min <= max <= 16). PuzzleBoard discs
+  // start a third of a tile from the corner: above about 0.14 their
+  // Gaussian tail pulls the fit by tenths of a pixel.
+  double saddle_sigma_fraction = 0.13;
+  double min_saddle_sigma_px = 0.7;
+  double max_saddle_sigma_px = 6.0;
   // Newton iterations of the gradient-orthogonality fixed point. >= 1.
   int max_iterations = 6;
   // Stop when the update is shorter than this (pixels). > 0.
@@ -127,17 +144,18 @@ struct DetectorSummary {
   std::string message;  // why not, when !ok
   int width = 0;
   int height = 0;
-  int levels_used = 0;        // pyramid levels searched
-  double normalizer = 0.0;    // grey value mapped to 1.0
-  double threshold = 0.0;     // response threshold of level `first_level`
-  int candidates = 0;         // pixels above threshold, all levels
-  int after_nms = 0;          // local maxima
-  int after_mask = 0;         // passed the thesis corner mask
-  int after_ring = 0;         // passed the ring test
-  int after_merge_levels = 0; // after merging detections of several levels
-  int refine_failed = 0;      // dropped because refinement diverged
-  int merged_duplicates = 0;  // dropped as duplicates after refinement
-  int corners = 0;            // returned
+  int levels_used = 0;         // pyramid levels searched
+  double normalizer = 0.0;     // grey value mapped to 1.0
+  double threshold = 0.0;      // response threshold of level `first_level`
+  double noise_sigma = 0.0;    // estimated pixel noise (grey in [0, 1])
+  int candidates = 0;          // pixels above threshold, all levels
+  int after_nms = 0;           // local maxima
+  int after_mask = 0;          // passed the thesis corner mask
+  int after_ring = 0;          // passed the ring test
+  int after_merge_levels = 0;  // after merging detections of several levels
+  int refine_failed = 0;       // dropped because refinement diverged
+  int merged_duplicates = 0;   // dropped as duplicates after refinement
+  int corners = 0;             // returned
   // CPU time of the calling thread per stage, milliseconds (work done inside
   // OpenCV's own worker threads, if enabled, is not counted).
   double ms_preprocess = 0.0;  // conversion, normalisation, blur, pyramid

@@ -3,9 +3,8 @@
 
 // The thesis's Hessian saddle response on one (blurred) image level.
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace puzzlecal {
 

@@ -1,10 +1,10 @@
 #include "detection/subpixel.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <vector>
-
-#include <Eigen/LU>
 
 #include "detection/corner_filters.h"
 
@@ -20,8 +20,8 @@ class GradientPatch {
   // not fit into the image (with one pixel for the differences).
   bool Fill(const cv::Mat& image, int cx, int cy, int radius) {
     // Shrink (down to `radius - 3`) to stay inside the image.
-    const int room = std::min({cx - 1, cy - 1, image.cols - 2 - cx,
-                               image.rows - 2 - cy});
+    const int room =
+        std::min({cx - 1, cy - 1, image.cols - 2 - cx, image.rows - 2 - cy});
     radius = std::max(std::min(radius, room), radius - 3);
     if (cx - radius < 1 || cy - radius < 1 || cx + radius > image.cols - 2 ||
         cy + radius > image.rows - 2) {
@@ -65,7 +65,8 @@ class GradientPatch {
   // do not jump, yet broad enough to use the straight edge arms): returns
   // the point minimising sum w g g^T (q - x) over x. False when the system
   // is ill-conditioned (fewer than two edge directions).
-  bool Solve(const Eigen::Vector2d& p, double h, Eigen::Vector2d* solution) const {
+  bool Solve(const Eigen::Vector2d& p, double h,
+             Eigen::Vector2d* solution) const {
     // Float sums in kLanes independent lanes so the loop vectorises; the
     // rounding error is far below 0.001 px for windows up to 64 px.
     const float inv_h2 = static_cast<float>(1.0 / (h * h));
@@ -125,9 +126,11 @@ class GradientPatch {
 };
 }  // namespace
 
-GradientRefineResult RefineByGradientOrthogonality(
-    const cv::Mat& image, const Eigen::Vector2d& start, int half_window,
-    int max_iterations, double convergence_px) {
+GradientRefineResult RefineByGradientOrthogonality(const cv::Mat& image,
+                                                   const Eigen::Vector2d& start,
+                                                   int half_window,
+                                                   int max_iterations,
+                                                   double convergence_px) {
   GradientRefineResult result;
   result.xy = start;
   if (!std::isfinite(start.x()) || !std::isfinite(start.y()) ||
@@ -187,6 +190,141 @@ GradientRefineResult RefineByGradientOrthogonality(
   return result;
 }
 
+namespace {
+
+// Moments of one window of the saddle fit: the weights are a separable
+// Gaussian on a square window, so the normal matrix is a product of 1-D
+// moments and only the right-hand side touches the pixels.
+template <typename Pixel>
+bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
+                int radius, Eigen::Vector2d* step) {
+  const int cx = static_cast<int>(std::lround(p.x()));
+  const int cy = static_cast<int>(std::lround(p.y()));
+  if (cx - radius < 0 || cy - radius < 0 || cx + radius >= image.cols ||
+      cy + radius >= image.rows) {
+    return false;
+  }
+  constexpr int kMaxSide = 2 * 48 + 1;
+  const int side = 2 * radius + 1;
+  // 1-D weights and powers of the coordinates relative to p, in units of
+  // sigma: wx[i] * u^k for k = 0..2 (and up to 4 for the normal matrix).
+  float wu[3][kMaxSide], wv[3][kMaxSide];
+  double mu[5] = {}, mv[5] = {};
+  const double inv_s = 1.0 / sigma;
+  for (int i = 0; i < side; ++i) {
+    const double u = (cx - radius + i - p.x()) * inv_s;
+    const double v = (cy - radius + i - p.y()) * inv_s;
+    // Gaussian tapered smoothly to zero at 3 sigma from p, so the window is
+    // symmetric about p whatever its sub-pixel offset.
+    const double tu = std::max(0.0, 1.0 - u * u * (1.0 / 9.0));
+    const double tv = std::max(0.0, 1.0 - v * v * (1.0 / 9.0));
+    const double w_u = std::exp(-0.5 * u * u) * tu * tu;
+    const double w_v = std::exp(-0.5 * v * v) * tv * tv;
+    wu[0][i] = static_cast<float>(w_u);
+    wu[1][i] = static_cast<float>(w_u * u);
+    wu[2][i] = static_cast<float>(w_u * u * u);
+    wv[0][i] = static_cast<float>(w_v);
+    wv[1][i] = static_cast<float>(w_v * v);
+    wv[2][i] = static_cast<float>(w_v * v * v);
+    double pu = w_u, pv = w_v;
+    for (int k = 0; k < 5; ++k) {
+      mu[k] += pu;
+      mv[k] += pv;
+      pu *= u;
+      pv *= v;
+    }
+  }
+  // Right-hand side: sum w u^a v^b I for (a, b) in the basis
+  // 1, u, v, u^2, u v, v^2.
+  double r00 = 0, r10 = 0, r01 = 0, r20 = 0, r11 = 0, r02 = 0;
+  for (int j = 0; j < side; ++j) {
+    const Pixel* row = image.ptr<Pixel>(cy - radius + j) + (cx - radius);
+    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+    for (int i = 0; i < side; ++i) {
+      const float value = static_cast<float>(row[i]);
+      s0 += wu[0][i] * value;
+      s1 += wu[1][i] * value;
+      s2 += wu[2][i] * value;
+    }
+    r00 += wv[0][j] * s0;
+    r10 += wv[0][j] * s1;
+    r20 += wv[0][j] * s2;
+    r01 += wv[1][j] * s0;
+    r11 += wv[1][j] * s1;
+    r02 += wv[2][j] * s0;
+  }
+  // Normal matrix: entry (A, B) = mu[a_A + a_B] * mv[b_A + b_B].
+  static const int kPowU[6] = {0, 1, 0, 2, 1, 0};
+  static const int kPowV[6] = {0, 0, 1, 0, 1, 2};
+  Eigen::Matrix<double, 6, 6> normal;
+  for (int a = 0; a < 6; ++a) {
+    for (int b = 0; b < 6; ++b) {
+      normal(a, b) = mu[kPowU[a] + kPowU[b]] * mv[kPowV[a] + kPowV[b]];
+    }
+  }
+  Eigen::Matrix<double, 6, 1> right;
+  right << r00, r10, r01, r20, r11, r02;
+  const Eigen::Matrix<double, 6, 1> q = normal.ldlt().solve(right);
+  // Gradient (q1, q2) and Hessian [[2 q3, q4], [q4, 2 q5]] at p.
+  const double hxx = 2.0 * q[3], hxy = q[4], hyy = 2.0 * q[5];
+  const double det = hxx * hyy - hxy * hxy;
+  // A saddle has an indefinite Hessian; a near-degenerate one (a ridge or
+  // an edge) gives no stable stationary point.
+  if (!(det < -0.05 * (hxx * hxx + hyy * hyy + 2.0 * hxy * hxy))) {
+    return false;
+  }
+  *step = sigma * Eigen::Vector2d((-hyy * q[1] + hxy * q[2]) / det,
+                                  (hxy * q[1] - hxx * q[2]) / det);
+  return std::isfinite(step->x()) && std::isfinite(step->y());
+}
+
+}  // namespace
+
+SaddleRefineResult RefineBySaddleFit(const cv::Mat& image,
+                                     const Eigen::Vector2d& start,
+                                     double sigma_px, int max_iterations,
+                                     double convergence_px,
+                                     double max_shift_px) {
+  SaddleRefineResult result;
+  result.xy = start;
+  if (!std::isfinite(start.x()) || !std::isfinite(start.y()) ||
+      !(sigma_px > 0.0) || std::abs(start.x()) > 1e6 ||
+      std::abs(start.y()) > 1e6) {
+    return result;
+  }
+  sigma_px = std::min(sigma_px, 16.0);
+  const int radius = static_cast<int>(std::ceil(3.0 * sigma_px));
+  Eigen::Vector2d p = start;
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
+    result.iterations = iteration + 1;
+    Eigen::Vector2d step;
+    bool ok = false;
+    switch (image.depth()) {
+      case CV_8U:
+        ok = SaddleStep<uint8_t>(image, p, sigma_px, radius, &step);
+        break;
+      case CV_16U:
+        ok = SaddleStep<uint16_t>(image, p, sigma_px, radius, &step);
+        break;
+      case CV_32F:
+        ok = SaddleStep<float>(image, p, sigma_px, radius, &step);
+        break;
+      default:
+        break;
+    }
+    if (!ok) return result;
+    const double length = step.norm();
+    const double limit = std::max(1.0, sigma_px);
+    if (length > limit) step *= limit / length;
+    p += step;
+    if ((p - start).norm() > max_shift_px) return result;
+    if (length < convergence_px) break;
+  }
+  result.ok = true;
+  result.xy = p;
+  return result;
+}
+
 Eigen::Vector2d CentroidOfSquaredResponse(const cv::Mat& response, int x,
                                           int y) {
   double sum = 0.0, sx = 0.0, sy = 0.0;
@@ -230,7 +368,8 @@ double HessianOrientation(const cv::Mat& image, const Eigen::Vector2d& xy,
   } table;
   double re = 0.0, im = 0.0;
   for (int i = 0; i < kSamples; ++i) {
-    const double v = SampleBilinear(image, x + r * table.c[i], y + r * table.s[i]);
+    const double v =
+        SampleBilinear(image, x + r * table.c[i], y + r * table.s[i]);
     const int twice = (2 * i) % kSamples;
     re += v * table.c[twice];
     im += v * table.s[twice];

@@ -9,7 +9,7 @@
 namespace puzzlecal {
 
 struct GradientRefineResult {
-  bool ok = false;       // converged to a well-conditioned solution
+  bool ok = false;  // converged to a well-conditioned solution
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();
   int iterations = 0;
 };
@@ -23,9 +23,34 @@ struct GradientRefineResult {
 // (blurred). Fails when the window leaves the image, the system is
 // ill-conditioned (fewer than two edge directions) or the estimate leaves
 // the window.
-GradientRefineResult RefineByGradientOrthogonality(
-    const cv::Mat& image, const Eigen::Vector2d& start, int half_window,
-    int max_iterations, double convergence_px);
+GradientRefineResult RefineByGradientOrthogonality(const cv::Mat& image,
+                                                   const Eigen::Vector2d& start,
+                                                   int half_window,
+                                                   int max_iterations,
+                                                   double convergence_px);
+
+struct SaddleRefineResult {
+  bool ok = false;  // converged to a saddle (Hessian of the fit indefinite)
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();
+  int iterations = 0;
+};
+
+// Saddle-point fit: a quadratic a + b x + c y + d x^2 + e x y + f y^2 is
+// fitted in weighted least squares to the grey values around the estimate p
+// (Gaussian weights of standard deviation `sigma_px` centred on p, cut at
+// 2.5 sigma), and p moves to the stationary point of the fit until the step
+// is shorter than `convergence_px`. A checkerboard corner's grey values are
+// point-symmetric about it for any blur, so the fixed point (window centred
+// on its own solution) is the corner whatever the window size; structures
+// further out (PuzzleBoard discs, neighbour corners) enter only through the
+// Gaussian tail. `image` is CV_32FC1. Fails when the window leaves the
+// image, the fit is no saddle (det of its Hessian >= 0 or too weak), or p
+// moves farther than `max_shift_px` from `start`.
+SaddleRefineResult RefineBySaddleFit(const cv::Mat& image,
+                                     const Eigen::Vector2d& start,
+                                     double sigma_px, int max_iterations,
+                                     double convergence_px,
+                                     double max_shift_px);
 
 // The thesis's squared-grey centroid over the 3x3 neighbourhood of the
 // integer peak (x, y) of `response` (CV_32FC1, product form). Returns the
