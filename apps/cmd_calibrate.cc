@@ -90,7 +90,7 @@ std::vector<ReportImage> ReportLines(const std::vector<ImageResult>& images,
     const int v = line.view_index;
     if (v >= 0 && result != nullptr) {
       if (!result->view_used[v]) {
-        line.outcome = "dropped as outlier view";
+        line.outcome = "not used by the calibration";
         line.reason = result->view_reason[v];
       } else {
         for (bool inlier : result->inlier[v]) line.corners_used += inlier;
@@ -214,7 +214,8 @@ int RunCalibrate() {
     input.threads = threads;
     if (!WriteReport(FLAGS_report, input, ReportOptions(), &error)) {
       std::cerr << "puzzlecal calibrate: report not written: " << error << "\n";
-      return kExitOutputError;
+      // A failed calibration stays the outcome that matters.
+      if (calibrated) return kExitOutputError;
     }
   }
   if (!calibrated) {

@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -67,7 +68,7 @@ std::vector<LabelledCorner> LabelCorners(const ImageResult& image,
   return rows;
 }
 
-// A distinct colour per component (golden-angle hues); grey for unlabelled.
+// A distinct colour per component (golden-angle hues); red for unlabelled.
 cv::Scalar ComponentColour(int component) {
   if (component < 0) return cv::Scalar(0, 0, 255);
   cv::Mat hsv(
@@ -133,11 +134,14 @@ bool WriteOverlay(const cv::Mat& grey, const std::vector<LabelledCorner>& rows,
           radius / 10.0, cv::Scalar(255, 255, 0), thickness, cv::LINE_AA);
     }
   }
+  std::vector<uchar> png;
   try {
-    return cv::imwrite(path, colour);
+    if (!cv::imencode(".png", colour, png)) return false;
   } catch (const cv::Exception&) {
     return false;
   }
+  std::string error;
+  return WriteFileAtomically(path, std::string(png.begin(), png.end()), &error);
 }
 
 void EmitImage(const ImageResult& image, bool have_board, YAML::Emitter* out) {
@@ -271,15 +275,21 @@ int RunDetect() {
   }
 
   if (!FLAGS_draw.empty()) {
-    // Overlays are drawn after the run, one image in memory at a time.
+    // Overlays are drawn after the run, one image in memory at a time, named
+    // after the image (a.png -> a_corners.png; a second a.jpg gets
+    // a_2_corners.png).
+    std::set<std::string> stems;
     for (const ImageResult& image : images) {
       if (image.outcome == ImageOutcome::kUnreadable) continue;
       cv::Mat grey;
       if (!LoadGreyImage(image.file, options.load, &grey, &error)) continue;
+      const std::string base = fs::path(image.file).stem().string();
+      std::string stem = base;
+      for (int k = 2; !stems.insert(stem).second; ++k) {
+        stem = base + "_" + std::to_string(k);
+      }
       const std::string overlay =
-          (fs::path(FLAGS_draw) /
-           (fs::path(image.file).stem().string() + "_corners.png"))
-              .string();
+          (fs::path(FLAGS_draw) / (stem + "_corners.png")).string();
       if (!WriteOverlay(grey, LabelCorners(image, have_board), overlay)) {
         std::cerr << "puzzlecal detect: cannot write overlay " << overlay
                   << "\n";

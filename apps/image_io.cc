@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -28,37 +30,110 @@ bool HasImageExtension(const fs::path& path) {
          ext == ".tiff" || ext == ".bmp";
 }
 
-bool EndsWith(const std::vector<unsigned char>& bytes,
-              const std::vector<unsigned char>& tail, size_t slack) {
-  if (bytes.size() < tail.size()) return false;
-  // Allow a few bytes of padding after the end marker.
-  const size_t last_start = bytes.size() - tail.size();
-  const size_t first_start = last_start > slack ? last_start - slack : 0;
-  for (size_t start = last_start + 1; start-- > first_start;) {
-    if (std::equal(tail.begin(), tail.end(), bytes.begin() + start)) {
-      return true;
-    }
-  }
-  return false;
+// What the file header tells before decoding: the image size (0 when the
+// format is not parsed here) and, for PNG and JPEG, whether the file is
+// complete. Decoders of truncated PNG/JPEG files often return a partly grey
+// image with only a warning, so completeness is checked on the structure.
+struct HeaderInfo {
+  long long width = 0;
+  long long height = 0;
+  std::string truncation;  // empty when complete (or not checked)
+};
+
+unsigned BigEndian(const std::vector<unsigned char>& b, size_t at, int n) {
+  unsigned value = 0;
+  for (int k = 0; k < n; ++k) value = (value << 8) | b[at + k];
+  return value;
 }
 
-// Decoders of truncated PNG/JPEG files often return a partly grey image with
-// only a warning; the end markers tell a complete file.
-std::string TruncationReason(const std::vector<unsigned char>& bytes) {
-  static const std::vector<unsigned char> kPngMagic = {0x89, 'P', 'N', 'G'};
-  static const std::vector<unsigned char> kPngEnd = {'I', 'E', 'N', 'D'};
-  static const std::vector<unsigned char> kJpegMagic = {0xFF, 0xD8};
-  static const std::vector<unsigned char> kJpegEnd = {0xFF, 0xD9};
-  if (bytes.size() >= 4 &&
-      std::equal(kPngMagic.begin(), kPngMagic.end(), bytes.begin())) {
-    if (!EndsWith(bytes, kPngEnd, 64)) return "truncated PNG (no IEND chunk)";
-  } else if (bytes.size() >= 2 &&
-             std::equal(kJpegMagic.begin(), kJpegMagic.end(), bytes.begin())) {
-    if (!EndsWith(bytes, kJpegEnd, 64)) {
-      return "truncated JPEG (no end-of-image marker)";
-    }
+// PNG: walks the chunks (length, type, data, CRC) up to IEND; data after
+// IEND is ignored. The size comes from IHDR.
+void InspectPng(const std::vector<unsigned char>& b, HeaderInfo* info) {
+  if (b.size() >= 24) {
+    info->width = BigEndian(b, 16, 4);
+    info->height = BigEndian(b, 20, 4);
   }
-  return "";
+  size_t pos = 8;
+  while (pos + 8 <= b.size()) {
+    const size_t length = BigEndian(b, pos, 4);
+    static const char kIend[] = "IEND";
+    const bool iend =
+        std::equal(b.begin() + pos + 4, b.begin() + pos + 8, kIend);
+    if (iend) return;
+    if (length > b.size()) break;  // also guards the sum below
+    pos += 12 + length;
+  }
+  info->truncation = "truncated PNG (the chunks end before IEND)";
+}
+
+// JPEG: walks the marker segments up to the first start-of-scan (skipping
+// APPn payloads, so an EXIF thumbnail's own markers do not count), reads the
+// size from the start-of-frame segment, then needs an end-of-image marker
+// somewhere after the scan starts (entropy-coded data never contains FF D9;
+// data after it, as phones append, is ignored).
+void InspectJpeg(const std::vector<unsigned char>& b, HeaderInfo* info) {
+  size_t pos = 2;
+  size_t scan = 0;
+  while (pos + 4 <= b.size()) {
+    if (b[pos] != 0xFF) break;  // not a marker: leave it to the decoder
+    const unsigned char marker = b[pos + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++pos;
+      continue;
+    }
+    if (marker == 0xDA) {
+      scan = pos;
+      break;
+    }
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD9)) {
+      pos += 2;  // markers without a payload
+      continue;
+    }
+    const size_t length = BigEndian(b, pos + 2, 2);
+    const bool start_of_frame = marker >= 0xC0 && marker <= 0xCF &&
+                                marker != 0xC4 && marker != 0xC8 &&
+                                marker != 0xCC;
+    if (start_of_frame && pos + 9 <= b.size()) {
+      info->height = BigEndian(b, pos + 5, 2);
+      info->width = BigEndian(b, pos + 7, 2);
+    }
+    pos += 2 + length;
+  }
+  if (scan == 0) {
+    if (pos + 4 > b.size()) {
+      info->truncation = "truncated JPEG (the file ends before the image data)";
+    }
+    return;
+  }
+  for (size_t k = scan + 2; k + 1 < b.size(); ++k) {
+    if (b[k] == 0xFF && b[k + 1] == 0xD9) return;
+  }
+  info->truncation = "truncated JPEG (no end-of-image marker)";
+}
+
+// BMP: size from the DIB header (height may be negative: top-down rows).
+void InspectBmp(const std::vector<unsigned char>& b, HeaderInfo* info) {
+  if (b.size() < 26) return;
+  auto little = [&](size_t at) {
+    return static_cast<int32_t>(b[at] | (b[at + 1] << 8) | (b[at + 2] << 16) |
+                                (static_cast<uint32_t>(b[at + 3]) << 24));
+  };
+  info->width = std::llabs(static_cast<long long>(little(18)));
+  info->height = std::llabs(static_cast<long long>(little(22)));
+}
+
+HeaderInfo InspectHeader(const std::vector<unsigned char>& b) {
+  HeaderInfo info;
+  static const unsigned char kPngMagic[] = {0x89, 'P',  'N',  'G',
+                                            0x0D, 0x0A, 0x1A, 0x0A};
+  if (b.size() >= 8 && std::equal(kPngMagic, kPngMagic + 8, b.begin())) {
+    InspectPng(b, &info);
+  } else if (b.size() >= 2 && b[0] == 0xFF && b[1] == 0xD8) {
+    InspectJpeg(b, &info);
+  } else if (b.size() >= 2 && b[0] == 'B' && b[1] == 'M') {
+    InspectBmp(b, &info);
+  }
+  return info;
 }
 
 }  // namespace
@@ -139,9 +214,18 @@ bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
     *error = path + ": empty file (0 bytes)";
     return false;
   }
-  const std::string truncated = TruncationReason(bytes);
-  if (!truncated.empty()) {
-    *error = path + ": " + truncated;
+  const HeaderInfo header = InspectHeader(bytes);
+  if (!header.truncation.empty()) {
+    *error = path + ": " + header.truncation;
+    return false;
+  }
+  // Refused before decoding where the header gives the size: decoding alone
+  // would claim the memory the limit is there to protect.
+  if (options.max_pixels > 0 && header.width > 0 && header.height > 0 &&
+      header.width * header.height > options.max_pixels) {
+    *error = path + ": image of " + std::to_string(header.width) + "x" +
+             std::to_string(header.height) + " pixels exceeds the limit of " +
+             std::to_string(options.max_pixels) + " pixels";
     return false;
   }
   cv::Mat decoded;

@@ -23,8 +23,9 @@ bool ListImages(const std::string& path, ImageListing* listing,
 
 // Limits applied while loading.
 struct ImageLoadOptions {
-  // Images with more pixels than this are refused (decoding alone would
-  // need too much memory). 0 disables the check.
+  // Images with more pixels than this are refused: PNG, JPEG and BMP before
+  // decoding (their headers give the size; decoding alone would need too
+  // much memory), other formats after. 0 disables the check.
   long long max_pixels = 120'000'000;
 
   bool Check(std::string* why = nullptr) const;

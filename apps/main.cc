@@ -1,13 +1,14 @@
 // puzzlecal: one program, several subcommands (apps/cmd_*.cc).
 
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cstring>
 #include <iostream>
+#include <iterator>
 #include <string>
 #include <vector>
-
-#include <gflags/gflags.h>
-#include <glog/logging.h>
 
 #include "apps/subcommand.h"
 
@@ -16,9 +17,10 @@ namespace {
 
 std::vector<Subcommand> SortedSubcommands() {
   std::vector<Subcommand> all = Subcommands();
-  std::sort(all.begin(), all.end(), [](const Subcommand& a, const Subcommand& b) {
-    return std::strcmp(a.name, b.name) < 0;
-  });
+  std::sort(all.begin(), all.end(),
+            [](const Subcommand& a, const Subcommand& b) {
+              return std::strcmp(a.name, b.name) < 0;
+            });
   return all;
 }
 
@@ -43,6 +45,74 @@ void PrintSubcommandHelp(const Subcommand& s) {
   }
 }
 
+// Logging flags every subcommand accepts (glog's own).
+bool IsLoggingFlag(const std::string& name) {
+  static const char* const kLogging[] = {
+      "v",           "vmodule",         "logtostderr",     "alsologtostderr",
+      "minloglevel", "stderrthreshold", "colorlogtostderr"};
+  return std::find(std::begin(kLogging), std::end(kLogging), name) !=
+         std::end(kLogging);
+}
+
+// Parses `args` (after the subcommand; args[0] is the program) as
+// --name=value, --name value, --bool_flag and --nobool_flag. Unknown flags,
+// flags the subcommand does not read, bad values and stray arguments are
+// errors (gflags would exit with 1 on its own; the documented code is 2).
+bool ParseSubcommandFlags(const Subcommand& subcommand,
+                          const std::vector<char*>& args, std::string* error) {
+  for (size_t i = 1; i < args.size(); ++i) {
+    std::string arg = args[i];
+    if (arg.size() < 2 || arg[0] != '-') {
+      *error = "unexpected argument '" + arg + "'";
+      return false;
+    }
+    arg.erase(0, arg[1] == '-' ? 2 : 1);
+    std::string flag = arg, value;
+    const size_t equals = arg.find('=');
+    const bool has_value = equals != std::string::npos;
+    if (has_value) {
+      flag = arg.substr(0, equals);
+      value = arg.substr(equals + 1);
+    }
+    gflags::CommandLineFlagInfo info;
+    bool found = gflags::GetCommandLineFlagInfo(flag.c_str(), &info);
+    if (!found && !has_value && flag.rfind("no", 0) == 0 &&
+        gflags::GetCommandLineFlagInfo(flag.substr(2).c_str(), &info) &&
+        info.type == "bool") {
+      flag = flag.substr(2);
+      value = "false";
+      found = true;
+    } else if (found && !has_value) {
+      if (info.type == "bool") {
+        value = "true";
+      } else if (i + 1 < args.size()) {
+        value = args[++i];
+      } else {
+        *error = "flag --" + flag + " needs a value";
+        return false;
+      }
+    }
+    if (!found) {
+      *error = "unknown flag --" + flag;
+      return false;
+    }
+    const bool listed =
+        std::find(subcommand.flags.begin(), subcommand.flags.end(), flag) !=
+        subcommand.flags.end();
+    if (!listed && !IsLoggingFlag(flag)) {
+      *error =
+          "flag --" + flag + " does not apply to `" + subcommand.name + "`";
+      return false;
+    }
+    if (gflags::SetCommandLineOption(flag.c_str(), value.c_str()).empty()) {
+      *error = "invalid value '" + value + "' for --" + flag + " (" +
+               info.type + ")";
+      return false;
+    }
+  }
+  return true;
+}
+
 int Main(int argc, char** argv) {
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 ||
       std::strcmp(argv[1], "-h") == 0 || std::strcmp(argv[1], "help") == 0) {
@@ -63,8 +133,8 @@ int Main(int argc, char** argv) {
   args.push_back(argv[0]);
   bool help = false;
   for (int i = 2; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0 ||
-        std::strcmp(argv[i], "-help") == 0) {
+    if (std::strcmp(argv[i], "--help") == 0 ||
+        std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "-help") == 0) {
       help = true;
     } else {
       args.push_back(argv[i]);
@@ -74,14 +144,10 @@ int Main(int argc, char** argv) {
     PrintSubcommandHelp(*it);
     return kExitOk;
   }
-  int new_argc = static_cast<int>(args.size());
-  char** new_argv = args.data();
-  gflags::SetUsageMessage(it->usage);
-  gflags::ParseCommandLineNonHelpFlags(&new_argc, &new_argv, true);
-  if (new_argc > 1) {
-    std::cerr << "puzzlecal " << name << ": unexpected argument '"
-              << new_argv[1] << "'. Run `puzzlecal " << name
-              << " --help`.\n";
+  std::string error;
+  if (!ParseSubcommandFlags(*it, args, &error)) {
+    std::cerr << "puzzlecal " << name << ": " << error << ". Run `puzzlecal "
+              << name << " --help`.\n";
     return kExitUsage;
   }
   FLAGS_logtostderr = true;

@@ -1,5 +1,7 @@
 #include "apps/pipeline.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -93,6 +95,10 @@ bool PipelineOptions::Check(std::string* why) const {
 
 void ProcessGreyImage(const cv::Mat& grey, const Board& board,
                       const PipelineOptions& options, ImageResult* result) {
+  // The options come from the program, not from the user: a bad value is a
+  // programming error.
+  std::string why;
+  CHECK(options.Check(&why)) << "pipeline options: " << why;
   result->width = grey.cols;
   result->height = grey.rows;
   auto start = std::chrono::steady_clock::now();

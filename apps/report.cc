@@ -5,11 +5,10 @@
 #include <filesystem>
 #include <map>
 #include <numeric>
-#include <set>
-#include <sstream>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
+#include <sstream>
 
 #include "apps/plot.h"
 #include "calib/atomic_file.h"
@@ -209,8 +208,8 @@ double ResidualArrowScale(const ReportData& data, const ReportOptions& options,
 }
 
 cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
-  ImageLayout layout = MakeImageLayout(options.image_plot_width, data.width,
-                                       data.height, 3);
+  ImageLayout layout =
+      MakeImageLayout(options.image_plot_width, data.width, data.height, 3);
   cv::Mat& canvas = layout.canvas;
   const plot::Frame& frame = layout.frame;
   canvas(frame.area).setTo(cv::Scalar(246, 246, 246));
@@ -222,7 +221,8 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
   const cv::Point2d origin(frame.area.x, frame.area.y);
   // Outliers can be off by tens of pixels: their arrows are cut to this
   // length (canvas pixels) so they do not hide the rest.
-  const double outlier_cap = std::max(40.0, 3 * p95 * arrow_scale * layout.scale);
+  const double outlier_cap =
+      std::max(40.0, 3 * p95 * arrow_scale * layout.scale);
   int num_capped = 0;
   auto draw = [&](const ResidualSample& s, const cv::Scalar& colour) {
     const cv::Point2d from =
@@ -257,28 +257,28 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
              arrow_scale),
       Format("%d corners used (blue), %d outliers (red) from %d views; "
              "RMS %.3f px per coordinate",
-             data.num_inliers, data.num_outliers,
-             data.result->num_views_used, data.result->rms_px));
+             data.num_inliers, data.num_outliers, data.result->num_views_used,
+             data.result->rms_px));
   // Scale reference: an arrow for a round residual near the 95th percentile.
   const double reference = plot::NiceNumber(p95 > 0 ? p95 : 1.0, false);
   const double reference_length = reference * arrow_scale * layout.scale;
   const int y0 = layout.notes_y - 6;
   const int x0 = frame.area.x;
   cv::arrowedLine(canvas, Fixed(cv::Point2d(x0, y0)),
-                  Fixed(cv::Point2d(x0 + reference_length, y0)), plot::kBlue,
-                  1, cv::LINE_AA, kShift,
+                  Fixed(cv::Point2d(x0 + reference_length, y0)), plot::kBlue, 1,
+                  cv::LINE_AA, kShift,
                   std::min(0.35, 5.0 / std::max(1.0, reference_length)));
   plot::DrawText(&canvas,
                  Format("= %g px residual (scale x%g)", reference, arrow_scale),
                  {x0 + static_cast<int>(reference_length) + 10, y0 + 5},
                  plot::kTickScale, plot::kBlack);
-  DrawNote(&layout, 1,
-           "Each arrow starts at a detected corner and points to where the "
-           "calibrated model reprojects it." +
-               (num_capped > 0
-                    ? Format(" %d outlier arrows are cut to %.0f px.",
-                             num_capped, outlier_cap)
-                    : std::string()));
+  DrawNote(
+      &layout, 1,
+      "Each arrow starts at a detected corner and points to where the "
+      "calibrated model reprojects it." +
+          (num_capped > 0 ? Format(" %d outlier arrows are cut to %.0f px.",
+                                   num_capped, outlier_cap)
+                          : std::string()));
   DrawNote(&layout, 2,
            "Random directions = noise; arrows aligned over a region = model "
            "error there (try another model) or a bent board.");
@@ -286,12 +286,12 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
 }
 
 cv::Mat PlotCoverage(const ReportData& data, const ReportOptions& options) {
-  ImageLayout layout = MakeImageLayout(options.image_plot_width, data.width,
-                                       data.height, 2);
+  ImageLayout layout =
+      MakeImageLayout(options.image_plot_width, data.width, data.height, 2);
   cv::Mat& canvas = layout.canvas;
   const plot::Frame& frame = layout.frame;
-  const double cell = static_cast<double>(data.width) /
-                      options.coverage_cells_across;
+  const double cell =
+      static_cast<double>(data.width) / options.coverage_cells_across;
   const int cols = options.coverage_cells_across;
   const int rows = std::max(1, static_cast<int>(std::ceil(data.height / cell)));
   std::vector<int> counts(static_cast<size_t>(cols) * rows, 0);
@@ -334,8 +334,8 @@ cv::Mat PlotCoverage(const ReportData& data, const ReportOptions& options) {
       Format("Coverage: used corners per %.0f x %.0f px cell", cell, cell),
       Format("%d corners from %d views; %d of %d cells empty (white); "
              "the calibration's coverage figure: %.0f %%",
-             data.num_inliers, data.result->num_views_used, empty,
-             rows * cols, 100.0 * data.result->coverage));
+             data.num_inliers, data.result->num_views_used, empty, rows * cols,
+             100.0 * data.result->coverage));
   DrawNote(&layout, 0,
            "The model is only trustworthy where corners were seen. Fill white "
            "cells (image corners and edges matter most for distortion)");
@@ -346,8 +346,8 @@ cv::Mat PlotCoverage(const ReportData& data, const ReportOptions& options) {
 cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
   const Camera& camera = data.result->camera;
   const bool fisheye = !CameraModelIsPinhole(camera.model);
-  ImageLayout layout = MakeImageLayout(options.image_plot_width, data.width,
-                                       data.height, 4);
+  ImageLayout layout =
+      MakeImageLayout(options.image_plot_width, data.width, data.height, 4);
   cv::Mat& canvas = layout.canvas;
   const plot::Frame& frame = layout.frame;
 
@@ -472,7 +472,8 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
         }
         // Label where the line is nearest the principal point's row (the
         // right-most such place).
-        if (label_v < 0 || std::abs(v - label_row) < std::abs(label_v - label_row) ||
+        if (label_v < 0 ||
+            std::abs(v - label_row) < std::abs(label_v - label_row) ||
             (std::abs(v - label_row) == std::abs(label_v - label_row) &&
              u > label_u)) {
           label_u = u;
@@ -497,18 +498,18 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
                       "distortion (px)");
   if (fisheye) {
     plot::DrawTitle(
-        &canvas,
-        "Distortion: shift from the equidistant fisheye r = f * theta",
+        &canvas, "Distortion: shift from the equidistant fisheye r = f * theta",
         Format("Pixels between where each pixel's ray lands with the model "
                "and with k1..k4 = 0 (same fx fy cx cy); max %.1f px",
-               max_magnitude) + std::string(have_observed ? " where seen" : ""));
+               max_magnitude) +
+            std::string(have_observed ? " where seen" : ""));
   } else {
     plot::DrawTitle(
-        &canvas,
-        "Distortion: shift from the distortion-free pinhole",
+        &canvas, "Distortion: shift from the distortion-free pinhole",
         Format("Pixels between where each pixel's ray lands with the model "
                "and with no distortion (same fx fy cx cy); max %.1f px",
-               max_magnitude) + std::string(have_observed ? " where seen" : ""));
+               max_magnitude) +
+            std::string(have_observed ? " where seen" : ""));
   }
   DrawNote(&layout, 0,
            Format("White lines: angle of the pixel's ray from the optical axis "
@@ -545,8 +546,9 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   // The histogram, and right of it one bar for everything beyond its range.
   constexpr int kOverflowWidth = 60;
   plot::Frame frame;
-  frame.area = cv::Rect(90, 80, options.chart_width - 90 - 30 - kOverflowWidth - 20,
-                        options.chart_height - 80 - 70);
+  frame.area =
+      cv::Rect(90, 80, options.chart_width - 90 - 30 - kOverflowWidth - 20,
+               options.chart_height - 80 - 70);
   std::vector<double> inlier_norms, outlier_norms;
   for (const ResidualSample& s : data.samples) {
     (s.inlier ? inlier_norms : outlier_norms).push_back(s.residual.norm());
@@ -559,12 +561,12 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   std::vector<int> inliers(bins, 0), outliers(bins, 0);
   int inliers_beyond = 0, outliers_beyond = 0;
   auto add = [&](double norm, std::vector<int>* counts, int* beyond) {
-    const int bin = static_cast<int>(norm / width);
-    if (bin >= bins) {
+    // Compared as doubles first: a huge residual would overflow the int.
+    if (!(norm < bins * width)) {
       ++*beyond;
-    } else {
-      ++(*counts)[std::max(0, bin)];
+      return;
     }
+    ++(*counts)[std::max(0, static_cast<int>(norm / width))];
   };
   for (double n : inlier_norms) add(n, &inliers, &inliers_beyond);
   for (double n : outlier_norms) add(n, &outliers, &outliers_beyond);
@@ -578,17 +580,19 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
       auto cdf = [&](double r) {
         return 1 - std::exp(-r * r / (2 * sigma * sigma));
       };
-      expected[b] = inlier_norms.size() * (cdf((b + 1) * width) - cdf(b * width));
+      expected[b] =
+          inlier_norms.size() * (cdf((b + 1) * width) - cdf(b * width));
     }
   }
   const double y_max =
-      1.1 * std::max<double>(highest,
-                             *std::max_element(expected.begin(), expected.end()));
+      1.1 * std::max<double>(
+                highest, *std::max_element(expected.begin(), expected.end()));
   frame.x_min = 0;
   frame.x_max = range;
   frame.y_min = 0;
   frame.y_max = y_max;
-  plot::DrawAxes(&canvas, frame, "residual length |reprojected - detected| (px)",
+  plot::DrawAxes(&canvas, frame,
+                 "residual length |reprojected - detected| (px)",
                  "corners per bin", true);
   for (int b = 0; b < bins; ++b) {
     const cv::Point p0 = frame.ToCanvasPixel(b * width, 0);
@@ -596,13 +600,13 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
     const cv::Point p2 =
         frame.ToCanvasPixel((b + 1) * width, inliers[b] + outliers[b]);
     if (inliers[b] > 0) {
-      cv::rectangle(canvas, cv::Rect(p0.x + 1, p1.y, p1.x - p0.x - 1,
-                                     p0.y - p1.y),
+      cv::rectangle(canvas,
+                    cv::Rect(p0.x + 1, p1.y, p1.x - p0.x - 1, p0.y - p1.y),
                     plot::kBlue, cv::FILLED);
     }
     if (outliers[b] > 0) {
-      cv::rectangle(canvas, cv::Rect(p0.x + 1, p2.y, p1.x - p0.x - 1,
-                                     p1.y - p2.y),
+      cv::rectangle(canvas,
+                    cv::Rect(p0.x + 1, p2.y, p1.x - p0.x - 1, p1.y - p2.y),
                     plot::kRed, cv::FILLED);
     }
   }
@@ -694,12 +698,13 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
       const bool is_high = data.view_rms[v] > high;
       num_high += is_high;
       const cv::Point2d top = frame.ToCanvas(v + 1, data.view_rms[v]);
-      cv::rectangle(canvas,
-                    cv::Point(static_cast<int>(std::lround(base.x - bar_width / 2)),
-                              static_cast<int>(std::lround(top.y))),
-                    cv::Point(static_cast<int>(std::lround(base.x + bar_width / 2)) - 1,
-                              static_cast<int>(std::lround(base.y)) - 1),
-                    is_high ? plot::kOrange : plot::kBlue, cv::FILLED);
+      cv::rectangle(
+          canvas,
+          cv::Point(static_cast<int>(std::lround(base.x - bar_width / 2)),
+                    static_cast<int>(std::lround(top.y))),
+          cv::Point(static_cast<int>(std::lround(base.x + bar_width / 2)) - 1,
+                    static_cast<int>(std::lround(base.y)) - 1),
+          is_high ? plot::kOrange : plot::kBlue, cv::FILLED);
     } else {
       ++num_unused;
       plot::DrawCross(&canvas, base - cv::Point2d(0, 8), 5, plot::kGrey, 2);
@@ -710,8 +715,8 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
       plot::DrawText(&canvas, Format("%d", data.view_number[v]),
                      {static_cast<int>(std::lround(base.x)),
                       frame.area.y + frame.area.height + 20},
-                     plot::kTickScale,
-                     v == worst ? plot::kRed : plot::kBlack, Align::kCenter);
+                     plot::kTickScale, v == worst ? plot::kRed : plot::kBlack,
+                     Align::kCenter);
     }
   }
   plot::DrawDashedLine(&canvas, frame.ToCanvas(0.5, overall),
@@ -757,10 +762,11 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
     *warning = "overlay drawn without the image: " + load_error;
     grey = cv::Mat(data.height, data.width, CV_8UC1, cv::Scalar(128));
   } else if (grey.cols != data.width || grey.rows != data.height) {
-    *warning = Format("%s is %d x %d, the calibration %d x %d; overlay "
-                      "drawn at the image's size",
-                      data.view_file[v].c_str(), grey.cols, grey.rows,
-                      data.width, data.height);
+    *warning = Format(
+        "%s is %d x %d, the calibration %d x %d; overlay "
+        "drawn at the image's size",
+        data.view_file[v].c_str(), grey.cols, grey.rows, data.width,
+        data.height);
   }
   const double scale = static_cast<double>(options.overlay_width) / grey.cols;
   const cv::Size scaled_size(
@@ -779,7 +785,8 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
                cv::COLOR_GRAY2BGR);
   cv::Mat image_area = canvas(cv::Rect(0, kHeader, small.cols, small.rows));
   auto to_canvas = [&](const Eigen::Vector2d& p) {
-    return cv::Point2d((p.x() + 0.5) * scale - 0.5, (p.y() + 0.5) * scale - 0.5);
+    return cv::Point2d((p.x() + 0.5) * scale - 0.5,
+                       (p.y() + 0.5) * scale - 0.5);
   };
   const int radius = 6;
   double p95 = 0;
@@ -795,8 +802,8 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
     const bool inlier = result.inlier[v][i];
     (inlier ? inliers : outliers)++;
     const cv::Point2d detected = to_canvas(xy);
-    cv::circle(image_area, Fixed(detected), (inlier ? radius : radius + 3)
-                                                << kShift,
+    cv::circle(image_area, Fixed(detected),
+               (inlier ? radius : radius + 3) << kShift,
                inlier ? plot::kGreen : plot::kRed, 2, cv::LINE_AA, kShift);
     Eigen::Vector2d projected;
     if (data.camera_valid && has_pose &&
@@ -818,10 +825,10 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
     }
   }
   const std::string name = FileName(data.view_file[v]);
-  plot::DrawText(&canvas,
-                 Format("#%d %s  (%s)", data.view_number[v], name.c_str(),
-                        rank.c_str()),
-                 {12, 28}, plot::kTitleScale, plot::kBlack, Align::kLeft, 2);
+  plot::DrawText(
+      &canvas,
+      Format("#%d %s  (%s)", data.view_number[v], name.c_str(), rank.c_str()),
+      {12, 28}, plot::kTitleScale, plot::kBlack, Align::kLeft, 2);
   plot::DrawText(
       &canvas,
       Format("view RMS %.3f px per coordinate (overall %.3f px); %d corners "
@@ -839,8 +846,7 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
   cv::circle(canvas, {x, y - 5}, 5, plot::kRed, 2, cv::LINE_AA);
   x += 12;
   const std::string outlier_text = "outlier";
-  plot::DrawText(&canvas, outlier_text, {x, y}, plot::kTickScale,
-                 plot::kBlack);
+  plot::DrawText(&canvas, outlier_text, {x, y}, plot::kTickScale, plot::kBlack);
   x += plot::TextSize(outlier_text, plot::kTickScale).width + 30;
   plot::DrawCross(&canvas, cv::Point2d(x, y - 5), 5, cv::Scalar(200, 0, 200),
                   1);
@@ -897,14 +903,14 @@ std::vector<std::pair<int, std::string>> PickOverlayViews(
                   static_cast<int>(picked.size()) < num_worst;
        ++k) {
     if (k == 1 && most_outliers >= 0 && !taken.count(most_outliers)) {
-      take(most_outliers, Format("most outliers: %d",
-                                 data.view_outliers[most_outliers]));
+      take(most_outliers,
+           Format("most outliers: %d", data.view_outliers[most_outliers]));
       if (static_cast<int>(picked.size()) >= num_worst) break;
     }
     take(used[k], k == 0 ? "worst view" : Format("%d. worst view", k + 1));
   }
-  for (int k = 0; k < static_cast<int>(used.size()) &&
-                  static_cast<int>(picked.size()) < n;
+  for (int k = 0;
+       k < static_cast<int>(used.size()) && static_cast<int>(picked.size()) < n;
        ++k) {
     take(used[used.size() - 1 - k],
          k == 0 ? "best view" : Format("%d. best view", k + 1));
@@ -949,8 +955,9 @@ bool ReportOptions::Check(std::string* why) const {
   }
   if (chart_width < 400 || chart_width > 10000 || chart_height < 300 ||
       chart_height > 10000) {
-    return fail("chart_width must be in [400, 10000], chart_height in "
-                "[300, 10000]");
+    return fail(
+        "chart_width must be in [400, 10000], chart_height in "
+        "[300, 10000]");
   }
   if (overlay_width < 400 || overlay_width > 10000) {
     return fail("overlay_width must be in [400, 10000]");
@@ -1011,8 +1018,8 @@ bool DistortionShift(const Camera& camera, const Eigen::Vector2d& pixel,
 std::string FormatWithSigma(double value, double sigma,
                             std::string* sigma_text) {
   if (sigma > 0 && std::isfinite(sigma)) {
-    const int decimals = std::clamp(
-        2 - static_cast<int>(std::floor(std::log10(sigma))), 0, 12);
+    const int decimals =
+        std::clamp(2 - static_cast<int>(std::floor(std::log10(sigma))), 0, 12);
     if (sigma_text) *sigma_text = Format("%.*f", decimals, sigma);
     return Format("%.*f", decimals, value);
   }
@@ -1034,9 +1041,9 @@ std::string ReportMarkdown(const ReportInput& input,
   std::ostringstream md;
   md << "# Calibration report\n\n";
   md << "Model **" << CameraModelName(camera.model) << "**, image "
-     << camera.width << " x " << camera.height << " px; board: "
-     << BoardTypeName(input.board.type) << ", " << input.board.cols << " x "
-     << input.board.rows << " inner corners, "
+     << camera.width << " x " << camera.height
+     << " px; board: " << BoardTypeName(input.board.type) << ", "
+     << input.board.cols << " x " << input.board.rows << " inner corners, "
      << Format("%g", input.board.tile_size_m * 1000) << " mm tiles.\n\n";
   if (!input.calibration_ok) {
     md << "> **Calibration failed:** " << input.calibration_error
@@ -1045,22 +1052,26 @@ std::string ReportMarkdown(const ReportInput& input,
   }
 
   md << "## Result\n\n| | |\n|---|---|\n";
-  md << Format("| RMS reprojection error | %.4f px per coordinate (%.4f px "
-               "per corner, OpenCV's figure) |\n",
-               result.rms_px, result.rms_point_px);
-  md << Format("| images | %zu, %d used as views (%d views passed to the "
-               "calibration) |\n",
-               input.images.size(), result.num_views_used,
-               static_cast<int>(input.views->size()));
-  md << Format("| corners used | %d (%d outliers dropped in %d rejection "
-               "round%s) |\n",
-               result.num_corners_used, result.num_outliers,
-               result.outlier_rounds, result.outlier_rounds == 1 ? "" : "s");
+  md << Format(
+      "| RMS reprojection error | %.4f px per coordinate (%.4f px "
+      "per corner, OpenCV's figure) |\n",
+      result.rms_px, result.rms_point_px);
+  md << Format(
+      "| images | %zu, %d used as views (%d views passed to the "
+      "calibration) |\n",
+      input.images.size(), result.num_views_used,
+      static_cast<int>(input.views->size()));
+  md << Format(
+      "| corners used | %d (%d outliers dropped in %d rejection "
+      "round%s) |\n",
+      result.num_corners_used, result.num_outliers, result.outlier_rounds,
+      result.outlier_rounds == 1 ? "" : "s");
   md << Format("| board orientations | normals spread over %.1f deg |\n",
                result.orientation_spread_deg);
-  md << Format("| coverage | %.0f %% of the cells of an 8 x 8 grid over the "
-               "image hold corners |\n",
-               100 * result.coverage);
+  md << Format(
+      "| coverage | %.0f %% of the cells of an 8 x 8 grid over the "
+      "image hold corners |\n",
+      100 * result.coverage);
   md << "| initialisation | " << Cell(result.initialization_method) << " |\n";
   md << Format("| solver | %d iterations, ", result.iterations)
      << Cell(result.termination) << " |\n\n";
@@ -1106,8 +1117,8 @@ std::string ReportMarkdown(const ReportInput& input,
   } else {
     md << "| # | image | RMS (px) | corners used | outliers | |\n"
           "|---:|---|---:|---:|---:|---|\n";
-    for (int k = 0; k < options.num_worst_views &&
-                    k < static_cast<int>(used.size());
+    for (int k = 0;
+         k < options.num_worst_views && k < static_cast<int>(used.size());
          ++k) {
       const int v = used[k];
       const bool high =
@@ -1136,7 +1147,8 @@ std::string ReportMarkdown(const ReportInput& input,
     std::string outcome = image.outcome;
     std::string reason = image.reason;
     // The calibration may drop a view the pipeline found usable.
-    if (is_view && !used_view && v < static_cast<int>(result.view_reason.size()) &&
+    if (is_view && !used_view &&
+        v < static_cast<int>(result.view_reason.size()) &&
         !result.view_reason[v].empty()) {
       if (!reason.empty()) reason += "; ";
       reason += result.view_reason[v];
@@ -1205,8 +1217,11 @@ std::string ReportMarkdown(const ReportInput& input,
     const size_t worst = (overlays.size() + 1) / 2;
     md << "- ";
     for (size_t k = 0; k < overlays.size(); ++k) {
-      md << (k == 0 ? "" : k == worst ? " and " : ", ") << "`" << overlays[k]
-         << "`" << (k + 1 == worst ? " (the worst views by RMS)" : "")
+      md << (k == 0       ? ""
+             : k == worst ? " and "
+                          : ", ")
+         << "`" << overlays[k] << "`"
+         << (k + 1 == worst ? " (the worst views by RMS)" : "")
          << (k + 1 == overlays.size() && k >= worst ? " (the best)" : "");
     }
     md << ": the view image with its detected corners (green circles; red = "
@@ -1235,14 +1250,15 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
   }
   const CalibrationResult& result = *input.result;
   if (result.view_used.size() != input.views->size()) {
-    *error = Format("report for %s: the result has %zu views, the view list "
-                    "%zu",
-                    dir.c_str(), result.view_used.size(), input.views->size());
+    *error = Format(
+        "report for %s: the result has %zu views, the view list "
+        "%zu",
+        dir.c_str(), result.view_used.size(), input.views->size());
     return false;
   }
   const int width = result.camera.width, height = result.camera.height;
-  const bool size_ok =
-      width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide;
+  const bool size_ok = width > 0 && height > 0 && width <= kMaxImageSide &&
+                       height <= kMaxImageSide;
 
   std::error_code ec;
   const std::filesystem::path folder(dir);
@@ -1285,8 +1301,7 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
           "no distortion map: the result's camera parameters are not valid");
     }
     std::set<std::string> taken;
-    for (const auto& [v, rank] :
-         PickOverlayViews(data, options.num_overlays)) {
+    for (const auto& [v, rank] : PickOverlayViews(data, options.num_overlays)) {
       std::string name = "overlay_" + SafeStem(data.view_file[v]);
       for (int k = 2; taken.count(name); ++k) {
         name = "overlay_" + SafeStem(data.view_file[v]) + Format("_%d", k);

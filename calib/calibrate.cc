@@ -1,5 +1,10 @@
 #include "calib/calibrate.h"
 
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -7,12 +12,6 @@
 #include <cstdio>
 #include <memory>
 #include <sstream>
-
-#include <ceres/ceres.h>
-#include <ceres/rotation.h>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
 #include "calib/reprojection_error.h"
 
@@ -105,18 +104,32 @@ void Solve(Problem* state, const std::vector<bool>& fixed,
   } else if (options.loss == RobustLoss::kCauchy) {
     loss->reset(new ceres::CauchyLoss(options.loss_scale_px));
   }
-  auto* ordering = new ceres::ParameterBlockOrdering;
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  int num_residuals = 0;
   for (size_t v = 0; v < state->views->size(); ++v) {
     if (!state->view_used[v]) continue;
     const CalibrationView& view = (*state->views)[v];
+    int view_residuals = 0;
     for (size_t i = 0; i < view.board_points.size(); ++i) {
       if (!state->inlier[v][i]) continue;
-      problem.AddResidualBlock(
-          ReprojectionError<Model>::Create(view.board_points[i],
-                                           view.image_points[i]),
-          loss->get(), state->params.data(), state->poses[v].data());
+      problem.AddResidualBlock(ReprojectionError<Model>::Create(
+                                   view.board_points[i], view.image_points[i]),
+                               loss->get(), state->params.data(),
+                               state->poses[v].data());
+      ++view_residuals;
     }
-    ordering->AddElementToGroup(state->poses[v].data(), 0);
+    // Only blocks the problem holds may be named in the ordering.
+    if (view_residuals > 0) {
+      ordering->AddElementToGroup(state->poses[v].data(), 0);
+    }
+    num_residuals += view_residuals;
+  }
+  if (num_residuals == 0) {
+    // Nothing to fit (and no intrinsics block to hold fixed): report a
+    // failed solve instead of handing Ceres an empty problem.
+    outcome->summary = ceres::Solver::Summary();
+    outcome->summary.message = "no corners left to fit";
+    return;
   }
   ordering->AddElementToGroup(state->params.data(), 1);
   std::vector<int> fixed_indices;
@@ -126,17 +139,17 @@ void Solve(Problem* state, const std::vector<bool>& fixed,
   if (static_cast<int>(fixed_indices.size()) == Model::kNumParams) {
     problem.SetParameterBlockConstant(state->params.data());
   } else if (!fixed_indices.empty()) {
-    problem.SetManifold(state->params.data(),
-                        new ceres::SubsetManifold(Model::kNumParams,
-                                                  fixed_indices));
+    problem.SetManifold(
+        state->params.data(),
+        new ceres::SubsetManifold(Model::kNumParams, fixed_indices));
   }
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.linear_solver_ordering.reset(ordering);
+  solver_options.linear_solver_ordering = ordering;
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = 1e-14;
-  solver_options.parameter_tolerance = 1e-12;
+  solver_options.gradient_tolerance = options.gradient_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
   solver_options.num_threads = options.deterministic ? 1 : options.num_threads;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solve(solver_options, &problem, &outcome->summary);
@@ -166,6 +179,7 @@ double OrientationSpreadDeg(const std::vector<Eigen::Isometry3d>& poses,
 template <int kNumParams>
 bool MarginalCovariance(ceres::Problem* problem, const Problem* state,
                         const std::vector<bool>& fixed,
+                        double min_eigenvalue_ratio,
                         Eigen::Matrix<double, kNumParams, kNumParams>* cov) {
   std::vector<int> free_index;
   for (int k = 0; k < kNumParams; ++k) {
@@ -224,7 +238,7 @@ bool MarginalCovariance(ceres::Problem* problem, const Problem* state,
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
   if (eig.info() != Eigen::Success) return false;
   const Eigen::VectorXd values = eig.eigenvalues();
-  if (!(values(0) > 1e-14 * values(n - 1))) return false;
+  if (!(values(0) > min_eigenvalue_ratio * values(n - 1))) return false;
   const Eigen::MatrixXd inverse = eig.eigenvectors() *
                                   values.cwiseInverse().asDiagonal() *
                                   eig.eigenvectors().transpose();
@@ -295,8 +309,8 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     }
     int good = 0;
     for (size_t i = 0; i < n; ++i) {
-      const bool finite = view.board_points[i].allFinite() &&
-                          view.image_points[i].allFinite();
+      const bool finite =
+          view.board_points[i].allFinite() && view.image_points[i].allFinite();
       if (finite && std::abs(view.board_points[i].z()) > 1e-9 * (1 + extent)) {
         planar = false;
       }
@@ -308,10 +322,9 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
       continue;
     }
     if (good < options.min_corners_per_view) {
-      result->view_reason[v] = "only " + std::to_string(good) +
-                               " corners (need " +
-                               std::to_string(options.min_corners_per_view) +
-                               ")";
+      result->view_reason[v] =
+          "only " + std::to_string(good) + " corners (need " +
+          std::to_string(options.min_corners_per_view) + ")";
       continue;
     }
     state.view_used[v] = true;
@@ -378,13 +391,14 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
   }
   if (usable < options.min_views) return too_few_views(usable);
   auto parallel_views = [&](double spread_deg) {
-    return Fail("all views show the board at nearly the same orientation "
-                "(largest angle between board normals " +
-                    Format("%.1f", spread_deg) + " degrees, need " +
-                    Format("%.1f", options.min_orientation_spread_deg) +
-                    "), so the focal length is undetermined: add views with "
-                    "the board tilted by 30 degrees or more",
-                error);
+    return Fail(
+        "all views show the board at nearly the same orientation "
+        "(largest angle between board normals " +
+            Format("%.1f", spread_deg) + " degrees, need " +
+            Format("%.1f", options.min_orientation_spread_deg) +
+            "), so the focal length is undetermined: add views with "
+            "the board tilted by 30 degrees or more",
+        error);
   };
   if (result->orientation_spread_deg < options.min_orientation_spread_deg) {
     return parallel_views(result->orientation_spread_deg);
@@ -394,9 +408,12 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
   std::vector<bool> fixed(kNumParams, false);
   const std::vector<std::string> names = CameraModelParamNames(model);
   for (int k = 0; k < kNumParams; ++k) {
-    if (k < kPrincipalPointBegin) fixed[k] = options.fix_focal_length;
-    else if (k < kDistortionBegin) fixed[k] = options.fix_principal_point;
-    else fixed[k] = options.fix_distortion;
+    if (k < kPrincipalPointBegin)
+      fixed[k] = options.fix_focal_length;
+    else if (k < kDistortionBegin)
+      fixed[k] = options.fix_principal_point;
+    else
+      fixed[k] = options.fix_distortion;
     if (std::find(options.fixed_params.begin(), options.fixed_params.end(),
                   names[k]) != options.fixed_params.end()) {
       fixed[k] = true;
@@ -410,13 +427,25 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
       std::fill(state.inlier[v].begin(), state.inlier[v].end(), false);
       continue;
     }
+    int projecting = 0;
     for (size_t i = 0; i < state.inlier[v].size(); ++i) {
       Eigen::Vector2d r;
       if (state.inlier[v][i] && !Residual(state, v, i, &r)) {
         state.inlier[v][i] = false;
       }
+      projecting += state.inlier[v][i] ? 1 : 0;
+    }
+    if (projecting < options.min_corners_per_view) {
+      state.view_used[v] = false;
+      std::fill(state.inlier[v].begin(), state.inlier[v].end(), false);
+      result->view_reason[v] =
+          "only " + std::to_string(projecting) +
+          " corners project through the initial camera (need " +
+          std::to_string(options.min_corners_per_view) + ")";
+      --usable;
     }
   }
+  if (usable < options.min_views) return too_few_views(usable);
 
   std::unique_ptr<ceres::LossFunction> loss;
   SolveOutcome outcome;
@@ -451,8 +480,7 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
           residuals[v][i] = r;
           (*projects)[v][i] = true;
         } else {
-          residuals[v][i].setConstant(
-              std::numeric_limits<double>::quiet_NaN());
+          residuals[v][i].setConstant(std::numeric_limits<double>::quiet_NaN());
         }
       }
     }
@@ -475,7 +503,8 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
       }
     }
     const double sigma = 1.4826 * Median(magnitudes);
-    const double threshold = std::max(options.outlier_k * sigma, 1e-3);
+    const double threshold =
+        std::max(options.outlier_k * sigma, options.min_outlier_threshold_px);
     std::vector<std::vector<bool>> next = state.inlier;
     bool changed = false;
     for (size_t v = 0; v < views.size(); ++v) {
@@ -490,8 +519,8 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     // A view left with too few corners has no trustworthy pose.
     for (size_t v = 0; v < views.size(); ++v) {
       if (!state.view_used[v]) continue;
-      const int kept = std::count(state.inlier[v].begin(),
-                                  state.inlier[v].end(), true);
+      const int kept =
+          std::count(state.inlier[v].begin(), state.inlier[v].end(), true);
       if (kept < options.min_corners_per_view) {
         state.view_used[v] = false;
         std::fill(state.inlier[v].begin(), state.inlier[v].end(), false);
@@ -562,7 +591,8 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     Eigen::Matrix<double, kNumParams, kNumParams> block;
     bool ok;
     if (options.deterministic) {
-      ok = MarginalCovariance(outcome.problem.get(), &state, fixed, &block);
+      ok = MarginalCovariance(outcome.problem.get(), &state, fixed,
+                              options.covariance_min_eigenvalue_ratio, &block);
     } else {
       // ceres::Covariance (SuiteSparseQR) may thread internally, which
       // changes the last bits from run to run.
@@ -574,8 +604,7 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
       Eigen::Matrix<double, kNumParams, kNumParams, Eigen::RowMajor> row_major;
       ok = covariance.Compute(blocks, outcome.problem.get()) &&
            covariance.GetCovarianceBlock(state.params.data(),
-                                         state.params.data(),
-                                         row_major.data());
+                                         state.params.data(), row_major.data());
       block = row_major;
     }
     if (ok) {
@@ -610,12 +639,11 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     report << "covariance: not available (the problem is rank deficient; "
               "some parameters are not determined by these views)\n";
   }
-  report << "rms: " << Format("%.4f", result->rms_px)
-         << " px per coordinate (" << Format("%.4f", result->rms_point_px)
-         << " px per corner)\n";
+  report << "rms: " << Format("%.4f", result->rms_px) << " px per coordinate ("
+         << Format("%.4f", result->rms_point_px) << " px per corner)\n";
   report << "views used: " << used << " of " << views.size()
-         << ", corners used: " << corners << ", outliers rejected: "
-         << outliers << " (" << rounds << " rejection rounds)\n";
+         << ", corners used: " << corners << ", outliers rejected: " << outliers
+         << " (" << rounds << " rejection rounds)\n";
   report << "coverage: " << Format("%.0f", 100 * result->coverage)
          << " % of the image, board orientation spread "
          << Format("%.1f", result->orientation_spread_deg) << " degrees\n";
@@ -638,23 +666,27 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
     return Fail("the bundle adjustment did not converge within " +
                     std::to_string(options.max_iterations) +
                     " iterations: raise the iteration limit or check the "
-                    "correspondences (RMS " + Format("%.3f", result->rms_px) +
-                    " px)",
+                    "correspondences (RMS " +
+                    Format("%.3f", result->rms_px) + " px)",
                 error);
   }
   if (used < options.min_views) return too_few_views(used);
   if (result->orientation_spread_deg < options.min_orientation_spread_deg) {
     return parallel_views(result->orientation_spread_deg);
   }
-  if (result->covariance_ok && !fixed[0] &&
-      !(result->param_stddev[0] <=
-        options.max_focal_relative_stddev * std::abs(state.params[0]))) {
-    return Fail("the views do not determine the focal length (fx = " +
-                    Format("%.1f", state.params[0]) + " +- " +
-                    Format("%.3g", result->param_stddev[0]) +
-                    " px): add views with the board tilted by 30 degrees or "
-                    "more, near the image borders too",
-                error);
+  // Both focal lengths (indices 0 and 1: fx, fy in every model) must be
+  // determined unless held fixed.
+  for (int k = 0; k < 2; ++k) {
+    if (result->covariance_ok && !fixed[k] &&
+        !(result->param_stddev[k] <=
+          options.max_focal_relative_stddev * std::abs(state.params[k]))) {
+      return Fail("the views do not determine the focal length (" + names[k] +
+                      " = " + Format("%.1f", state.params[k]) + " +- " +
+                      Format("%.3g", result->param_stddev[k]) +
+                      " px): add views with the board tilted by 30 degrees "
+                      "or more, near the image borders too",
+                  error);
+    }
   }
   if (!(result->rms_px <= options.max_rms_px)) {
     return Fail("the reprojection RMS is " + Format("%.2f", result->rms_px) +
@@ -702,6 +734,18 @@ bool CalibrationOptions::Check(std::string* why) const {
   if (!(function_tolerance > 0)) {
     return Fail("function_tolerance must be > 0", why);
   }
+  if (!(gradient_tolerance > 0)) {
+    return Fail("gradient_tolerance must be > 0", why);
+  }
+  if (!(parameter_tolerance > 0)) {
+    return Fail("parameter_tolerance must be > 0", why);
+  }
+  if (!(covariance_min_eigenvalue_ratio > 0)) {
+    return Fail("covariance_min_eigenvalue_ratio must be > 0", why);
+  }
+  if (!(min_outlier_threshold_px >= 0)) {
+    return Fail("min_outlier_threshold_px must be >= 0", why);
+  }
   if (num_threads < 1) return Fail("num_threads must be >= 1", why);
   if (min_corners_per_view < 4) {
     return Fail("min_corners_per_view must be >= 4", why);
@@ -724,10 +768,19 @@ bool CalibrationOptions::Check(std::string* why) const {
 bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
                int width, int height, const CalibrationOptions& options,
                CalibrationResult* result, std::string* error) {
+  // Per-view fields are sized to the input from the start, so that a
+  // failure at any step still returns a result a report can describe (every
+  // view unused, with its reason where one is known).
   *result = CalibrationResult();
   result->camera.model = model;
   result->camera.width = width;
   result->camera.height = height;
+  result->view_used.assign(views.size(), false);
+  result->view_reason.assign(views.size(), "");
+  result->cam_from_board.assign(views.size(), Eigen::Isometry3d::Identity());
+  result->view_rms_px.assign(views.size(), 0.0);
+  result->residuals.resize(views.size());  // empty: no view used yet
+  result->inlier.resize(views.size());
   std::string why;
   if (!options.Check(&why)) return Fail("calibration options: " + why, error);
   if (width <= 0 || height <= 0) {
@@ -752,8 +805,8 @@ bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
                 error);
   }
   return DispatchCameraModel(model, [&](auto model_struct) {
-    return CalibrateModel<decltype(model_struct)>(views, width, height,
-                                                  options, result, error);
+    return CalibrateModel<decltype(model_struct)>(views, width, height, options,
+                                                  result, error);
   });
 }
 

@@ -5,13 +5,14 @@
 // initialisation (calib/initialization.h), then a Ceres bundle adjustment over
 // the intrinsics and one cam_from_board pose per view (poses eliminated by
 // the Schur complement), a robust loss, iterative k-sigma outlier rejection
-// and parameter standard deviations from ceres::Covariance.
-
-#include <string>
-#include <vector>
+// and parameter standard deviations (by default from a deterministic Schur
+// complement of the Jacobian; ceres::Covariance when `deterministic` is
+// false).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <string>
+#include <vector>
 
 #include "calib/calibration_view.h"
 #include "calib/camera_models.h"
@@ -53,11 +54,23 @@ struct CalibrationOptions {
   double outlier_k = 4.0;
   // At most this many rejection rounds. Default 3.
   int outlier_iterations = 3;
+  // The rejection threshold never drops below this (pixels), so that exact
+  // synthetic data (sigma near 0) keeps its corners. Default 1e-3 px. >= 0.
+  double min_outlier_threshold_px = 1e-3;
 
   // Levenberg-Marquardt iterations per solve. Default 100.
   int max_iterations = 100;
   // Relative cost change that ends a solve. Default 1e-12.
   double function_tolerance = 1e-12;
+  // Ceres's gradient and parameter tolerances (max-norm of the projected
+  // gradient; relative step size) that also end a solve. Defaults 1e-14 and
+  // 1e-12: tight, so the solve stops on the cost change. > 0.
+  double gradient_tolerance = 1e-14;
+  double parameter_tolerance = 1e-12;
+  // The intrinsics' covariance is refused as singular when the smallest
+  // eigenvalue of their (Schur) information matrix is below this fraction of
+  // the largest. Default 1e-14. > 0.
+  double covariance_min_eigenvalue_ratio = 1e-14;
   // Threads for the Ceres solve and the covariance. Default 1. Only used
   // when `deterministic` is false: Ceres sums over residual blocks in the
   // order its threads finish, so a multi-threaded solve can differ in the
@@ -90,7 +103,8 @@ struct CalibrationOptions {
   double max_rms_px = 3.0;
 
   // Fit fx, fy, cx, cy first with the distortion held at zero, then all.
-  // Makes the start from the undistorted initialisation safer. Default true.
+  // Default false: every test scene converges from the initialisation
+  // without it.
   bool staged_distortion = false;
   // Compute the parameter covariance and standard deviations. Default true.
   bool compute_covariance = true;
@@ -132,7 +146,7 @@ struct CalibrationResult {
   double initialization_seconds = 0;
   std::string initialization_method;
   double orientation_spread_deg = 0;
-  double coverage = 0;  // fraction of coverage-grid cells with corners
+  double coverage = 0;      // fraction of coverage-grid cells with corners
   std::string termination;  // Ceres' message of the last solve
   std::string report;       // readable summary of all of the above
 };

@@ -1,10 +1,11 @@
 #include "calib/camera_yaml.h"
 
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
-
-#include <yaml-cpp/yaml.h>
 
 #include "calib/atomic_file.h"
 
@@ -57,7 +58,8 @@ bool CheckCamera(const Camera& camera, std::string* error) {
                 error);
   }
   for (double v : camera.params) {
-    if (!std::isfinite(v)) return Fail("the camera has non-finite parameters", error);
+    if (!std::isfinite(v))
+      return Fail("the camera has non-finite parameters", error);
   }
   if (camera.width <= 0 || camera.height <= 0) {
     return Fail("the camera has no image size", error);
@@ -90,8 +92,7 @@ std::string FormatPuzzlecal(const Camera& camera,
     }
     out << YAML::Key << "rms_px" << YAML::Value << stats.rms_px;
     out << YAML::Key << "views_used" << YAML::Value << stats.num_views_used;
-    out << YAML::Key << "corners_used" << YAML::Value
-        << stats.num_corners_used;
+    out << YAML::Key << "corners_used" << YAML::Value << stats.num_corners_used;
     out << YAML::Key << "outliers" << YAML::Value << stats.num_outliers;
   }
   out << YAML::EndMap;
@@ -104,8 +105,8 @@ std::string FormatOpenCv(const Camera& camera) {
   out.SetDoublePrecision(17);
   auto matrix = [&](const char* key, int rows, int cols,
                     const std::vector<double>& data) {
-    out << YAML::Key << key << YAML::Value << YAML::SecondaryTag("opencv-matrix")
-        << YAML::BeginMap;
+    out << YAML::Key << key << YAML::Value
+        << YAML::SecondaryTag("opencv-matrix") << YAML::BeginMap;
     out << YAML::Key << "rows" << YAML::Value << rows;
     out << YAML::Key << "cols" << YAML::Value << cols;
     out << YAML::Key << "dt" << YAML::Value << "d";
@@ -155,8 +156,7 @@ std::string FormatRos(const Camera& camera) {
   return std::string(out.c_str()) + "\n";
 }
 
-bool FormatKalibr(const Camera& camera, std::string* text,
-                  std::string* error) {
+bool FormatKalibr(const Camera& camera, std::string* text, std::string* error) {
   const auto& p = camera.params;
   std::vector<double> coeffs;
   const char* model = "radtan";
@@ -165,8 +165,7 @@ bool FormatKalibr(const Camera& camera, std::string* text,
       for (int k = 8; k < 12; ++k) {
         if (p[k] != 0) {
           return Fail("kalibr has no rational distortion model (k" +
-                          std::to_string(k - 5) + " = " +
-                          std::to_string(p[k]) +
+                          std::to_string(k - 5) + " = " + std::to_string(p[k]) +
                           "): write the opencv or ros format, or calibrate "
                           "pinhole-radtan with k3 fixed",
                       error);
@@ -175,11 +174,11 @@ bool FormatKalibr(const Camera& camera, std::string* text,
       [[fallthrough]];
     case CameraModelId::kPinholeRadtan:
       if (p[8] != 0) {
-        return Fail("kalibr's radtan model has no k3 (k3 = " +
-                        std::to_string(p[8]) +
-                        "): write the opencv or ros format, or calibrate "
-                        "with k3 fixed",
-                    error);
+        return Fail(
+            "kalibr's radtan model has no k3 (k3 = " + std::to_string(p[8]) +
+                "): write the opencv or ros format, or calibrate "
+                "with k3 fixed",
+            error);
       }
       coeffs = {p[4], p[5], p[6], p[7]};
       break;
@@ -190,8 +189,7 @@ bool FormatKalibr(const Camera& camera, std::string* text,
   }
   YAML::Emitter out;
   out.SetDoublePrecision(17);
-  out << YAML::BeginMap << YAML::Key << "cam0" << YAML::Value
-      << YAML::BeginMap;
+  out << YAML::BeginMap << YAML::Key << "cam0" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "camera_model" << YAML::Value << "pinhole";
   out << YAML::Key << "intrinsics" << YAML::Value;
   Flow(out, {p[0], p[1], p[2], p[3]});
@@ -220,8 +218,8 @@ class Reader {
     return false;
   }
 
-  bool Get(const YAML::Node& node, const std::string& field,
-           const char* key, YAML::Node* child) {
+  bool Get(const YAML::Node& node, const std::string& field, const char* key,
+           YAML::Node* child) {
     if (!node.IsMap() || !node[key]) return Fail(field, "missing");
     *child = node[key];
     return true;
@@ -261,8 +259,7 @@ class Reader {
     YAML::Node child;
     if (!Get(node, field, "data", &child)) return false;
     if (!Numbers(child, field + "/data", data)) return false;
-    if (rows > 0 && cols > 0 &&
-        static_cast<int>(data->size()) != rows * cols) {
+    if (rows > 0 && cols > 0 && static_cast<int>(data->size()) != rows * cols) {
       return Fail(field + "/data", "expected " + std::to_string(rows * cols) +
                                        " numbers, got " +
                                        std::to_string(data->size()));
@@ -306,14 +303,13 @@ class Reader {
                      size_t min_count, Camera* camera) {
     const size_t count = camera->params.size() - kDistortionBegin;
     if (d.size() < min_count || d.size() > count) {
-      return Fail(field, std::string("expected ") +
-                             (min_count == count ? std::to_string(count)
-                                                 : std::to_string(min_count) +
-                                                       " to " +
-                                                       std::to_string(count)) +
-                             " coefficients for " +
-                             CameraModelName(camera->model) + ", got " +
-                             std::to_string(d.size()));
+      return Fail(field,
+                  std::string("expected ") +
+                      (min_count == count ? std::to_string(count)
+                                          : std::to_string(min_count) + " to " +
+                                                std::to_string(count)) +
+                      " coefficients for " + CameraModelName(camera->model) +
+                      ", got " + std::to_string(d.size()));
     }
     for (size_t i = 0; i < d.size(); ++i) {
       camera->params[kDistortionBegin + i] = d[i];
@@ -326,8 +322,8 @@ class Reader {
     std::string name;
     if (!Scalar(node, field, &name)) return false;
     if (!CameraModelIdFromName(name, id)) {
-      return Fail(field, "unknown model '" + name + "' (known: " +
-                             CameraModelNames() + ")");
+      return Fail(field, "unknown model '" + name +
+                             "' (known: " + CameraModelNames() + ")");
     }
     return true;
   }
@@ -404,8 +400,10 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
   } else {
     // OpenCV's own files carry no model: tell it by the number of
     // coefficients (4 or 5: plumb_bob, 8: rational).
-    if (d.size() == 8) id = CameraModelId::kPinholeRational;
-    else if (d.size() == 4 || d.size() == 5) id = CameraModelId::kPinholeRadtan;
+    if (d.size() == 8)
+      id = CameraModelId::kPinholeRational;
+    else if (d.size() == 4 || d.size() == 5)
+      id = CameraModelId::kPinholeRadtan;
     else {
       return r.Fail("distortion_coefficients",
                     std::to_string(d.size()) +
@@ -432,8 +430,8 @@ bool ParseKalibr(const YAML::Node& root, Reader& r, Camera* camera) {
     return false;
   }
   if (camera_model != "pinhole") {
-    return r.Fail("cam0/camera_model", "only 'pinhole' is supported, got '" +
-                                           camera_model + "'");
+    return r.Fail("cam0/camera_model",
+                  "only 'pinhole' is supported, got '" + camera_model + "'");
   }
   if (!r.Get(cam, "cam0/distortion_model", "distortion_model", &node) ||
       !r.Scalar(node, "cam0/distortion_model", &distortion_model)) {
@@ -475,9 +473,14 @@ bool ParseKalibr(const YAML::Node& root, Reader& r, Camera* camera) {
       !r.Numbers(node, "cam0/resolution", &resolution)) {
     return false;
   }
-  if (resolution.size() != 2 || !(resolution[0] > 0) ||
-      !(resolution[1] > 0)) {
-    return r.Fail("cam0/resolution", "expected [width, height]");
+  // Whole numbers in a sane range before the cast (a double beyond int's
+  // range would make it undefined).
+  if (resolution.size() != 2 ||
+      !std::all_of(resolution.begin(), resolution.end(), [](double v) {
+        return v >= 1 && v <= 1e6 && v == std::floor(v);
+      })) {
+    return r.Fail("cam0/resolution",
+                  "expected [width, height], whole numbers in [1, 1000000]");
   }
   camera->width = static_cast<int>(resolution[0]);
   camera->height = static_cast<int>(resolution[1]);
@@ -538,8 +541,8 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      std::string* error) {
   std::string text, why;
   if (!FormatCameraFile(camera, stats, format, &text, &why)) {
-    return Fail("cannot write '" + path + "' (" +
-                    CameraFileFormatName(format) + " format): " + why,
+    return Fail("cannot write '" + path + "' (" + CameraFileFormatName(format) +
+                    " format): " + why,
                 error);
   }
   return WriteFileAtomically(path, text, error);
@@ -595,9 +598,11 @@ bool ParseCameraFile(const std::string& text, const std::string& source,
       found = CameraFileFormat::kOpenCv;
       ok = ParseOpenCvOrRos(root, reader, /*ros=*/false, &parsed);
     } else {
-      return Fail(source + ": not a camera file in any known format "
-                  "(puzzlecal, opencv, ros, kalibr): no 'parameters', "
-                  "'camera_matrix' or 'cam0'", error);
+      return Fail(source +
+                      ": not a camera file in any known format "
+                      "(puzzlecal, opencv, ros, kalibr): no 'parameters', "
+                      "'camera_matrix' or 'cam0'",
+                  error);
     }
   } catch (const YAML::Exception& e) {
     return Fail(source + ": " + e.what(), error);

@@ -1,15 +1,14 @@
 #include "calib/initialization.h"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <memory>
-
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
 
 #include "calib/reprojection_error.h"
 
@@ -287,8 +286,7 @@ bool ZhangFull(const std::vector<Eigen::Matrix3d>& homographies, double* fx,
 
 // Zhang's closed form with the principal point at the centre and square
 // pixels: one unknown f^2, linear least squares. Normalised units.
-bool ZhangCentred(const std::vector<Eigen::Matrix3d>& homographies,
-                  double* f) {
+bool ZhangCentred(const std::vector<Eigen::Matrix3d>& homographies, double* f) {
   double pq = 0, qq = 0;
   for (const Eigen::Matrix3d& h : homographies) {
     // h1' w h2 = 0 and h1' w h1 = h2' w h2 with w = diag(1, 1, f^2).
@@ -320,11 +318,10 @@ bool RefinePose(const Camera& camera, const CalibrationView& view,
   std::vector<double> intrinsics = camera.params;
   ceres::Problem problem;
   for (size_t i = 0; i < view.board_points.size(); ++i) {
-    problem.AddResidualBlock(
-        ReprojectionError<Model>::Create(view.board_points[i],
-                                         view.image_points[i]),
-        new ceres::HuberLoss(options.pose_refine_loss_px), intrinsics.data(),
-        pose);
+    problem.AddResidualBlock(ReprojectionError<Model>::Create(
+                                 view.board_points[i], view.image_points[i]),
+                             new ceres::HuberLoss(options.pose_refine_loss_px),
+                             intrinsics.data(), pose);
   }
   problem.SetParameterBlockConstant(intrinsics.data());
   ceres::Solver::Options solver_options;
@@ -339,8 +336,8 @@ bool RefinePose(const Camera& camera, const CalibrationView& view,
     return false;
   }
   Eigen::Matrix3d refined;
-  ceres::AngleAxisToRotationMatrix(pose,
-                                   ceres::ColumnMajorAdapter3x3(refined.data()));
+  ceres::AngleAxisToRotationMatrix(
+      pose, ceres::ColumnMajorAdapter3x3(refined.data()));
   cam_from_board->linear() = refined;
   cam_from_board->translation() = Eigen::Vector3d(pose[3], pose[4], pose[5]);
   return true;
@@ -352,11 +349,17 @@ bool InitializationOptions::Check(std::string* why) const {
   if (reweight_iterations < 0) {
     return Fail("initialization.reweight_iterations must be >= 0", why);
   }
-  if (!(reweight_k > 0)) return Fail("initialization.reweight_k must be > 0", why);
+  if (!(reweight_k > 0))
+    return Fail("initialization.reweight_k must be > 0", why);
+  if (!(max_focal_aspect >= 1)) {
+    return Fail("initialization.max_focal_aspect must be >= 1", why);
+  }
   if (!(focal_search_min_ratio > 0) ||
       !(focal_search_max_ratio > focal_search_min_ratio)) {
-    return Fail("initialization.focal_search_min_ratio must be > 0 and below "
-                "focal_search_max_ratio", why);
+    return Fail(
+        "initialization.focal_search_min_ratio must be > 0 and below "
+        "focal_search_max_ratio",
+        why);
   }
   if (focal_search_steps < 3) {
     return Fail("initialization.focal_search_steps must be >= 3", why);
@@ -393,8 +396,8 @@ bool EstimateBoardToRayHomography(const std::vector<Eigen::Vector2d>& board_xy,
   if (n < 4 || rays.size() != n) return false;
   std::vector<bool> use(n, false);
   for (size_t i = 0; i < n; ++i) {
-    use[i] = board_xy[i].allFinite() && rays[i].allFinite() &&
-             rays[i].norm() > 0.5;
+    use[i] =
+        board_xy[i].allFinite() && rays[i].allFinite() && rays[i].norm() > 0.5;
   }
   if (!PointsSpanPlane(board_xy, use)) return false;
   // Normalise the board coordinates (centroid, mean distance sqrt 2).
@@ -478,8 +481,8 @@ bool PoseFromBoardToRayHomography(const Eigen::Matrix3d& homography,
   r.col(1) = h.col(1) * scale;
   r.col(2) = r.col(0).cross(r.col(1));
   // The nearest rotation (polar decomposition).
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(r, Eigen::ComputeFullU |
-                                               Eigen::ComputeFullV);
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+      r, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
   if (rotation.determinant() < 0) {
     Eigen::Matrix3d u = svd.matrixU();
@@ -500,8 +503,7 @@ bool EstimateViewPose(const Camera& camera, const CalibrationView& view,
   if (options.pose_refine_iterations > 0) {
     // A failed refinement keeps the homography pose: it is still a start.
     DispatchCameraModel(camera.model, [&](auto model) {
-      return RefinePose<decltype(model)>(camera, view, options,
-                                         cam_from_board);
+      return RefinePose<decltype(model)>(camera, view, options, cam_from_board);
     });
   }
   return true;
@@ -534,18 +536,20 @@ bool InitializeCalibration(const std::vector<CalibrationView>& views,
     search_views = used;
   } else {
     for (int k = 0; k < max_views; ++k) {
-      search_views.push_back(used[static_cast<size_t>(k) * used.size() /
-                                  max_views]);
+      search_views.push_back(
+          used[static_cast<size_t>(k) * used.size() / max_views]);
     }
   }
 
   Camera camera;
   if (!initial_params.empty()) {
-    if (static_cast<int>(initial_params.size()) != CameraModelNumParams(model)) {
-      return Fail("initial parameters: " + std::to_string(initial_params.size()) +
-                      " values given, model " + CameraModelName(model) +
-                      " has " + std::to_string(CameraModelNumParams(model)),
-                  error);
+    if (static_cast<int>(initial_params.size()) !=
+        CameraModelNumParams(model)) {
+      return Fail(
+          "initial parameters: " + std::to_string(initial_params.size()) +
+              " values given, model " + CameraModelName(model) + " has " +
+              std::to_string(CameraModelNumParams(model)),
+          error);
     }
     camera.model = model;
     camera.width = width;
@@ -554,9 +558,8 @@ bool InitializeCalibration(const std::vector<CalibrationView>& views,
     result->method = "given by the caller";
   } else {
     double search_cost = 0;
-    const double f_search = SearchFocalLength(model, width, height,
-                                              search_views, options,
-                                              &search_cost);
+    const double f_search = SearchFocalLength(
+        model, width, height, search_views, options, &search_cost);
     camera = CandidateCamera(model, width, height, f_search);
     result->method = "focal-length search (f = " + std::to_string(f_search) +
                      " px, centred principal point)";
@@ -573,12 +576,12 @@ bool InitializeCalibration(const std::vector<CalibrationView>& views,
         full.params[1] = fy * scale;
         full.params[2] = cx0 + u0 * scale;
         full.params[3] = cy0 + v0 * scale;
-        const bool plausible = fx / fy > 0.5 && fx / fy < 2.0 &&
+        const bool plausible = fx / fy > 1.0 / options.max_focal_aspect &&
+                               fx / fy < options.max_focal_aspect &&
                                full.params[2] > 0 && full.params[2] < width &&
                                full.params[3] > 0 && full.params[3] < height;
-        const double cost =
-            plausible ? ViewFitCost(full, search_views, options)
-                      : std::numeric_limits<double>::infinity();
+        const double cost = plausible ? ViewFitCost(full, search_views, options)
+                                      : std::numeric_limits<double>::infinity();
         if (cost < best_cost) {
           best_cost = cost;
           camera = full;
@@ -609,8 +612,8 @@ bool InitializeCalibration(const std::vector<CalibrationView>& views,
       continue;
     }
     std::string view_why;
-    if (EstimateViewPose(camera, views[i], options,
-                         &result->cam_from_board[i], &view_why)) {
+    if (EstimateViewPose(camera, views[i], options, &result->cam_from_board[i],
+                         &view_why)) {
       result->view_ok[i] = true;
       normals.push_back(result->cam_from_board[i].linear().col(2));
     } else {
@@ -619,7 +622,8 @@ bool InitializeCalibration(const std::vector<CalibrationView>& views,
   }
   if (normals.empty()) {
     return Fail("no view gives a pose with the initial intrinsics (" +
-                    result->method + ")", error);
+                    result->method + ")",
+                error);
   }
   double spread = 0;
   for (size_t i = 0; i < normals.size(); ++i) {

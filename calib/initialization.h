@@ -11,14 +11,14 @@
 //   beyond 90 degrees, so for 190 degree lenses and partial views);
 // - per view: a pose "PnP through the model": pixels are unprojected to rays
 //   with the current intrinsics, a board-to-ray homography gives the pose,
-//   and a small robust Ceres refinement polishes it.
+//   optionally polished by a small robust Ceres refinement
+//   (pose_refine_iterations > 0; off by default).
 // Every estimate is robust to a few gross outliers (iteratively reweighted).
-
-#include <string>
-#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <string>
+#include <vector>
 
 #include "calib/calibration_view.h"
 #include "calib/camera_models.h"
@@ -50,6 +50,10 @@ struct InitializationOptions {
   // At most this many views (evenly spread over the input) take part in the
   // focal search; all views get a pose afterwards. Default 60.
   int focal_search_max_views = 60;
+  // Zhang's full solution (fx, fy, cx, cy free) is kept as a candidate only
+  // when fx / fy lies in [1 / max_focal_aspect, max_focal_aspect] and the
+  // principal point inside the image. Default 2. >= 1.
+  double max_focal_aspect = 2.0;
   // Iterations of the per-view pose refinement (Ceres, Huber loss) after the
   // homography pose. Default 0: the bundle adjustment refines the poses
   // anyway, and the homography pose is close enough to start it.
@@ -62,11 +66,11 @@ struct InitializationOptions {
 
 // What the initialisation produced and how.
 struct InitializationResult {
-  Camera camera;                                // starting intrinsics
-  std::vector<bool> view_ok;                    // pose found for the view
+  Camera camera;                                  // starting intrinsics
+  std::vector<bool> view_ok;                      // pose found for the view
   std::vector<Eigen::Isometry3d> cam_from_board;  // per view (identity if !ok)
-  std::vector<std::string> view_reason;         // why a view has no pose
-  std::string method;                           // how the intrinsics were made
+  std::vector<std::string> view_reason;           // why a view has no pose
+  std::string method;  // how the intrinsics were made
   // Largest angle between the board normals of two posed views, degrees: a
   // small value means the focal length is poorly determined.
   double orientation_spread_deg = 0;

@@ -36,6 +36,10 @@ bool Board::Check(std::string* why) const {
   if (cols < 2 || rows < 2) {
     return fail("cols and rows must both be >= 2 (inner corners)");
   }
+  if (cols > kMaxBoardSide || rows > kMaxBoardSide) {
+    return fail("cols and rows must be <= " + std::to_string(kMaxBoardSide) +
+                " (inner corners; a typo?)");
+  }
   if (!(std::isfinite(tile_size_m) && tile_size_m > 0.0)) {
     return fail("tile_size_m must be a positive number of metres");
   }

@@ -18,6 +18,11 @@ bool BoardTypeFromName(const std::string& name, BoardType* type);
 
 // Geometry of a printed target. Corner id (col, row) sits at
 // (col * tile_size_m, row * tile_size_m, 0) in the board frame.
+// Largest number of inner corners along one side that a board file may give
+// (a checkerboard; a PuzzleBoard is limited to 501 by its code). Bounds
+// memory and work for a mistyped size.
+inline constexpr int kMaxBoardSide = 2000;
+
 struct Board {
   // Which pattern is printed.
   BoardType type = BoardType::kPuzzleBoard;

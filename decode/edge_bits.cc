@@ -30,11 +30,14 @@ class Sampler {
 
   bool Sample(const Eigen::Vector2d& p, double* value) const {
     const double x = p.x(), y = p.y();
-    if (!(x >= 0.0 && y >= 0.0 && x <= image_.cols - 1 && y <= image_.rows - 1)) {
+    if (!(x >= 0.0 && y >= 0.0 && x <= image_.cols - 1 &&
+          y <= image_.rows - 1)) {
       return false;
     }
-    const int x0 = std::min(static_cast<int>(x), image_.cols - 2 < 0 ? 0 : image_.cols - 2);
-    const int y0 = std::min(static_cast<int>(y), image_.rows - 2 < 0 ? 0 : image_.rows - 2);
+    const int x0 = std::min(static_cast<int>(x),
+                            image_.cols - 2 < 0 ? 0 : image_.cols - 2);
+    const int y0 = std::min(static_cast<int>(y),
+                            image_.rows - 2 < 0 ? 0 : image_.rows - 2);
     const int x1 = std::min(x0 + 1, image_.cols - 1);
     const int y1 = std::min(y0 + 1, image_.rows - 1);
     const double fx = x - x0, fy = y - y0;
@@ -146,14 +149,16 @@ bool BuildLabelLattice(const std::vector<Corner>& corners,
   return true;
 }
 
-std::vector<int> LatticeOutliers(const LabelLattice& lattice, double max_deviation) {
+std::vector<int> LatticeOutliers(const LabelLattice& lattice,
+                                 double max_deviation) {
   std::vector<int> outliers;
   for (size_t k = 0; k < lattice.xy.size(); ++k) {
     const Eigen::Vector2i a = lattice.label[k];
     const Eigen::Vector2d& p = lattice.xy[k];
     int good = 0, bad = 0;
     for (int axis = 0; axis < 2; ++axis) {
-      const Eigen::Vector2i e = axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1);
+      const Eigen::Vector2i e =
+          axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1);
       const int prev = lattice.At(a - e), next = lattice.At(a + e);
       const int prev2 = lattice.At(a - 2 * e), next2 = lattice.At(a + 2 * e);
       Eigen::Vector2d predicted;
@@ -233,8 +238,10 @@ EdgeBitReading ReadEdgeBits(const LabelLattice& lattice, const cv::Mat& image,
   for (size_t k = 0; k < lattice.xy.size(); ++k) {
     const Eigen::Vector2i a = lattice.label[k];
     for (int axis = 0; axis < 2; ++axis) {
-      const Eigen::Vector2i e = axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1);
-      const Eigen::Vector2i f = axis == 0 ? Eigen::Vector2i(0, 1) : Eigen::Vector2i(1, 0);
+      const Eigen::Vector2i e =
+          axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1);
+      const Eigen::Vector2i f =
+          axis == 0 ? Eigen::Vector2i(0, 1) : Eigen::Vector2i(1, 0);
       const Eigen::Vector2i b = a + e;
       const Eigen::Vector2d* pb = point(b);
       if (pb == nullptr) continue;
@@ -280,7 +287,7 @@ EdgeBitReading ReadEdgeBits(const LabelLattice& lattice, const cv::Mat& image,
           centre[side] = mid + (side == 0 ? 0.5 : -0.5) * across;
         }
       }
-      double level[2];
+      double level[2] = {0.0, 0.0};
       bool ok = SampleStencil(sampler, centre[0], along, across,
                               options.tile_sample_offset, &level[0]) &&
                 SampleStencil(sampler, centre[1], along, across,
@@ -301,7 +308,8 @@ EdgeBitReading ReadEdgeBits(const LabelLattice& lattice, const cv::Mat& image,
         edge.read = std::abs(edge.confidence) >= options.min_confidence;
         // The tile on side +f has min corner a (axis 0: tile (i, j); axis 1:
         // tile (i, j)) and the one on side -f has min corner a - f.
-        const Eigen::Vector2i dark_tile = level[0] < level[1] ? a : Eigen::Vector2i(a - f);
+        const Eigen::Vector2i dark_tile =
+            level[0] < level[1] ? a : Eigen::Vector2i(a - f);
         ++parity_votes[(dark_tile.x() + dark_tile.y()) & 1];
       }
       if (edge.read) ++reading.num_read;

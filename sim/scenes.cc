@@ -111,11 +111,25 @@ bool SceneSpec::Check(std::string* why) const {
     if (why != nullptr) *why = message;
     return false;
   };
+  // Names become file names (scene_view.png): plain names only.
+  auto plain_name = [](const std::string& text) {
+    return !text.empty() && text.front() != '.' &&
+           text.find_first_of("/\\") == std::string::npos &&
+           text.find('\0') == std::string::npos;
+  };
+  if (!plain_name(name)) {
+    return fail("name: '" + name +
+                "' must be non-empty, without / or \\, not starting with .");
+  }
   std::string reason;
   if (!CheckRenderCamera(camera, &reason)) return fail("camera: " + reason);
   if (!board.Check(&reason)) return fail("board: " + reason);
   if (!render.Check(&reason)) return fail("render: " + reason);
   for (size_t i = 0; i < views.size(); ++i) {
+    if (!plain_name(views[i].name)) {
+      return fail("views[" + std::to_string(i) + "].name: '" + views[i].name +
+                  "' must be non-empty, without / or \\, not starting with .");
+    }
     const Eigen::Matrix3d r = views[i].cam_from_board.linear();
     if (!views[i].cam_from_board.matrix().allFinite() ||
         (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() > 1e-6 ||

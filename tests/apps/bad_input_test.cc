@@ -650,6 +650,37 @@ TEST_F(BadInputTest, UnknownModelName) {
   EXPECT_FALSE(fs::exists(camera));
 }
 
+// Command-line mistakes: exit 2 with a message naming the flag or argument,
+// and nothing written.
+TEST_F(BadInputTest, BadFlagsExitTwoAndNameTheFlag) {
+  const fs::path out = case_dir_ / "detections.yaml";
+  const std::string images = Quote((*root_ / "good").string());
+  struct Case {
+    std::string arguments;
+    std::string named;  // must appear in the message
+  };
+  for (const Case& c : std::vector<Case>{
+           {"detect --images " + images + " --out " + Quote(out.string()) +
+                " --nosuchflag=1",
+            "--nosuchflag"},
+           {"detect --images " + images + " --out " + Quote(out.string()) +
+                " --threads=abc",
+            "abc"},
+           {"detect --images " + images + " --out " + Quote(out.string()) +
+                " --dpi 300",
+            "--dpi"},
+           {"detect --images " + images + " --out " + Quote(out.string()) +
+                " stray",
+            "stray"},
+           {"detect --images " + images + " --out", "--out"},
+       }) {
+    const RunResult run = Run(c.arguments);
+    EXPECT_EQ(run.exit_code, kExitUsage) << c.arguments << "\n" << run.all();
+    EXPECT_NE(run.err.find(c.named), std::string::npos) << run.err;
+    EXPECT_FALSE(fs::exists(out)) << c.arguments;
+  }
+}
+
 // The output goes to a missing folder, below a regular file, or (when not
 // root) into a read-only folder: output error, nothing half-written.
 TEST_F(BadInputTest, UnwritableOutput) {
@@ -700,6 +731,15 @@ TEST_F(BadInputTest, TooFewViewsWritesNothing) {
   for (const std::string& file : FilesUnder(case_dir_)) {
     EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
   }
+
+  // With --report the failure is still exit 4, and the report says why.
+  const fs::path report = case_dir_ / "report";
+  const RunResult reported =
+      Calibrate(folder, camera, "--report " + Quote(report.string()));
+  EXPECT_EQ(reported.exit_code, kExitNoResult) << reported.all();
+  EXPECT_FALSE(fs::exists(camera));
+  const std::string summary = ReadFile(report / "summary.md");
+  EXPECT_NE(summary.find("usable view"), std::string::npos) << summary;
 }
 
 }  // namespace

@@ -132,6 +132,59 @@ TEST_F(ImageIoTest, RefusesBadFilesWithTheReason) {
   }
 }
 
+// Phone JPEGs: an EXIF thumbnail (a complete JPEG inside APP1) before the
+// image and data appended after its end-of-image marker. The file loads with
+// the trailer; with the main image cut in half it is refused although the
+// thumbnail inside it is complete.
+TEST_F(ImageIoTest, JpegWithThumbnailAndTrailer) {
+  cv::imwrite(Path("main.jpg"), ramp_);
+  cv::Mat small;
+  cv::resize(ramp_, small, cv::Size(15, 10));
+  cv::imwrite(Path("thumb.jpg"), small);
+  const std::string main_jpg = ReadBytes("main.jpg");
+  const std::string payload =
+      std::string("Exif\0\0", 6) + ReadBytes("thumb.jpg");
+  const size_t length = payload.size() + 2;
+  ASSERT_LT(length, 65536u);
+  const std::string app1 = std::string("\xFF\xE1") +
+                           static_cast<char>(length >> 8) +
+                           static_cast<char>(length & 0xFF) + payload;
+  const std::string with_thumbnail =
+      main_jpg.substr(0, 2) + app1 + main_jpg.substr(2);
+  std::string trailer(3000, '\0');
+  for (size_t k = 0; k < trailer.size(); ++k) {
+    trailer[k] = static_cast<char>((k * 7919 + 13) >> 2);  // includes FF DA
+  }
+  WriteBytes("phone.jpg", with_thumbnail + trailer);
+  WriteBytes("cut.jpg", with_thumbnail.substr(
+                            0, app1.size() + 2 + (main_jpg.size() - 2) / 2));
+  cv::Mat grey;
+  std::string error;
+  ASSERT_TRUE(LoadGreyImage(Path("phone.jpg"), {}, &grey, &error)) << error;
+  EXPECT_EQ(grey.size(), ramp_.size());
+  EXPECT_FALSE(LoadGreyImage(Path("cut.jpg"), {}, &grey, &error));
+  EXPECT_NE(error.find("truncated JPEG"), std::string::npos) << error;
+}
+
+// A PNG whose header claims 20000 x 20000 pixels is refused from the header,
+// before any decoding (the file holds no image data at all).
+TEST_F(ImageIoTest, RefusesAHugePngFromItsHeader) {
+  auto big_endian = [](uint32_t v) {
+    return std::string{static_cast<char>(v >> 24), static_cast<char>(v >> 16),
+                       static_cast<char>(v >> 8), static_cast<char>(v)};
+  };
+  const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + big_endian(13) +
+                          "IHDR" + big_endian(20000) + big_endian(20000) +
+                          std::string("\x08\0\0\0\0", 5) + big_endian(0) +
+                          big_endian(0) + "IEND" + big_endian(0xAE426082u);
+  WriteBytes("bomb.png", png);
+  cv::Mat grey;
+  std::string error;
+  EXPECT_FALSE(LoadGreyImage(Path("bomb.png"), {}, &grey, &error));
+  EXPECT_NE(error.find("20000x20000"), std::string::npos) << error;
+  EXPECT_NE(error.find("exceeds"), std::string::npos) << error;
+}
+
 TEST_F(ImageIoTest, RefusesImagesAboveThePixelLimit) {
   cv::imwrite(Path("ramp.png"), ramp_);
   ImageLoadOptions options;

@@ -311,7 +311,7 @@ TEST(ReportTest, FisheyeRunWithMissingImagesStillWritesEverything) {
   SyntheticRun run;
   MakeRun(scene, dir / "missing", /*render=*/false, &run);
   ASSERT_TRUE(run.calibrated) << run.calibrate_error;
-  // The lead reports a failed run too: the summary must say so.
+  // A failed run is reported too: the summary must say so.
   run.input.calibration_ok = false;
   run.input.calibration_error = "too few views tilted by 30 deg or more";
   ReportOptions options;

@@ -245,6 +245,13 @@ TEST(BoardGeometry, CheckRejectsBadFields) {
   EXPECT_TRUE(board.Check(&why)) << why;
   board.origin = Eigen::Vector2i(1, 0);
   EXPECT_FALSE(board.Check(&why));
+  // A mistyped checkerboard size is refused, not looped over.
+  board.origin = Eigen::Vector2i::Zero();
+  board.cols = 2000;
+  EXPECT_TRUE(board.Check(&why)) << why;
+  board.cols = 110000;
+  EXPECT_FALSE(board.Check(&why));
+  EXPECT_NE(why.find("2000"), std::string::npos) << why;
 }
 
 TEST(BoardGeometry, ContainsPointAndAllIds) {

@@ -155,6 +155,19 @@ TEST(ScenesTest, BadScenesSayWhy) {
   scene.tilt_series.view_angles_deg.push_back(95.0);
   EXPECT_FALSE(scene.Check(&why));
   EXPECT_NE(why.find("tilt_series"), std::string::npos) << why;
+  // Names become file names: nothing that leaves the output folder.
+  for (const std::string bad : {"../x", "a/b", ".hidden", ""}) {
+    scene = WidePinholeScene(200, 150);
+    scene.name = bad;
+    EXPECT_FALSE(scene.Check(&why)) << bad;
+    EXPECT_NE(why.find("name"), std::string::npos) << why;
+  }
+  scene = WidePinholeScene(200, 150);
+  SceneViewSpec escaping;
+  escaping.name = "../../escape";
+  scene.views.insert(scene.views.begin(), escaping);
+  EXPECT_FALSE(scene.Check(&why));
+  EXPECT_NE(why.find("views[0].name"), std::string::npos) << why;
 }
 
 }  // namespace
