@@ -74,7 +74,7 @@ PositionSearchResult SearchPuzzleBoardPosition(
     const Eigen::Vector2i& label_max, int handedness, int dark_tile_parity,
     const Board& board, bool inverted = false);
 
-// The code bit of label edge `vote` under `map` (board edge rules of SPEC.md).
+// The code bit of label edge `vote` under `map` (board edge rules of docs/puzzleboard.md).
 int BoardBitOfLabelEdge(const LabelToBoard& map, const Eigen::Vector2i& from,
                         int axis);
 

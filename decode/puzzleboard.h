@@ -1,7 +1,7 @@
 #ifndef PUZZLECAL_DECODE_PUZZLEBOARD_H_
 #define PUZZLECAL_DECODE_PUZZLEBOARD_H_
 
-// The PuzzleBoard pattern as SPEC.md defines it: edge bits from the A and B
+// The PuzzleBoard pattern as docs/puzzleboard.md defines it: edge bits from the A and B
 // codes, tile colours, ids on the 501 x 501 torus.
 
 #include "decode/puzzleboard_codes.h"

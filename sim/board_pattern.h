@@ -25,7 +25,7 @@ enum class BoardInk : uint8_t {
 
 // Extent of a printed pattern in tile units of the corner-id frame (corner
 // (x, y) at (x, y)): PuzzleBoard pages end half a tile outside the outermost
-// corners (SPEC.md, 'Printed boards'); checkerboards have full border tiles.
+// corners (docs/puzzleboard.md, 'Printed boards'); checkerboards have full border tiles.
 struct PatternExtent {
   double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
 };

@@ -1,7 +1,7 @@
 #ifndef PUZZLECAL_SIM_PRINT_BOARD_H_
 #define PUZZLECAL_SIM_PRINT_BOARD_H_
 
-// Printable boards, laid out as SPEC.md's 'Printed boards' section says: the
+// Printable boards, laid out as docs/puzzleboard.md's 'Printed boards' section says: the
 // page is W x H tiles (W x H = cols x rows corners), corner (x0 + i, y0 + j)
 // sits at ((i + 1/2) s, (j + 1/2) s) from the top-left page corner, the
 // border tiles are half tiles, and every edge between two printed corners

@@ -50,7 +50,7 @@ struct RenderOptions {
   double background_level = 0.45;
   // White paper around the printed pattern, in tiles. The pattern itself
   // ends half a tile outside the outermost inner corners for a PuzzleBoard
-  // (SPEC.md's half border tiles) and one full tile outside for a plain
+  // (docs/puzzleboard.md's half border tiles) and one full tile outside for a plain
   // checkerboard; this margin comes on top. >= 0.
   double paper_margin_tiles = 1.0;
   // Linear lighting gradient across the image: relative change of brightness

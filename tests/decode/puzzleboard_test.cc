@@ -1,5 +1,5 @@
 // The embedded PuzzleBoard tables against the published codes.txt, and the
-// facts SPEC.md states about them, recomputed from the tables.
+// facts docs/puzzleboard.md states about them, recomputed from the tables.
 
 #include "decode/puzzleboard.h"
 
@@ -73,9 +73,30 @@ TEST(PuzzleBoardCodes, EmbeddedTablesMatchPublishedCodesFile) {
   EXPECT_EQ(rows_seen, 2 * kPuzzleBoardCodeRows);
 }
 
+// Runs without the codes file too: the FNV-1a 64-bit hash of the published
+// codes.txt rows, canonicalised as "A0 <167 bits>\n" ... "B2 <167 bits>\n"
+// (computed from that file, not from these tables), must match the tables.
+TEST(PuzzleBoardCodes, EmbeddedTablesHashToThePublishedCodes) {
+  constexpr uint64_t kPublishedCodesFnv1a = 0x2e161139c3baae29ull;
+  std::string text;
+  for (const char letter : {'A', 'B'}) {
+    for (int row = 0; row < kPuzzleBoardCodeRows; ++row) {
+      text +=
+          std::string(1, letter) + std::to_string(row) + " " +
+          (letter == 'A' ? kPuzzleBoardCodeA[row] : kPuzzleBoardCodeB[row]) +
+          "\n";
+    }
+  }
+  uint64_t hash = 0xcbf29ce484222325ull;
+  for (const unsigned char c : text) {
+    hash = (hash ^ c) * 0x100000001b3ull;
+  }
+  EXPECT_EQ(hash, kPublishedCodesFnv1a);
+}
+
 TEST(PuzzleBoardCodes, EdgeBitsFollowSpecTableAndWrap) {
-  // SPEC.md: vertical (x,y)->(x,y+1) is A[y mod 3][x mod 167], horizontal
-  // (x,y)->(x+1,y) is B[x mod 3][y mod 167]; ids wrap mod 501.
+  // docs/puzzleboard.md: vertical (x,y)->(x,y+1) is A[y mod 3][x mod 167],
+  // horizontal (x,y)->(x+1,y) is B[x mod 3][y mod 167]; ids wrap mod 501.
   EXPECT_EQ(PuzzleBoardVerticalEdgeBit(5, 7),
             kPuzzleBoardCodeA[7 % 3][5] == '1' ? 1 : 0);
   EXPECT_EQ(PuzzleBoardHorizontalEdgeBit(170, 200),
@@ -214,7 +235,7 @@ TEST(PuzzleBoardFacts, FourByFourWindowsUniqueUpToRotation) {
 }
 
 TEST(PuzzleBoardFacts, ThreeByThreeRotationFiguresOfSpec) {
-  // SPEC.md: 98.67 % (bits only), 99.36 % (bits + tile colour).
+  // docs/puzzleboard.md: 98.67 % (bits only), 99.36 % (bits + tile colour).
   EXPECT_NEAR(FractionUniqueUpToRotation(3, false), 0.9867, 0.00005);
   EXPECT_NEAR(FractionUniqueUpToRotation(3, true), 0.9936, 0.00005);
 }
