@@ -99,6 +99,9 @@ std::string FormatPuzzlecal(const Camera& camera,
   return std::string("# puzzlecal camera calibration\n") + out.c_str() + "\n";
 }
 
+// Key of a kannala-brandt camera's coefficients in the opencv format.
+constexpr char kOpenCvFisheyeKey[] = "fisheye_distortion_coefficients";
+
 // OpenCV's FileStorage wants "%YAML:1.0" and its own matrix tag.
 std::string FormatOpenCv(const Camera& camera) {
   YAML::Emitter out;
@@ -120,8 +123,15 @@ std::string FormatOpenCv(const Camera& camera) {
   out << YAML::Key << "image_height" << YAML::Value << camera.height;
   matrix("camera_matrix", 3, 3, CameraMatrix(camera));
   const std::vector<double> distortion = Distortion(camera);
-  matrix("distortion_coefficients", 1, static_cast<int>(distortion.size()),
-         distortion);
+  // A fisheye's k1..k4 under OpenCV's usual key would be read as pinhole
+  // k1 k2 p1 p2 by cv::undistort and friends; its own key (the D of
+  // cv::fisheye) makes pinhole readers fail loudly instead.
+  const bool fisheye = camera.model == CameraModelId::kKannalaBrandt;
+  if (fisheye) {
+    out << YAML::Key << "distortion_model" << YAML::Value << "fisheye";
+  }
+  matrix(fisheye ? kOpenCvFisheyeKey : "distortion_coefficients", 1,
+         static_cast<int>(distortion.size()), distortion);
   out << YAML::EndMap;
   return std::string("%YAML:1.0\n---\n") + out.c_str() + "\n";
 }
@@ -372,9 +382,11 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
       !r.Matrix(node, "camera_matrix", 3, 3, &k)) {
     return false;
   }
-  if (!r.Get(root, "distortion_coefficients", "distortion_coefficients",
-             &node) ||
-      !r.Matrix(node, "distortion_coefficients", 0, 0, &d)) {
+  const char* distortion_key =
+      !ros && root[kOpenCvFisheyeKey] ? kOpenCvFisheyeKey
+                                      : "distortion_coefficients";
+  if (!r.Get(root, distortion_key, distortion_key, &node) ||
+      !r.Matrix(node, distortion_key, 0, 0, &d)) {
     return false;
   }
   if (ros) {
@@ -397,6 +409,17 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
     }
   } else if (root["model"]) {
     if (!r.Model(root["model"], "model", &id)) return false;
+    if ((id == CameraModelId::kKannalaBrandt) !=
+        (distortion_key == std::string(kOpenCvFisheyeKey))) {
+      return r.Fail(distortion_key,
+                    std::string("model ") + CameraModelName(id) +
+                        (id == CameraModelId::kKannalaBrandt
+                             ? " keeps its coefficients under "
+                             : " cannot use ") +
+                        kOpenCvFisheyeKey);
+    }
+  } else if (distortion_key == std::string(kOpenCvFisheyeKey)) {
+    id = CameraModelId::kKannalaBrandt;
   } else {
     // OpenCV's own files carry no model: tell it by the number of
     // coefficients (4 or 5: plumb_bob, 8: rational).
@@ -417,7 +440,8 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
   const size_t count = camera->params.size() - kDistortionBegin;
   // plumb_bob may omit k3; the other models need all coefficients.
   const size_t min_count = id == CameraModelId::kPinholeRadtan ? 4 : count;
-  return r.SetDistortion(d, "distortion_coefficients/data", min_count, camera);
+  return r.SetDistortion(d, std::string(distortion_key) + "/data", min_count,
+                         camera);
 }
 
 bool ParseKalibr(const YAML::Node& root, Reader& r, Camera* camera) {
@@ -591,7 +615,7 @@ bool ParseCameraFile(const std::string& text, const std::string& source,
     } else if (root["cam0"]) {
       found = CameraFileFormat::kKalibr;
       ok = ParseKalibr(root, reader, &parsed);
-    } else if (root["distortion_model"]) {
+    } else if (root["distortion_model"] && !opencv_header) {
       found = CameraFileFormat::kRos;
       ok = ParseOpenCvOrRos(root, reader, /*ros=*/true, &parsed);
     } else if (opencv_header || root["camera_matrix"]) {

@@ -1,14 +1,13 @@
 #include "calib/camera_yaml.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cstdio>
 #include <fstream>
-#include <string>
-
-#include <gtest/gtest.h>
 #include <opencv2/core.hpp>
-#include <yaml-cpp/yaml.h>
+#include <string>
 
 #include "calib/atomic_file.h"
 
@@ -22,8 +21,8 @@ Camera MakeCamera(CameraModelId id) {
   camera.height = 960;
   switch (id) {
     case CameraModelId::kPinholeRadtan:
-      camera.params = {820.125, 818.5, 642.3, 477.1, -0.28, 0.09, 6e-4, -4e-4,
-                       -0.012};
+      camera.params = {820.125, 818.5, 642.3, 477.1, -0.28,
+                       0.09,    6e-4,  -4e-4, -0.012};
       break;
     case CameraModelId::kPinholeRational:
       camera.params = {760.0, 761.2, 637.8, 482.6, 0.3,  0.02,
@@ -41,8 +40,7 @@ class CameraYamlTest : public ::testing::Test {
  protected:
   void SetUp() override {
     char pattern[] = "camera_yaml_test_XXXXXX";
-    const std::string base =
-        std::string(::testing::TempDir()) + "/" + pattern;
+    const std::string base = std::string(::testing::TempDir()) + "/" + pattern;
     std::vector<char> name(base.begin(), base.end());
     name.push_back('\0');
     ASSERT_NE(mkdtemp(name.data()), nullptr);
@@ -105,8 +103,8 @@ TEST_F(CameraYamlTest, PuzzlecalFormatCarriesTheStatistics) {
   result.num_outliers = 3;
   const std::string path = Path("camera.yaml");
   std::string error;
-  ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kPuzzlecal, result,
-                              &error))
+  ASSERT_TRUE(
+      WriteCameraFile(path, CameraFileFormat::kPuzzlecal, result, &error))
       << error;
   // Read back with a plain YAML reader: the fields are where they belong.
   const YAML::Node root = YAML::LoadFile(path);
@@ -134,7 +132,16 @@ TEST_F(CameraYamlTest, OpenCvFormatIsReadableByFileStorage) {
     ASSERT_TRUE(fs.isOpened());
     cv::Mat k, d;
     fs["camera_matrix"] >> k;
-    fs["distortion_coefficients"] >> d;
+    // A fisheye keeps its k1..k4 (cv::fisheye's D) under its own key, so
+    // that pinhole readers cannot take them for k1 k2 p1 p2.
+    const bool fisheye = id == CameraModelId::kKannalaBrandt;
+    fs[fisheye ? "fisheye_distortion_coefficients"
+               : "distortion_coefficients"] >>
+        d;
+    EXPECT_EQ(fs["distortion_coefficients"].empty(), fisheye);
+    if (fisheye) {
+      EXPECT_EQ(static_cast<std::string>(fs["distortion_model"]), "fisheye");
+    }
     ASSERT_EQ(k.rows, 3);
     ASSERT_EQ(k.cols, 3);
     EXPECT_EQ(k.at<double>(0, 0), camera.params[0]);
@@ -186,12 +193,12 @@ TEST_F(CameraYamlTest, RosFileHasCameraInfoFields) {
     EXPECT_NE(text.find(field), std::string::npos) << field << "\n" << text;
   }
   ASSERT_TRUE(FormatCameraFile(MakeCamera(CameraModelId::kKannalaBrandt),
-                               CameraFileStats(), CameraFileFormat::kRos,
-                               &text, &error));
+                               CameraFileStats(), CameraFileFormat::kRos, &text,
+                               &error));
   EXPECT_NE(text.find("distortion_model: equidistant"), std::string::npos);
   ASSERT_TRUE(FormatCameraFile(MakeCamera(CameraModelId::kPinholeRadtan),
-                               CameraFileStats(), CameraFileFormat::kRos,
-                               &text, &error));
+                               CameraFileStats(), CameraFileFormat::kRos, &text,
+                               &error));
   EXPECT_NE(text.find("distortion_model: plumb_bob"), std::string::npos);
 }
 
@@ -278,7 +285,8 @@ TEST_F(CameraYamlTest, FormatNames) {
        {CameraFileFormat::kPuzzlecal, CameraFileFormat::kOpenCv,
         CameraFileFormat::kRos, CameraFileFormat::kKalibr}) {
     CameraFileFormat parsed;
-    ASSERT_TRUE(CameraFileFormatFromName(CameraFileFormatName(format), &parsed));
+    ASSERT_TRUE(
+        CameraFileFormatFromName(CameraFileFormatName(format), &parsed));
     EXPECT_EQ(parsed, format);
   }
   CameraFileFormat parsed;
