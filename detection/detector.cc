@@ -48,6 +48,13 @@ bool DetectorOptions::Check(std::string* why) const {
     return fail("min_ring_contrast must be >= 0");
   if (!(max_ring_asymmetry > 0.0))
     return fail("max_ring_asymmetry must be > 0");
+  if (!(max_ring_asymmetry_clean > 0.0)) {
+    return fail("max_ring_asymmetry_clean must be > 0");
+  }
+  if (!(min_ring_second_harmonic_clean >= 0.0 &&
+        min_ring_second_harmonic_clean <= 1.0)) {
+    return fail("min_ring_second_harmonic_clean must be in [0, 1]");
+  }
   if (!(min_ring_second_harmonic >= 0.0 && min_ring_second_harmonic <= 1.0)) {
     return fail("min_ring_second_harmonic must be in [0, 1]");
   }
@@ -108,9 +115,37 @@ struct Workspace {
   cv::Mat single;                // one-channel input (colour converted)
   cv::Mat finite;                // float input with non-finite pixels zeroed
   std::vector<cv::Mat> blurred;  // per level, CV_32FC1, grey in [0, 1]
-  cv::Mat response;
+  std::vector<float> response_rows;  // ring of response rows
   std::vector<float> scratch;
 };
+
+// Largest pixel value of a one-channel image (a loop the compiler
+// vectorises; cv::minMaxLoc also tracks locations).
+template <typename Pixel>
+double MaxValueOf(const cv::Mat& image) {
+  Pixel best = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    const Pixel* __restrict row = image.ptr<Pixel>(y);
+    Pixel row_max = 0;
+    for (int x = 0; x < image.cols; ++x) row_max = std::max(row_max, row[x]);
+    best = std::max(best, row_max);
+  }
+  return static_cast<double>(best);
+}
+
+double MaxValue(const cv::Mat& image) {
+  switch (image.depth()) {
+    case CV_8U:
+      return MaxValueOf<uint8_t>(image);
+    case CV_16U:
+      return MaxValueOf<uint16_t>(image);
+    default: {
+      double max_value = 0.0;
+      cv::minMaxLoc(image, nullptr, &max_value);
+      return max_value;
+    }
+  }
+}
 
 // Picks the one-channel, finite version of the input and the grey value
 // that maps to 1.0. Returns false with a reason for unsupported types.
@@ -158,8 +193,7 @@ bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
   }
   double scale = full_scale;
   if (normalize_by_max) {
-    double max_value = 0.0;
-    cv::minMaxLoc(**single, nullptr, &max_value);
+    const double max_value = MaxValue(**single);
     if (max_value > 0.0) scale = max_value;
   }
   *normalizer = scale;
@@ -320,36 +354,34 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
   s.levels_used = std::max(0, levels - options.first_level);
   // Pixel noise of the input, grey normalised to [0, 1].
   const double noise = options.ring_noise_factor > 0.0
-                           ? NoiseSigma(*single, 7, &ws.scratch) / s.normalizer
+                           ? NoiseSigma(*single, 11, &ws.scratch) / s.normalizer
                            : 0.0;
   s.noise_sigma = noise;
   s.ms_preprocess = MsSince(t);
 
   // --- per level: response, threshold, NMS, filters ---
   std::vector<Candidate> candidates;
-  cv::Mat& response = ws.response;
   std::vector<float>& scratch = ws.scratch;
   std::vector<ResponsePeak> peaks;
   for (int l = options.first_level; l < levels; ++l) {
     t = Clock::now();
-    ComputeSaddleResponse(
-        blurred[l], static_cast<float>(options.trace_weight_k), &response);
-    s.ms_response += MsSince(t);
-
-    t = Clock::now();
+    const float k = static_cast<float>(options.trace_weight_k);
     double threshold = options.min_response;
     if (options.noise_response_factor > 0.0) {
-      const double median = SampledMedian(response, 8, &scratch);
+      const double median = SampledResponseMedian(blurred[l], k, 12, &scratch);
       threshold = std::max(threshold,
                            options.noise_response_factor * std::sqrt(median));
     }
     if (l == options.first_level) s.threshold = threshold;
-    peaks.clear();
-    s.candidates +=
-        FindResponsePeaks(response, static_cast<float>(threshold * threshold),
-                          options.nms_radius_px, &peaks);
-    s.after_nms += static_cast<int>(peaks.size());
     s.ms_nms += MsSince(t);
+
+    t = Clock::now();
+    peaks.clear();
+    s.candidates += FindSaddlePeaks(
+        blurred[l], k, static_cast<float>(threshold * threshold),
+        options.nms_radius_px, &ws.response_rows, &peaks);
+    s.after_nms += static_cast<int>(peaks.size());
+    s.ms_response += MsSince(t);
 
     t = Clock::now();
     const double scale = std::ldexp(1.0, l);
@@ -362,15 +394,20 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
       }
       ++s.after_mask;
       if (options.use_ring_test) {
-        const RingMeasure ring =
-            MeasureRing(blurred[l], peak.x, peak.y, options.ring_radius_px,
-                        options.ring_samples);
-        if (!ring.inside || ring.contrast < min_contrast ||
-            ring.asymmetry > options.max_ring_asymmetry ||
-            ring.second_harmonic_share < options.min_ring_second_harmonic ||
-            ring.centre_offset > options.max_ring_centre_offset) {
-          continue;
-        }
+        auto passes = [&](double radius) {
+          const RingMeasure ring =
+              MeasureRing(blurred[l], peak.centroid_x, peak.centroid_y, radius,
+                          options.ring_samples);
+          return ring.inside && ring.contrast >= min_contrast &&
+                 (ring.asymmetry <= options.max_ring_asymmetry ||
+                  (ring.asymmetry <= options.max_ring_asymmetry_clean &&
+                   ring.second_harmonic_share >=
+                       options.min_ring_second_harmonic_clean)) &&
+                 ring.second_harmonic_share >=
+                     options.min_ring_second_harmonic &&
+                 ring.centre_offset <= options.max_ring_centre_offset;
+        };
+        if (!passes(options.ring_radius_px)) continue;
       }
       ++s.after_ring;
       Candidate c;
@@ -379,8 +416,10 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
       c.peak_y = peak.y;
       c.response = std::sqrt(peak.value);
       c.xy = Eigen::Vector2d(peak.x * scale, peak.y * scale);
-      if (options.subpixel == SubpixelMethod::kCentroid) {
-        c.xy = CentroidOfSquaredResponse(response, peak.x, peak.y) * scale;
+      // The centroid is also the start of the iterative refinements
+      // (closer than the integer peak: fewer iterations).
+      if (options.subpixel != SubpixelMethod::kNone) {
+        c.xy = Eigen::Vector2d(peak.centroid_x, peak.centroid_y) * scale;
       }
       candidates.push_back(c);
     }

@@ -1,54 +1,87 @@
 #include "detection/hessian_response.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
 
 namespace puzzlecal {
+
+namespace {
+
+// The response at interior pixel x of row y (2 <= x < width - 2,
+// 2 <= y < height - 2), rows given as pointers.
+inline float ResponseAt(const float* __restrict rm2,
+                        const float* __restrict rm1, const float* __restrict r0,
+                        const float* __restrict rp1,
+                        const float* __restrict rp2, int x, float k) {
+  const float c2 = 2.0f * r0[x];
+  // Axis-aligned second differences (spacing 2).
+  const float rxx = r0[x + 2] + r0[x - 2] - c2;
+  const float ryy = rp2[x] + rm2[x] - c2;
+  const float rxy = rp1[x + 1] - rp1[x - 1] - rm1[x + 1] + rm1[x - 1];
+  const float trace = rxx + ryy;
+  const float s = rxx * ryy - rxy * rxy + k * trace * trace;
+  // Diagonal second differences: along (1,1), along (1,-1) and mixed.
+  const float rll = rm2[x - 2] + rp2[x + 2] - c2;
+  const float rrr = rm2[x + 2] + rp2[x - 2] - c2;
+  const float rlr = ryy - rxx;
+  const float trace_d = rll + rrr;
+  const float s_d = rll * rrr - rlr * rlr + k * trace_d * trace_d;
+  const float a = std::max(-s, 0.0f);
+  const float b = std::max(-s_d, 0.0f);
+  return a * b;
+}
+
+}  // namespace
+
+__attribute__((target_clones("avx2,fma", "default"))) void
+ComputeSaddleResponseRow(const cv::Mat& blurred, int y, float trace_weight_k,
+                         float* __restrict out) {
+  const int width = blurred.cols;
+  const int height = blurred.rows;
+  if (y < 2 || y >= height - 2 || width < 5) {
+    std::fill(out, out + width, 0.0f);
+    return;
+  }
+  const float* rm2 = blurred.ptr<float>(y - 2);
+  const float* rm1 = blurred.ptr<float>(y - 1);
+  const float* r0 = blurred.ptr<float>(y);
+  const float* rp1 = blurred.ptr<float>(y + 1);
+  const float* rp2 = blurred.ptr<float>(y + 2);
+  out[0] = out[1] = 0.0f;
+  out[width - 2] = out[width - 1] = 0.0f;
+  for (int x = 2; x < width - 2; ++x) {
+    out[x] = ResponseAt(rm2, rm1, r0, rp1, rp2, x, trace_weight_k);
+  }
+}
 
 void ComputeSaddleResponse(const cv::Mat& blurred, float trace_weight_k,
                            cv::Mat* response) {
   CV_Assert(blurred.type() == CV_32FC1);
-  const int width = blurred.cols;
-  const int height = blurred.rows;
-  response->create(height, width, CV_32FC1);
-  response->setTo(0.0f);
-  if (width < 5 || height < 5) return;
-  const float k = trace_weight_k;
-  for (int y = 2; y < height - 2; ++y) {
-    const float* __restrict rm2 = blurred.ptr<float>(y - 2);
-    const float* __restrict rm1 = blurred.ptr<float>(y - 1);
-    const float* __restrict r0 = blurred.ptr<float>(y);
-    const float* __restrict rp1 = blurred.ptr<float>(y + 1);
-    const float* __restrict rp2 = blurred.ptr<float>(y + 2);
-    float* __restrict out = response->ptr<float>(y);
-    for (int x = 2; x < width - 2; ++x) {
-      const float c2 = 2.0f * r0[x];
-      // Axis-aligned second differences (spacing 2).
-      const float rxx = r0[x + 2] + r0[x - 2] - c2;
-      const float ryy = rp2[x] + rm2[x] - c2;
-      const float rxy = rp1[x + 1] - rp1[x - 1] - rm1[x + 1] + rm1[x - 1];
-      const float trace = rxx + ryy;
-      const float s = rxx * ryy - rxy * rxy + k * trace * trace;
-      // Diagonal second differences: along (1,1), along (1,-1) and mixed.
-      const float rll = rm2[x - 2] + rp2[x + 2] - c2;
-      const float rrr = rm2[x + 2] + rp2[x - 2] - c2;
-      const float rlr = ryy - rxx;
-      const float trace_d = rll + rrr;
-      const float s_d = rll * rrr - rlr * rlr + k * trace_d * trace_d;
-      const float a = std::max(-s, 0.0f);
-      const float b = std::max(-s_d, 0.0f);
-      out[x] = a * b;
-    }
+  response->create(blurred.rows, blurred.cols, CV_32FC1);
+  for (int y = 0; y < blurred.rows; ++y) {
+    ComputeSaddleResponseRow(blurred, y, trace_weight_k,
+                             response->ptr<float>(y));
   }
 }
 
-float SampledMedian(const cv::Mat& response, int step,
-                    std::vector<float>* scratch) {
+float SampledResponseMedian(const cv::Mat& blurred, float trace_weight_k,
+                            int step, std::vector<float>* scratch) {
   scratch->clear();
   step = std::max(step, 1);
-  for (int y = step / 2; y < response.rows; y += step) {
-    const float* row = response.ptr<float>(y);
-    for (int x = step / 2; x < response.cols; x += step) {
-      scratch->push_back(row[x]);
+  const int width = blurred.cols;
+  const int height = blurred.rows;
+  for (int y = step / 2; y < height; y += step) {
+    const bool inside_y = y >= 2 && y < height - 2;
+    for (int x = step / 2; x < width; x += step) {
+      if (!inside_y || x < 2 || x >= width - 2) {
+        scratch->push_back(0.0f);
+        continue;
+      }
+      scratch->push_back(
+          ResponseAt(blurred.ptr<float>(y - 2), blurred.ptr<float>(y - 1),
+                     blurred.ptr<float>(y), blurred.ptr<float>(y + 1),
+                     blurred.ptr<float>(y + 2), x, trace_weight_k));
     }
   }
   if (scratch->empty()) return 0.0f;
@@ -57,44 +90,115 @@ float SampledMedian(const cv::Mat& response, int step,
   return *middle;
 }
 
-int FindResponsePeaks(const cv::Mat& response, float threshold, int radius,
-                      std::vector<ResponsePeak>* peaks) {
-  const int width = response.cols;
-  const int height = response.rows;
-  int above = 0;
+int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
+                    float threshold, int radius, std::vector<float>* rows,
+                    std::vector<ResponsePeak>* peaks) {
+  CV_Assert(blurred.type() == CV_32FC1);
+  const int width = blurred.cols;
+  const int height = blurred.rows;
   radius = std::max(radius, 1);
-  for (int y = 1; y < height - 1; ++y) {
-    const float* up = response.ptr<float>(y - 1);
-    const float* row = response.ptr<float>(y);
-    const float* down = response.ptr<float>(y + 1);
-    for (int x = 1; x < width - 1; ++x) {
-      const float v = row[x];
-      if (!(v > threshold)) continue;
-      ++above;
-      // Cheap 3x3 test first: earlier pixels in scan order must be smaller,
-      // later ones not larger.
-      if (up[x - 1] >= v || up[x] >= v || up[x + 1] >= v || row[x - 1] >= v ||
-          row[x + 1] > v || down[x - 1] > v || down[x] > v || down[x + 1] > v) {
-        continue;
+  const int ring = 2 * radius + 1;
+  // Ring of response rows, then a ring of their horizontal 3-maxima, then
+  // one row of flags.
+  const size_t row_size = static_cast<size_t>(width);
+  rows->resize(2 * ring * row_size + row_size);
+  float* response_rows = rows->data();
+  float* max3_rows = rows->data() + ring * row_size;
+  uint8_t* flags =
+      reinterpret_cast<uint8_t*>(rows->data() + 2 * ring * row_size);
+  auto row_of = [&](int y) -> const float* {
+    return response_rows + static_cast<size_t>(y % ring) * row_size;
+  };
+  auto max3_of = [&](int y) -> const float* {
+    return max3_rows + static_cast<size_t>(y % ring) * row_size;
+  };
+  int above = 0;
+  for (int y_new = 0; y_new < height + radius; ++y_new) {
+    if (y_new < height) {
+      float* __restrict out =
+          response_rows + static_cast<size_t>(y_new % ring) * row_size;
+      ComputeSaddleResponseRow(blurred, y_new, trace_weight_k, out);
+      float* __restrict max3 =
+          max3_rows + static_cast<size_t>(y_new % ring) * row_size;
+      max3[0] = out[0];
+      max3[width - 1] = out[width - 1];
+      for (int x = 1; x < width - 1; ++x) {
+        max3[x] = std::max(std::max(out[x - 1], out[x]), out[x + 1]);
       }
-      bool is_max = true;
-      if (radius > 1) {
-        const int y0 = std::max(y - radius, 0);
-        const int y1 = std::min(y + radius, height - 1);
-        const int x0 = std::max(x - radius, 0);
-        const int x1 = std::min(x + radius, width - 1);
-        for (int yy = y0; yy <= y1 && is_max; ++yy) {
-          const float* r = response.ptr<float>(yy);
-          for (int xx = x0; xx <= x1; ++xx) {
-            const bool earlier = yy < y || (yy == y && xx < x);
-            if (earlier ? r[xx] >= v : r[xx] > v) {
-              is_max = false;
-              break;
+    }
+    const int y = y_new - radius;  // the row whose window is complete
+    if (y < 1 || y > height - 2) continue;
+    const float* __restrict up = row_of(y - 1);
+    const float* __restrict row = row_of(y);
+    {
+      // Pixels above the threshold that equal the maximum of their 3x3
+      // neighbourhood, without branches (most of the image is neither).
+      const float* __restrict m_up = max3_of(y - 1);
+      const float* __restrict m_row = max3_of(y);
+      const float* __restrict m_down = max3_of(y + 1);
+      int count = 0;
+      for (int x = 1; x < width - 1; ++x) {
+        const float v = row[x];
+        const float m = std::max(std::max(m_up[x], m_row[x]), m_down[x]);
+        const int is_above = v > threshold;
+        count += is_above;
+        flags[x] = static_cast<uint8_t>(is_above & (v >= m));
+      }
+      above += count;
+    }
+    flags[0] = 0;
+    flags[width - 1] = 0;
+    for (int x8 = 0; x8 < width; x8 += 8) {
+      // Skip eight flags at once (almost all are zero).
+      if (x8 + 8 <= width) {
+        uint64_t word;
+        std::memcpy(&word, flags + x8, sizeof word);
+        if (word == 0) continue;
+      }
+      for (int x = x8; x < std::min(x8 + 8, width); ++x) {
+        if (!flags[x]) continue;
+        const float v = row[x];
+        // Ties in the 3x3 neighbourhood: earlier pixels in scan order must be
+        // smaller, later ones not larger.
+        if (up[x - 1] >= v || up[x] >= v || up[x + 1] >= v || row[x - 1] >= v) {
+          continue;
+        }
+        bool is_max = true;
+        if (radius > 1) {
+          const int ya = std::max(y - radius, 0);
+          const int yb = std::min(y + radius, height - 1);
+          const int xa = std::max(x - radius, 0);
+          const int xb = std::min(x + radius, width - 1);
+          for (int yy = ya; yy <= yb && is_max; ++yy) {
+            const float* r = row_of(yy);
+            for (int xx = xa; xx <= xb; ++xx) {
+              const bool earlier = yy < y || (yy == y && xx < x);
+              if (earlier ? r[xx] >= v : r[xx] > v) {
+                is_max = false;
+                break;
+              }
             }
           }
         }
+        if (!is_max) continue;
+        ResponsePeak peak;
+        peak.x = x;
+        peak.y = y;
+        peak.value = v;
+        double sum = 0.0, sx = 0.0, sy = 0.0;
+        for (int dy = -1; dy <= 1; ++dy) {
+          const float* r = row_of(y + dy);
+          for (int dx = -1; dx <= 1; ++dx) {
+            const double w = static_cast<double>(r[x + dx]) * r[x + dx];
+            sum += w;
+            sx += w * dx;
+            sy += w * dy;
+          }
+        }
+        peak.centroid_x = static_cast<float>(x + (sum > 0.0 ? sx / sum : 0.0));
+        peak.centroid_y = static_cast<float>(y + (sum > 0.0 ? sy / sum : 0.0));
+        peaks->push_back(peak);
       }
-      if (is_max) peaks->push_back({x, y, v});
     }
   }
   return above;

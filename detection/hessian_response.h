@@ -1,7 +1,8 @@
 #ifndef PUZZLECAL_DETECTION_HESSIAN_RESPONSE_H_
 #define PUZZLECAL_DETECTION_HESSIAN_RESPONSE_H_
 
-// The thesis's Hessian saddle response on one (blurred) image level.
+// The thesis's Hessian saddle response on one (blurred) image level, and its
+// peaks.
 
 #include <opencv2/core.hpp>
 #include <vector>
@@ -17,24 +18,36 @@ namespace puzzlecal {
 void ComputeSaddleResponse(const cv::Mat& blurred, float trace_weight_k,
                            cv::Mat* response);
 
-// Median of `response` sampled every `step` pixels in x and y (step >= 1).
-// `scratch` is reused between calls.
-float SampledMedian(const cv::Mat& response, int step,
-                    std::vector<float>* scratch);
+// The same response for one row `y` of `blurred` into `out` (width floats).
+void ComputeSaddleResponseRow(const cv::Mat& blurred, int y,
+                              float trace_weight_k, float* out);
+
+// Median of the response sampled every `step` pixels in x and y (step >= 1,
+// starting at step / 2), computed at those pixels only. `scratch` is reused
+// between calls.
+float SampledResponseMedian(const cv::Mat& blurred, float trace_weight_k,
+                            int step, std::vector<float>* scratch);
 
 // An integer local maximum of the response.
 struct ResponsePeak {
   int x = 0;
   int y = 0;
   float value = 0.0f;  // the response (product form) at the peak
+  // The thesis's sub-pixel step: centroid of the squared response over the
+  // 3x3 neighbourhood of the peak.
+  float centroid_x = 0.0f;
+  float centroid_y = 0.0f;
 };
 
 // Pixels whose response exceeds `threshold` (product form) and is the
-// maximum of the (2 radius + 1)^2 window around it. Ties are broken by scan
-// order (the first pixel wins), so plateaus yield one peak. Appends in scan
-// order. Returns the number of pixels above the threshold.
-int FindResponsePeaks(const cv::Mat& response, float threshold, int radius,
-                      std::vector<ResponsePeak>* peaks);
+// maximum of the (2 radius + 1)^2 window around it (clipped to the image).
+// Ties are broken by scan order (the first pixel wins), so plateaus yield
+// one peak. The response is computed row by row into a ring of 2 radius + 1
+// rows (`rows`, reused between calls) and never stored whole. Appends in
+// scan order. Returns the number of pixels above the threshold.
+int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
+                    float threshold, int radius, std::vector<float>* rows,
+                    std::vector<ResponsePeak>* peaks);
 
 }  // namespace puzzlecal
 

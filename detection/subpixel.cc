@@ -195,31 +195,55 @@ namespace {
 // Moments of one window of the saddle fit: the weights are a separable
 // Gaussian on a square window, so the normal matrix is a product of 1-D
 // moments and only the right-hand side touches the pixels.
+// Gaussian weights exp(-u^2 / 2) at u = u0 + i h for i < n, by the
+// recurrence e(i+1) = e(i) g(i), g(i+1) = g(i) exp(-h^2) (three exp calls
+// instead of n).
+void GaussianRun(double u0, double h, int n, double* out) {
+  double e = std::exp(-0.5 * u0 * u0);
+  double g = std::exp(-u0 * h - 0.5 * h * h);
+  const double c = std::exp(-h * h);
+  for (int i = 0; i < n; ++i) {
+    out[i] = e;
+    e *= g;
+    g *= c;
+  }
+}
+
 template <typename Pixel>
 bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
                 int radius, Eigen::Vector2d* step) {
-  const int cx = static_cast<int>(std::lround(p.x()));
-  const int cy = static_cast<int>(std::lround(p.y()));
+  const int cx = static_cast<int>(std::floor(p.x() + 0.5));
+  const int cy = static_cast<int>(std::floor(p.y() + 0.5));
   if (cx - radius < 0 || cy - radius < 0 || cx + radius >= image.cols ||
       cy + radius >= image.rows) {
     return false;
   }
+  constexpr int kLanes = 8;
   constexpr int kMaxSide = 2 * 48 + 1;
+  constexpr int kMaxPadded = (kMaxSide + kLanes - 1) / kLanes * kLanes;
   const int side = 2 * radius + 1;
+  const int padded = (side + kLanes - 1) / kLanes * kLanes;
   // 1-D weights and powers of the coordinates relative to p, in units of
-  // sigma: wx[i] * u^k for k = 0..2 (and up to 4 for the normal matrix).
-  float wu[3][kMaxSide], wv[3][kMaxSide];
+  // sigma: wu[k][i] = w(u) u^k for k = 0..2 (zero in the padding), and the
+  // moments sum w u^k for k = 0..4 for the normal matrix.
+  alignas(32) float wu[3][kMaxPadded] = {};
+  float wv[3][kMaxSide];
   double mu[5] = {}, mv[5] = {};
   const double inv_s = 1.0 / sigma;
+  const double u0 = (cx - radius - p.x()) * inv_s;
+  const double v0 = (cy - radius - p.y()) * inv_s;
+  double gauss_u[kMaxSide], gauss_v[kMaxSide];
+  GaussianRun(u0, inv_s, side, gauss_u);
+  GaussianRun(v0, inv_s, side, gauss_v);
   for (int i = 0; i < side; ++i) {
-    const double u = (cx - radius + i - p.x()) * inv_s;
-    const double v = (cy - radius + i - p.y()) * inv_s;
+    const double u = u0 + i * inv_s;
+    const double v = v0 + i * inv_s;
     // Gaussian tapered smoothly to zero at 3 sigma from p, so the window is
     // symmetric about p whatever its sub-pixel offset.
     const double tu = std::max(0.0, 1.0 - u * u * (1.0 / 9.0));
     const double tv = std::max(0.0, 1.0 - v * v * (1.0 / 9.0));
-    const double w_u = std::exp(-0.5 * u * u) * tu * tu;
-    const double w_v = std::exp(-0.5 * v * v) * tv * tv;
+    const double w_u = gauss_u[i] * tu * tu;
+    const double w_v = gauss_v[i] * tv * tv;
     wu[0][i] = static_cast<float>(w_u);
     wu[1][i] = static_cast<float>(w_u * u);
     wu[2][i] = static_cast<float>(w_u * u * u);
@@ -235,23 +259,34 @@ bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
     }
   }
   // Right-hand side: sum w u^a v^b I for (a, b) in the basis
-  // 1, u, v, u^2, u v, v^2.
+  // 1, u, v, u^2, u v, v^2. Rows in kLanes independent float lanes so the
+  // loop vectorises.
+  alignas(32) float values[kMaxPadded] = {};
   double r00 = 0, r10 = 0, r01 = 0, r20 = 0, r11 = 0, r02 = 0;
   for (int j = 0; j < side; ++j) {
     const Pixel* row = image.ptr<Pixel>(cy - radius + j) + (cx - radius);
-    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-    for (int i = 0; i < side; ++i) {
-      const float value = static_cast<float>(row[i]);
-      s0 += wu[0][i] * value;
-      s1 += wu[1][i] * value;
-      s2 += wu[2][i] * value;
+    for (int i = 0; i < side; ++i) values[i] = static_cast<float>(row[i]);
+    float s0[kLanes] = {}, s1[kLanes] = {}, s2[kLanes] = {};
+    for (int i = 0; i < padded; i += kLanes) {
+      for (int l = 0; l < kLanes; ++l) {
+        const float value = values[i + l];
+        s0[l] += wu[0][i + l] * value;
+        s1[l] += wu[1][i + l] * value;
+        s2[l] += wu[2][i + l] * value;
+      }
     }
-    r00 += wv[0][j] * s0;
-    r10 += wv[0][j] * s1;
-    r20 += wv[0][j] * s2;
-    r01 += wv[1][j] * s0;
-    r11 += wv[1][j] * s1;
-    r02 += wv[2][j] * s0;
+    float t0 = 0.0f, t1 = 0.0f, t2 = 0.0f;
+    for (int l = 0; l < kLanes; ++l) {
+      t0 += s0[l];
+      t1 += s1[l];
+      t2 += s2[l];
+    }
+    r00 += wv[0][j] * t0;
+    r10 += wv[0][j] * t1;
+    r20 += wv[0][j] * t2;
+    r01 += wv[1][j] * t0;
+    r11 += wv[1][j] * t1;
+    r02 += wv[2][j] * t0;
   }
   // Normal matrix: entry (A, B) = mu[a_A + a_B] * mv[b_A + b_B].
   static const int kPowU[6] = {0, 1, 0, 2, 1, 0};
