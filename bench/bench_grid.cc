@@ -3,8 +3,9 @@
 // seen through a pinhole camera at a 60-degree viewing angle, corners projected
 // with exact ids (plus 0.1 px noise), orientations from the projected geometry
 // and a drawn checkerboard image for the intensity penalty. Prints JSON: the
-// best and median wall and thread-CPU time of repeated runs per size, and the
-// labelled corners.
+// best and median wall and thread-CPU time of repeated runs per size, the
+// stage times (wall) of the run with the best CPU time, and the labelled
+// corners.
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -138,13 +139,18 @@ int main() {
     const Scene scene = MakeScene(size.cols, size.rows, size.tile_px, 1 + s);
     const int repeats = size.cols * size.rows > 1000 ? 30 : 200;
     std::vector<double> times, cpu_times;
-    GridSummary summary;
+    GridSummary summary, best_summary;
+    double best_cpu = 1e30;
     std::vector<GridComponent> components;
     for (int r = 0; r < repeats; ++r) {
       const auto start = std::chrono::steady_clock::now();
       const double cpu_start = ThreadCpuMs();
       components = BuildGrid(scene.corners, scene.image, {}, &summary);
       cpu_times.push_back(ThreadCpuMs() - cpu_start);
+      if (cpu_times.back() < best_cpu) {
+        best_cpu = cpu_times.back();
+        best_summary = summary;
+      }
       times.push_back(std::chrono::duration<double, std::milli>(
                           std::chrono::steady_clock::now() - start)
                           .count());
@@ -162,8 +168,9 @@ int main() {
         scene.corners.size(), size.cols, size.rows, scene.image.cols,
         scene.image.rows, times.front(), times[times.size() / 2],
         cpu_times.front(), cpu_times[cpu_times.size() / 2], size.goal_ms,
-        summary.largest_component, summary.num_components, summary.neighbors_ms,
-        summary.weights_ms, summary.kruskal_ms, summary.cleanup_ms,
+        summary.largest_component, summary.num_components,
+        best_summary.neighbors_ms, best_summary.weights_ms,
+        best_summary.kruskal_ms, best_summary.cleanup_ms,
         summary.num_removed_not_saddle, summary.num_removed_by_prediction,
         s + 1 < std::size(sizes) ? "," : "");
   }

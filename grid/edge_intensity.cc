@@ -38,7 +38,44 @@ bool CrossesTile(const cv::Mat& image, const Eigen::Vector2d& a,
   return std::abs(first - last) / third > fraction * mean;
 }
 
+template <typename T>
+bool SidesFlip(const cv::Mat& image, const Eigen::Vector2d& a,
+               const Eigen::Vector2d& b, double offset_fraction,
+               double min_contrast) {
+  const Eigen::Vector2d along = b - a;
+  const Eigen::Vector2d side =
+      offset_fraction * Eigen::Vector2d(-along.y(), along.x());
+  double difference[2], sum = 0;
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::Vector2d p = a + along * (k == 0 ? 0.25 : 0.75);
+    const Eigen::Vector2d l = p + side, r = p - side;
+    const double left = SampleBilinear<T>(image, l.x(), l.y());
+    const double right = SampleBilinear<T>(image, r.x(), r.y());
+    difference[k] = left - right;
+    sum += left + right;
+  }
+  const double threshold = min_contrast * sum / 4;
+  return difference[0] * difference[1] < 0 &&
+         std::abs(difference[0]) > threshold &&
+         std::abs(difference[1]) > threshold;
+}
+
 }  // namespace
+
+bool EdgeSidesFlip(const cv::Mat& image, const Eigen::Vector2d& a,
+                   const Eigen::Vector2d& b, double offset_fraction,
+                   double min_contrast) {
+  switch (image.type()) {
+    case CV_8UC1:
+      return SidesFlip<uint8_t>(image, a, b, offset_fraction, min_contrast);
+    case CV_16UC1:
+      return SidesFlip<uint16_t>(image, a, b, offset_fraction, min_contrast);
+    case CV_32FC1:
+      return SidesFlip<float>(image, a, b, offset_fraction, min_contrast);
+    default:
+      return false;
+  }
+}
 
 bool IsSupportedGridImage(const cv::Mat& image) {
   return !image.empty() && image.dims == 2 &&

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "grid/edge_intensity.h"
@@ -26,6 +27,32 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 }
 
 }  // namespace
+
+const char* GridEdgeDecisionName(GridEdgeDecision decision) {
+  switch (decision) {
+    case GridEdgeDecision::kMerged:
+      return "merged";
+    case GridEdgeDecision::kSameTree:
+      return "same tree";
+    case GridEdgeDecision::kNeighborWeight:
+      return "neighbor weight";
+    case GridEdgeDecision::kTreeMeanWeight:
+      return "tree mean weight";
+    case GridEdgeDecision::kAmbiguousAxis:
+      return "ambiguous axis";
+    case GridEdgeDecision::kLabelCollision:
+      return "label collision";
+    case GridEdgeDecision::kNeighborContradiction:
+      return "neighbor contradiction";
+    case GridEdgeDecision::kCollinearity:
+      return "collinearity";
+    case GridEdgeDecision::kSidesFlip:
+      return "sides flip";
+    case GridEdgeDecision::kPenalised:
+      return "penalised";
+  }
+  return "unknown";
+}
 
 bool GridOptions::Check(std::string* why) const {
   if (num_neighbors < 1 || num_neighbors > 64)
@@ -65,6 +92,10 @@ bool GridOptions::Check(std::string* why) const {
     return Fail(why, "max_axis_aspect_ratio must be finite and >= 1");
   if (kruskal_passes < 1 || kruskal_passes > 10)
     return Fail(why, "kruskal_passes must be in [1, 10]");
+  if (!(side_offset_fraction > 0 && side_offset_fraction <= 0.5))
+    return Fail(why, "side_offset_fraction must be in (0, 0.5]");
+  if (!(side_min_contrast >= 0 && std::isfinite(side_min_contrast)))
+    return Fail(why, "side_min_contrast must be finite and >= 0");
   if (!(line_prediction_tolerance > 0 &&
         std::isfinite(line_prediction_tolerance)))
     return Fail(why, "line_prediction_tolerance must be finite and > 0");
@@ -78,7 +109,9 @@ bool GridOptions::Check(std::string* why) const {
 std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
                                      const cv::Mat& image,
                                      const GridOptions& options,
-                                     GridSummary* summary_out) {
+                                     GridSummary* summary_out,
+                                     std::vector<GridEdgeTrace>* trace) {
+  if (trace != nullptr) trace->clear();
   const auto start = std::chrono::steady_clock::now();
   GridSummary local_summary;
   GridSummary& summary = summary_out ? *summary_out : local_summary;
@@ -110,6 +143,7 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
   nodes.xy.resize(n);
   nodes.axis.resize(n);
   nodes.valid.assign(n, 0);
+  std::vector<Eigen::Vector2d> doubled(n, Eigen::Vector2d::Zero());
   std::vector<int> valid_index;
   valid_index.reserve(n);
   std::vector<Eigen::Vector2d> valid_xy;
@@ -127,8 +161,10 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
       continue;
     }
     nodes.valid[i] = 1;
-    const double axis_angle = c.orientation + M_PI / 4;
-    nodes.axis[i] = Eigen::Vector2d(std::cos(axis_angle), std::sin(axis_angle));
+    const double co = std::cos(c.orientation), so = std::sin(c.orientation);
+    // Orientation + 45 degrees; the doubled angle for the orientation filter.
+    nodes.axis[i] = Eigen::Vector2d(co - so, co + so) * M_SQRT1_2;
+    doubled[i] = Eigen::Vector2d(co * co - so * so, 2 * co * so);
     valid_index.push_back(i);
     valid_xy.push_back(c.xy);
   }
@@ -163,15 +199,17 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
   summary.num_candidate_edges = static_cast<int>(pairs.size());
   summary.neighbors_ms = MillisecondsSince(phase_start);
 
-  // Orientation filter and weights.
+  // Orientation filter and lengths. Orientations are compared through their
+  // doubled angles: sin^2(d) = (1 - cos(2 d)) / 2.
   phase_start = std::chrono::steady_clock::now();
   const double min_abs_sin =
       std::sin(options.min_orientation_difference_deg * M_PI / 180);
+  const double max_cos_double = 1 - 2 * min_abs_sin * min_abs_sin;
   std::vector<GridEdge> edges;
   edges.reserve(pairs.size());
   for (const auto& [a, b] : pairs) {
-    const double difference = corners[a].orientation - corners[b].orientation;
-    if (!(std::abs(std::sin(difference)) > min_abs_sin)) {
+    const double cos_double = doubled[a].dot(doubled[b]);
+    if (!(cos_double < max_cos_double)) {
       ++summary.num_edges_orientation_filtered;
       continue;
     }
@@ -185,22 +223,32 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
     edge.b = b;
     edge.length = length;
     edge.weight = length;
-    if (summary.image_used &&
-        EdgeCrossesTile(image, nodes.xy[a], nodes.xy[b],
-                        options.intensity_samples,
-                        options.intensity_difference_fraction)) {
-      edge.weight *= options.penalty_factor;
-      ++summary.num_edges_penalised;
-    }
     edges.push_back(edge);
   }
   std::sort(edges.begin(), edges.end(), GridEdgeLess);
   summary.num_edges_considered = static_cast<int>(edges.size());
   summary.weights_ms = MillisecondsSince(phase_start);
 
+  // Kruskal; the intensity penalty is sampled when an edge's turn comes.
   phase_start = std::chrono::steady_clock::now();
+  std::function<bool(const GridEdge&)> crosses_tile, sides_flip;
+  if (summary.image_used) {
+    crosses_tile = [&](const GridEdge& edge) {
+      return EdgeCrossesTile(image, nodes.xy[edge.a], nodes.xy[edge.b],
+                             options.intensity_samples,
+                             options.intensity_difference_fraction);
+    };
+    if (options.side_min_contrast > 0) {
+      sides_flip = [&](const GridEdge& edge) {
+        return EdgeSidesFlip(image, nodes.xy[edge.a], nodes.xy[edge.b],
+                             options.side_offset_fraction,
+                             options.side_min_contrast);
+      };
+    }
+  }
   LatticeForest forest;
-  BuildLatticeForest(nodes, edges, options, &summary, &forest);
+  BuildLatticeForest(nodes, edges, crosses_tile, sides_flip, options, &summary,
+                     &forest, trace);
   summary.kruskal_ms = MillisecondsSince(phase_start);
 
   phase_start = std::chrono::steady_clock::now();

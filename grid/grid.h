@@ -45,6 +45,20 @@ struct GridOptions {
   // Weight = length x this factor for penalised edges (thesis: 3; above
   // neighbor_weight_ratio so a penalised edge never joins normal ones).
   double penalty_factor = 3.0;
+  // Refuse penalised edges instead of taking them up later at the higher
+  // weight. On the deltille fisheye photos 0.5 % of the true lattice edges
+  // tried by Kruskal are penalised (and other paths join their corners),
+  // while a penalised tile diagonal at the rim, where the true neighbours
+  // were not detected, could otherwise join and mislabel a corner.
+  bool refuse_penalised_edges = true;
+  // With an image, an edge is refused when the tiles beside it change colour
+  // halfway (it spans two tiles through an undetected corner; lengths alone
+  // cannot tell when tile sizes vary by 3x along a fisheye line). Samples
+  // at this fraction of the edge length to either side of it...
+  double side_offset_fraction = 0.1;
+  // ... and both left-right differences above this fraction of their mean
+  // grey level. 0 turns the test off.
+  double side_min_contrast = 0.2;
 
   // Merge check at both ends of the joining edge: every tree edge already at
   // that corner on the same lattice line has a weight within this factor of
@@ -66,8 +80,12 @@ struct GridOptions {
   double max_line_spacing_ratio = 2.0;
   // A lattice step must point within this angle (degrees) of the corner's
   // axis estimate (eigenvector +- 45 degrees); steps near 45 degrees are
-  // ambiguous between the two axes and are not used. Steep views put the true
-  // axis up to ~26 degrees off the estimate.
+  // ambiguous between the two axes and are not used. The image directions of
+  // the two tile edges at a corner lie on either side of the eigenvectors
+  // (which bisect them), at 45 - theta/2 degrees from the estimate for tile
+  // edges theta degrees apart: theta = 20 (steep views under fisheye, tiles
+  // of aspect 5 and more at the rim) gives 35 degrees. Merges are verified,
+  // so a step classified wrongly is refused, not mislabelled.
   double max_axis_deviation_deg = 38.0;
   // Two corners that a merge makes lattice neighbours must be at most this
   // factor farther apart (or closer) than the tree edges on the same lattice
@@ -76,8 +94,9 @@ struct GridOptions {
   double max_adjacency_length_ratio = 2.0;
   // ... and, when a corner has tree edges only across that line, at most
   // this factor (the foreshortening of one axis against the other in steep
-  // views: 1 / sin(viewing angle) and more under perspective).
-  double max_axis_aspect_ratio = 5.0;
+  // views: 1 / sin(viewing angle) and more under perspective; rim tiles of
+  // the deltille fisheye photos reach 5-6).
+  double max_axis_aspect_ratio = 8.0;
   // Kruskal passes over the sorted edges; a later pass retries edges between
   // trees that an earlier pass refused (the trees have grown since).
   int kruskal_passes = 2;
@@ -114,7 +133,9 @@ struct GridSummary {
   int num_edges_orientation_filtered = 0;  // dropped: orientations too alike
   int num_edges_too_short = 0;             // dropped: duplicate positions
   int num_edges_considered = 0;            // given to Kruskal
-  int num_edges_penalised = 0;             // intensity-thirds penalty applied
+  // Intensity-thirds penalty applied. Edges are sampled lazily, only when
+  // Kruskal reaches one that joins two trees, so this counts those.
+  int num_edges_penalised = 0;
 
   // Kruskal.
   int num_merges = 0;                           // accepted unions
@@ -125,6 +146,7 @@ struct GridSummary {
   int num_rejected_label_collision = 0;         // two corners on one label
   int num_rejected_neighbor_contradiction = 0;  // direction/length mismatch
   int num_rejected_collinearity = 0;            // lines bend or jump
+  int num_rejected_sides_flip = 0;              // through a missed corner
 
   // Final pass.
   int num_removed_not_saddle = 0;     // tiles around it do not alternate
@@ -136,10 +158,37 @@ struct GridSummary {
 
   // Wall time in milliseconds.
   double neighbors_ms = 0;
-  double weights_ms = 0;
-  double kruskal_ms = 0;
+  double weights_ms = 0;  // orientation filter, lengths, sort
+  double kruskal_ms = 0;  // with the intensity sampling
   double cleanup_ms = 0;
   double total_ms = 0;
+};
+
+// Why Kruskal merged or did not merge the two trees of an edge.
+enum class GridEdgeDecision {
+  kMerged,                 // the edge joined two trees
+  kSameTree,               // both ends were already in one tree
+  kNeighborWeight,         // eq. 4.2
+  kTreeMeanWeight,         // eq. 4.3
+  kAmbiguousAxis,          // step near 45 degrees to a corner's axes
+  kLabelCollision,         // two corners on one label
+  kNeighborContradiction,  // direction/length mismatch of new neighbours
+  kCollinearity,           // lines bend or jump
+  kSidesFlip,              // runs through an undetected corner (image)
+  kPenalised,              // crosses a tile, refused_penalised_edges
+};
+
+// "merged", "same tree", ...
+const char* GridEdgeDecisionName(GridEdgeDecision decision);
+
+// One edge given to Kruskal and what became of it (in its last pass).
+struct GridEdgeTrace {
+  int a = 0;  // corner indices
+  int b = 0;
+  double length = 0;  // pixels
+  double weight = 0;  // length, times the penalty when penalised
+  bool penalised = false;
+  GridEdgeDecision decision = GridEdgeDecision::kSameTree;
 };
 
 // Builds lattice components from detected corners.
@@ -148,11 +197,12 @@ struct GridSummary {
 // none. Returns components sorted by size (largest first, ties by smallest
 // corner index); labels of a component start at (0, 0) in its minimum.
 // Deterministic. Invalid corners are ignored; bad options or an unsupported
-// image type return no components with a reason in `summary`.
-std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
-                                     const cv::Mat& image,
-                                     const GridOptions& options = {},
-                                     GridSummary* summary = nullptr);
+// image type return no components with a reason in `summary`. `trace`, when
+// not null, receives every edge Kruskal saw, for diagnostics.
+std::vector<GridComponent> BuildGrid(
+    const std::vector<Corner>& corners, const cv::Mat& image,
+    const GridOptions& options = {}, GridSummary* summary = nullptr,
+    std::vector<GridEdgeTrace>* trace = nullptr);
 
 }  // namespace puzzlecal
 

@@ -1,6 +1,7 @@
 #include "grid/lattice_cleanup.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -10,24 +11,26 @@
 namespace puzzlecal {
 namespace {
 
+// Per corner: its lattice neighbour in each of the 4 label directions
+// (LatticeStep order) inside its tree, or -1.
+using Links = std::vector<std::array<int, 4>>;
+
 // How well corner n's lattice lines predict it: each of its 4 directions with
 // at least two more corners gives one verdict. With three corners, a
 // quadratic extrapolation (it follows the changing spacing and curvature of
 // steep and fisheye views) must land within the tolerance; with two, the
 // three corners must pass the merge's collinearity test.
-void ScoreCorner(const std::vector<Eigen::Vector2d>& xy,
-                 const LabelTable& table, int tree, int n,
-                 const Eigen::Vector2i& label, const GridOptions& options,
-                 int* supported, int* contradicted) {
+void ScoreCorner(const std::vector<Eigen::Vector2d>& xy, const Links& links,
+                 int n, const GridOptions& options, int* supported,
+                 int* contradicted) {
   *supported = 0;
   *contradicted = 0;
   for (int d = 0; d < 4; ++d) {
-    const Eigen::Vector2i step = LatticeStep(d);
-    const int p1 = table.Find(tree, label + step);
+    const int p1 = links[n][d];
     if (p1 < 0) continue;
-    const int p2 = table.Find(tree, label + 2 * step);
+    const int p2 = links[p1][d];
     if (p2 < 0) continue;
-    const int p3 = table.Find(tree, label + 3 * step);
+    const int p3 = links[p2][d];
     bool ok;
     if (p3 >= 0) {
       const Eigen::Vector2d predicted = 3 * xy[p1] - 3 * xy[p2] + xy[p3];
@@ -52,69 +55,82 @@ void ScoreCorner(const std::vector<Eigen::Vector2d>& xy,
   }
 }
 
-// Grey level at (x, y), bilinear, clamped to the image.
-double Grey(const cv::Mat& image, const Eigen::Vector2d& p) {
+// Grey level at p, bilinear, clamped to the image.
+template <typename T>
+double GreyAt(const cv::Mat& image, const Eigen::Vector2d& p) {
   const double x = std::clamp(p.x(), 0.0, image.cols - 1.0);
   const double y = std::clamp(p.y(), 0.0, image.rows - 1.0);
   const int x0 = std::min(static_cast<int>(x), image.cols - 1);
   const int y0 = std::min(static_cast<int>(y), image.rows - 1);
   const int x1 = std::min(x0 + 1, image.cols - 1);
   const int y1 = std::min(y0 + 1, image.rows - 1);
-  auto at = [&](int xx, int yy) -> double {
-    switch (image.type()) {
-      case CV_8UC1:
-        return image.at<uint8_t>(yy, xx);
-      case CV_16UC1:
-        return image.at<uint16_t>(yy, xx);
-      default:
-        return image.at<float>(yy, xx);
-    }
-  };
+  const T* row0 = image.ptr<T>(y0);
+  const T* row1 = image.ptr<T>(y1);
   const double fx = x - x0, fy = y - y0;
-  const double top = at(x0, y0) + fx * (at(x1, y0) - at(x0, y0));
-  const double bottom = at(x0, y1) + fx * (at(x1, y1) - at(x0, y1));
+  const double top = row0[x0] + fx * (double(row0[x1]) - row0[x0]);
+  const double bottom = row1[x0] + fx * (double(row1[x1]) - row1[x0]);
   return top + fy * (bottom - top);
+}
+
+double Grey(const cv::Mat& image, const Eigen::Vector2d& p) {
+  switch (image.type()) {
+    case CV_8UC1:
+      return GreyAt<uint8_t>(image, p);
+    case CV_16UC1:
+      return GreyAt<uint16_t>(image, p);
+    default:
+      return GreyAt<float>(image, p);
+  }
+}
+
+// The image vector of one lattice step from corner n in direction d: to its
+// neighbour there, else the reversed step to the opposite neighbour, else
+// the same from a neighbour across; false when none of them exists.
+bool StepVector(const std::vector<Eigen::Vector2d>& xy, const Links& links,
+                int n, int d, Eigen::Vector2d* v) {
+  for (int base : {n, links[n][Mod4(d + 1)], links[n][Mod4(d + 3)]}) {
+    if (base < 0) continue;
+    if (links[base][d] >= 0) {
+      *v = xy[links[base][d]] - xy[base];
+      return true;
+    }
+    if (links[base][Mod4(d + 2)] >= 0) {
+      *v = xy[base] - xy[links[base][Mod4(d + 2)]];
+      return true;
+    }
+  }
+  return false;
 }
 
 // False when the four tiles around corner n (sampled inside them, towards
 // the lattice diagonals) do not alternate dark/light like a checkerboard
 // saddle: an L-junction at the board's border or a clutter corner. True when
-// n lacks the neighbours to place the samples.
+// n lacks the neighbours to place the samples. Each tile is sampled along
+// its own two edges from n, so tiles of different sizes (fisheye rim, steep
+// views) are each hit near their middle.
 bool LooksLikeSaddle(const std::vector<Eigen::Vector2d>& xy,
-                     const cv::Mat& image, const LabelTable& table, int tree,
-                     int n, const Eigen::Vector2i& label, double fraction) {
-  // Each lattice axis from n's own neighbours along it, else from those of a
-  // neighbour across it.
-  Eigen::Vector2d axis[2];
-  for (int a = 0; a < 2; ++a) {
-    bool found = false;
-    const Eigen::Vector2i across = LatticeStep(a + 1);
-    for (const Eigen::Vector2i& base :
-         {Eigen::Vector2i(label), Eigen::Vector2i(label + across),
-          Eigen::Vector2i(label - across)}) {
-      const int at = base == label ? n : table.Find(tree, base);
-      if (at < 0) continue;
-      const int forward = table.Find(tree, base + LatticeStep(a));
-      const int backward = table.Find(tree, base - LatticeStep(a));
-      if (forward >= 0) {
-        axis[a] = xy[forward] - xy[at];
-      } else if (backward >= 0) {
-        axis[a] = xy[at] - xy[backward];
-      } else {
-        continue;
-      }
-      found = true;
-      break;
-    }
-    if (!found) return true;
-  }
-  const double v_pp = Grey(image, xy[n] + fraction * (axis[0] + axis[1]));
-  const double v_mm = Grey(image, xy[n] - fraction * (axis[0] + axis[1]));
-  const double v_pm = Grey(image, xy[n] + fraction * (axis[0] - axis[1]));
-  const double v_mp = Grey(image, xy[n] - fraction * (axis[0] - axis[1]));
-  const double contrast = std::abs((v_pp + v_mm) - (v_pm + v_mp)) / 2;
-  const double spread = std::max(std::abs(v_pp - v_mm), std::abs(v_pm - v_mp));
+                     const cv::Mat& image, const Links& links, int n,
+                     double fraction) {
+  Eigen::Vector2d step[4];
+  for (int d = 0; d < 4; ++d)
+    if (!StepVector(xy, links, n, d, &step[d])) return true;
+  // Tile between directions d and d + 1.
+  double v[4];
+  for (int d = 0; d < 4; ++d)
+    v[d] = Grey(image, xy[n] + fraction * (step[d] + step[Mod4(d + 1)]));
+  // v[0], v[2] are opposite tiles, as are v[1], v[3].
+  const double contrast = std::abs((v[0] + v[2]) - (v[1] + v[3])) / 2;
+  const double spread = std::max(std::abs(v[0] - v[2]), std::abs(v[1] - v[3]));
   return spread < contrast;
+}
+
+// Removes corner i: unlinks it from its neighbours.
+void Unlink(Links* links, int i) {
+  for (int d = 0; d < 4; ++d) {
+    const int m = (*links)[i][d];
+    if (m >= 0) (*links)[m][Mod4(d + 2)] = -1;
+    (*links)[i][d] = -1;
+  }
 }
 
 }  // namespace
@@ -124,32 +140,31 @@ std::vector<GridComponent> ExtractComponents(
     const LatticeForest& forest, const GridOptions& options,
     GridSummary* summary) {
   const int n = static_cast<int>(xy.size());
-  // Members of each tree, trees in order of their smallest corner.
-  std::vector<int> order;
-  order.reserve(n);
+  std::vector<int> members;
+  members.reserve(n);
   for (int i = 0; i < n; ++i)
-    if (forest.tree[i] >= 0) order.push_back(i);
-  std::stable_sort(order.begin(), order.end(), [&](int x, int y) {
-    return forest.tree[x] < forest.tree[y];
-  });
+    if (forest.tree[i] >= 0) members.push_back(i);
 
-  LabelTable table(n);
+  // Lattice neighbours, looked up once.
+  Links links(n, {-1, -1, -1, -1});
   std::vector<char> alive(n, 0);
-  for (int i : order) {
-    table.Insert(forest.tree[i], forest.label[i], i);
+  for (int i : members) {
     alive[i] = 1;
+    for (int d = 0; d < 4; ++d)
+      links[i][d] =
+          forest.table.Find(forest.tree[i], forest.label[i] + LatticeStep(d));
   }
 
-  // Remove corners that are no saddles of the lattice's checkerboard.
+  // Remove corners that are no saddles of the lattice's checkerboard (all
+  // judged on the links before any removal).
   if (!image.empty() && options.check_saddle_pattern) {
     std::vector<int> not_saddle;
-    for (int i : order) {
-      if (!LooksLikeSaddle(xy, image, table, forest.tree[i], i, forest.label[i],
-                           options.saddle_sample_fraction))
+    for (int i : members) {
+      if (!LooksLikeSaddle(xy, image, links, i, options.saddle_sample_fraction))
         not_saddle.push_back(i);
     }
     for (int i : not_saddle) {
-      table.Erase(forest.tree[i], forest.label[i]);
+      Unlink(&links, i);
       alive[i] = 0;
       ++summary->num_removed_not_saddle;
     }
@@ -160,16 +175,15 @@ std::vector<GridComponent> ExtractComponents(
   std::vector<int> removals;
   for (int round = 0; round < kMaxRounds; ++round) {
     removals.clear();
-    for (int i : order) {
+    for (int i : members) {
       if (!alive[i]) continue;
       int supported, contradicted;
-      ScoreCorner(xy, table, forest.tree[i], i, forest.label[i], options,
-                  &supported, &contradicted);
+      ScoreCorner(xy, links, i, options, &supported, &contradicted);
       if (contradicted > supported) removals.push_back(i);
     }
     if (removals.empty()) break;
     for (int i : removals) {
-      table.Erase(forest.tree[i], forest.label[i]);
+      Unlink(&links, i);
       alive[i] = 0;
       ++summary->num_removed_by_prediction;
     }
@@ -180,16 +194,13 @@ std::vector<GridComponent> ExtractComponents(
   std::vector<char> visited(n, 0);
   std::vector<int> queue;
   queue.reserve(n);
-  for (int seed : order) {
+  for (int seed : members) {
     if (!alive[seed] || visited[seed]) continue;
-    const int tree = forest.tree[seed];
     queue.clear();
     queue.push_back(seed);
     visited[seed] = 1;
     for (size_t q = 0; q < queue.size(); ++q) {
-      const int c = queue[q];
-      for (int d = 0; d < 4; ++d) {
-        const int m = table.Find(tree, forest.label[c] + LatticeStep(d));
+      for (int m : links[queue[q]]) {
         if (m >= 0 && !visited[m]) {
           visited[m] = 1;
           queue.push_back(m);

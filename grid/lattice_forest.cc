@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <utility>
 
 #include "grid/dihedral.h"
@@ -18,16 +19,8 @@ bool GridEdgeLess(const GridEdge& x, const GridEdge& y) {
 
 namespace {
 
-// Why a merge was refused.
-enum class Refusal {
-  kNone,
-  kNeighborWeight,
-  kTreeMeanWeight,
-  kAmbiguousAxis,
-  kLabelCollision,
-  kNeighborContradiction,
-  kCollinearity,
-};
+// Why a merge was refused (kMerged: it was not).
+using Refusal = GridEdgeDecision;
 
 // Direction index of an image vector in a corner's own axes: k = 0..3 for the
 // axis estimate rotated by k * 90 degrees; `cosine` of the angle between them.
@@ -51,6 +44,8 @@ class Forest {
     weight_sum_.assign(n, {0.0, 0.0});
     edge_count_.assign(n, {0, 0});
     label_.assign(n, Eigen::Vector2i::Zero());
+    box_low_.assign(n, Eigen::Vector2i::Zero());
+    box_high_.assign(n, Eigen::Vector2i::Zero());
     frame_.assign(n, Dihedral());
     neighbor_.assign(n, {-1, -1, -1, -1});
     neighbor_weight_.assign(n, {0, 0, 0, 0});
@@ -79,9 +74,10 @@ class Forest {
   void Export(LatticeForest* forest) {
     const int n = static_cast<int>(nodes_.xy.size());
     forest->tree.assign(n, -1);
-    forest->label = label_;
+    forest->label = std::move(label_);
     for (int i = 0; i < n; ++i)
       if (nodes_.valid[i]) forest->tree[i] = Find(i);
+    forest->table = std::move(table_);
   }
 
  private:
@@ -191,6 +187,11 @@ class Forest {
   // Per root and lattice axis (0 = i, 1 = j): sum and count of edge weights.
   std::vector<std::array<double, 2>> weight_sum_;
   std::vector<std::array<int, 2>> edge_count_;
+  // Per root: bounding box of its labels. A moved corner whose new label lies
+  // more than one step outside the kept tree's box can neither collide with
+  // nor neighbour any of its corners.
+  std::vector<Eigen::Vector2i> box_low_;
+  std::vector<Eigen::Vector2i> box_high_;
 
   // Per corner: label in its tree, the map from its own axis directions
   // (k = 0..3) to lattice steps, and its tree edges by own axis direction.
@@ -257,11 +258,23 @@ Refusal Forest::TryMerge(const GridEdge& edge) {
       return Refusal::kTreeMeanWeight;
   }
 
-  // Verify every corner of the moved tree in its new place.
+  // The moved tree's box in the kept tree's labels.
+  const Eigen::Vector2i c0 = rotation.Apply(box_low_[rb]) + offset;
+  const Eigen::Vector2i c1 = rotation.Apply(box_high_[rb]) + offset;
+  const Eigen::Vector2i moved_low = c0.cwiseMin(c1);
+  const Eigen::Vector2i moved_high = c0.cwiseMax(c1);
+  if (moved_low.minCoeff() < -LabelTable::kMaxLabel ||
+      moved_high.maxCoeff() > LabelTable::kMaxLabel)
+    return Refusal::kLabelCollision;
+  const Eigen::Vector2i near_low = box_low_[ra] - Eigen::Vector2i::Ones();
+  const Eigen::Vector2i near_high = box_high_[ra] + Eigen::Vector2i::Ones();
+
+  // Verify every corner of the moved tree that lands next to the kept one.
   for (int n = rb; n >= 0; n = next_[n]) {
     const Eigen::Vector2i new_label = rotation.Apply(label_[n]) + offset;
-    if (new_label.cwiseAbs().maxCoeff() > LabelTable::kMaxLabel)
-      return Refusal::kLabelCollision;
+    if ((new_label.array() < near_low.array()).any() ||
+        (new_label.array() > near_high.array()).any())
+      continue;
     if (table_.Find(ra, new_label) >= 0) return Refusal::kLabelCollision;
     const Dihedral new_frame = rotation.Compose(frame_[n]);
     for (int d = 0; d < 4; ++d) {
@@ -287,6 +300,8 @@ Refusal Forest::TryMerge(const GridEdge& edge) {
     frame_[n] = rotation.Compose(frame_[n]);
     table_.Insert(ra, label_[n], n);
   }
+  box_low_[ra] = box_low_[ra].cwiseMin(moved_low);
+  box_high_[ra] = box_high_[ra].cwiseMax(moved_high);
   parent_[rb] = ra;
   size_[ra] += size_[rb];
   next_[tail_[ra]] = rb;
@@ -305,49 +320,141 @@ Refusal Forest::TryMerge(const GridEdge& edge) {
   neighbor_[b][at_b.k] = a;
   neighbor_weight_[b][at_b.k] = w;
   neighbor_length_[b][at_b.k] = edge.length;
-  return Refusal::kNone;
+  return Refusal::kMerged;
 }
 
 }  // namespace
 
-void BuildLatticeForest(const LatticeNodes& nodes,
-                        const std::vector<GridEdge>& sorted_edges,
-                        const GridOptions& options, GridSummary* summary,
-                        LatticeForest* forest) {
+void BuildLatticeForest(
+    const LatticeNodes& nodes, const std::vector<GridEdge>& sorted_edges,
+    const std::function<bool(const GridEdge&)>& crosses_tile,
+    const std::function<bool(const GridEdge&)>& sides_flip,
+    const GridOptions& options, GridSummary* summary, LatticeForest* forest,
+    std::vector<GridEdgeTrace>* trace) {
   Forest state(nodes, options);
-  for (int pass = 0; pass < options.kruskal_passes; ++pass) {
-    int merges_this_pass = 0;
-    for (const GridEdge& edge : sorted_edges) {
-      if (state.Find(edge.a) == state.Find(edge.b)) {
-        if (pass == 0) ++summary->num_edges_same_tree;
+  if (trace != nullptr) trace->clear();
+  auto record = [&](const GridEdge& edge, Refusal decision) -> int {
+    if (trace == nullptr) return -1;
+    GridEdgeTrace t;
+    t.a = edge.a;
+    t.b = edge.b;
+    t.length = edge.length;
+    t.weight = edge.weight;
+    t.penalised = edge.penalised;
+    t.decision = decision;
+    trace->push_back(t);
+    return static_cast<int>(trace->size()) - 1;
+  };
+  auto count = [&](Refusal refusal) {
+    switch (refusal) {
+      case Refusal::kSameTree:
+        ++summary->num_edges_same_tree;
+        break;
+      case Refusal::kMerged:
+        ++summary->num_merges;
+        break;
+      case Refusal::kNeighborWeight:
+        ++summary->num_rejected_neighbor_weight;
+        break;
+      case Refusal::kTreeMeanWeight:
+        ++summary->num_rejected_tree_mean_weight;
+        break;
+      case Refusal::kAmbiguousAxis:
+        ++summary->num_rejected_ambiguous_axis;
+        break;
+      case Refusal::kLabelCollision:
+        ++summary->num_rejected_label_collision;
+        break;
+      case Refusal::kNeighborContradiction:
+        ++summary->num_rejected_neighbor_contradiction;
+        break;
+      case Refusal::kCollinearity:
+        ++summary->num_rejected_collinearity;
+        break;
+      case Refusal::kSidesFlip:
+        ++summary->num_rejected_sides_flip;
+        break;
+      case Refusal::kPenalised:
+        break;  // counted in num_edges_penalised
+    }
+  };
+
+  // First pass in weight order: the edges sorted by length, merged with a
+  // heap of the penalised ones (weight = length x penalty). An edge is
+  // sampled for the penalty only when it is reached and joins two trees.
+  auto heap_after = [](const GridEdge& x, const GridEdge& y) {
+    return GridEdgeLess(y, x);
+  };
+  std::vector<GridEdge> heap;
+  std::vector<GridEdge> refused;   // in the order they were refused
+  std::vector<int> refused_trace;  // their trace entries
+  size_t next = 0;
+  while (next < sorted_edges.size() || !heap.empty()) {
+    const bool from_heap =
+        !heap.empty() && (next == sorted_edges.size() ||
+                          GridEdgeLess(heap.front(), sorted_edges[next]));
+    GridEdge edge;
+    if (from_heap) {
+      std::pop_heap(heap.begin(), heap.end(), heap_after);
+      edge = heap.back();
+      heap.pop_back();
+    } else {
+      edge = sorted_edges[next++];
+    }
+    if (state.Find(edge.a) == state.Find(edge.b)) {
+      count(Refusal::kSameTree);
+      record(edge, Refusal::kSameTree);
+      continue;
+    }
+    if (!from_heap && crosses_tile && crosses_tile(edge)) {
+      edge.weight *= options.penalty_factor;
+      edge.penalised = true;
+      ++summary->num_edges_penalised;
+      if (options.refuse_penalised_edges) {
+        count(Refusal::kPenalised);
+        record(edge, Refusal::kPenalised);
         continue;
       }
-      switch (state.TryMerge(edge)) {
-        case Refusal::kNone:
-          ++summary->num_merges;
-          ++merges_this_pass;
-          break;
-        case Refusal::kNeighborWeight:
-          ++summary->num_rejected_neighbor_weight;
-          break;
-        case Refusal::kTreeMeanWeight:
-          ++summary->num_rejected_tree_mean_weight;
-          break;
-        case Refusal::kAmbiguousAxis:
-          ++summary->num_rejected_ambiguous_axis;
-          break;
-        case Refusal::kLabelCollision:
-          ++summary->num_rejected_label_collision;
-          break;
-        case Refusal::kNeighborContradiction:
-          ++summary->num_rejected_neighbor_contradiction;
-          break;
-        case Refusal::kCollinearity:
-          ++summary->num_rejected_collinearity;
-          break;
+      heap.push_back(edge);
+      std::push_heap(heap.begin(), heap.end(), heap_after);
+      continue;
+    }
+    if (sides_flip && sides_flip(edge)) {
+      count(Refusal::kSidesFlip);
+      record(edge, Refusal::kSidesFlip);
+      continue;  // never retried
+    }
+    const Refusal refusal = state.TryMerge(edge);
+    count(refusal);
+    const int t = record(edge, refusal);
+    if (refusal != Refusal::kMerged) {
+      refused.push_back(edge);
+      refused_trace.push_back(t);
+    }
+  }
+
+  // Later passes retry the refused edges (the trees have grown since).
+  for (int pass = 1; pass < options.kruskal_passes && !refused.empty();
+       ++pass) {
+    std::vector<GridEdge> still_refused;
+    std::vector<int> still_refused_trace;
+    int merges_this_pass = 0;
+    for (size_t e = 0; e < refused.size(); ++e) {
+      const GridEdge& edge = refused[e];
+      if (state.Find(edge.a) == state.Find(edge.b)) continue;
+      const Refusal refusal = state.TryMerge(edge);
+      count(refusal);
+      if (trace != nullptr) (*trace)[refused_trace[e]].decision = refusal;
+      if (refusal == Refusal::kMerged) {
+        ++merges_this_pass;
+      } else {
+        still_refused.push_back(edge);
+        still_refused_trace.push_back(refused_trace[e]);
       }
     }
-    if (pass > 0 && merges_this_pass == 0) break;
+    if (merges_this_pass == 0) break;
+    refused.swap(still_refused);
+    refused_trace.swap(still_refused_trace);
   }
   state.Export(forest);
 }

@@ -5,9 +5,11 @@
 // merge step of BuildGrid (grid/grid.h).
 
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "grid/grid.h"
+#include "grid/label_table.h"
 
 namespace puzzlecal {
 
@@ -17,6 +19,7 @@ struct GridEdge {
   double length = 0;  // pixels
   int a = 0;
   int b = 0;
+  bool penalised = false;
 };
 
 // Orders edges by weight, then by (a, b): one deterministic sort.
@@ -35,16 +38,26 @@ struct LatticeNodes {
 struct LatticeForest {
   std::vector<int> tree;               // tree id per corner, -1 if invalid
   std::vector<Eigen::Vector2i> label;  // label inside its tree
+  LabelTable table{0};                 // (tree, label) -> corner
 };
 
 // Runs options.kruskal_passes passes of Kruskal over `sorted_edges` (sorted by
-// GridEdgeLess), merging trees by the lattice symmetry that the corners' axes
-// at the joining edge imply, and only when the merge checks pass. Counts go to
-// `summary` (merge rejections are counted per attempt).
-void BuildLatticeForest(const LatticeNodes& nodes,
-                        const std::vector<GridEdge>& sorted_edges,
-                        const GridOptions& options, GridSummary* summary,
-                        LatticeForest* forest);
+// GridEdgeLess, weight = length), merging trees by the lattice symmetry that
+// the corners' axes at the joining edge imply, and only when the merge checks
+// pass. `crosses_tile` (may be empty) says whether an edge gets the intensity
+// penalty (weight x options.penalty_factor); it is asked only for edges that
+// join two trees when their turn comes, and penalised edges are taken up
+// again at their new weight. `sides_flip` (may be empty) refuses an edge
+// when its turn comes (it spans two tiles). The second and later passes retry
+// the edges refused before. Counts go to `summary` (merge rejections are
+// counted per attempt); `trace` (optional) gets every edge with its last
+// decision.
+void BuildLatticeForest(
+    const LatticeNodes& nodes, const std::vector<GridEdge>& sorted_edges,
+    const std::function<bool(const GridEdge&)>& crosses_tile,
+    const std::function<bool(const GridEdge&)>& sides_flip,
+    const GridOptions& options, GridSummary* summary, LatticeForest* forest,
+    std::vector<GridEdgeTrace>* trace = nullptr);
 
 }  // namespace puzzlecal
 

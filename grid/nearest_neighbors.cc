@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace puzzlecal {
 namespace {
@@ -64,7 +65,6 @@ void FindNearestNeighbors(const std::vector<Eigen::Vector2d>& points, int k,
       std::clamp(std::ceil(height / cell), 1.0, double(kMaxCellsPerAxis)));
   const double cell_x = width / nx;
   const double cell_y = height / ny;
-  const double cell_min = std::min(cell_x, cell_y);
 
   auto cell_of = [&](const Eigen::Vector2d& p, int* cx, int* cy) {
     *cx = static_cast<int>(
@@ -73,7 +73,8 @@ void FindNearestNeighbors(const std::vector<Eigen::Vector2d>& points, int k,
         std::clamp(std::floor((p.y() - y_lo) / cell_y), 0.0, ny - 1.0));
   };
 
-  // Counting sort of the points into cells.
+  // Counting sort of the points into cells; coordinates copied in cell
+  // order so that a cell's points are contiguous in memory.
   std::vector<int> cell_index(n);
   std::vector<int> cell_start(static_cast<size_t>(nx) * ny + 1, 0);
   for (int i = 0; i < n; ++i) {
@@ -84,21 +85,28 @@ void FindNearestNeighbors(const std::vector<Eigen::Vector2d>& points, int k,
   }
   for (size_t c = 1; c < cell_start.size(); ++c)
     cell_start[c] += cell_start[c - 1];
-  std::vector<int> cell_points(n);
+  std::vector<int> sorted_id(n);
+  std::vector<double> sorted_x(n), sorted_y(n);
   {
     std::vector<int> fill(cell_start.begin(), cell_start.end() - 1);
-    for (int i = 0; i < n; ++i) cell_points[fill[cell_index[i]]++] = i;
+    for (int i = 0; i < n; ++i) {
+      const int s = fill[cell_index[i]]++;
+      sorted_id[s] = i;
+      sorted_x[s] = points[i].x();
+      sorted_y[s] = points[i].y();
+    }
   }
 
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
   std::vector<double> best_dist(k);
   std::vector<int> best_index(k);
-  const int max_ring = std::max(nx, ny);
-  for (int i = 0; i < n; ++i) {
+  for (int qs = 0; qs < n; ++qs) {  // queries in cell order
+    const int i = sorted_id[qs];
     TopK top{k, 0, best_dist.data(), best_index.data()};
-    int qx, qy;
-    cell_of(points[i], &qx, &qy);
-    const Eigen::Vector2d& q = points[i];
-    for (int ring = 0; ring <= max_ring; ++ring) {
+    const int qcell = cell_index[i];
+    const int qx = qcell % nx, qy = qcell / nx;
+    const double px = sorted_x[qs], py = sorted_y[qs];
+    for (int ring = 0;; ++ring) {
       const int y0 = qy - ring, y1 = qy + ring;
       const int x0 = qx - ring, x1 = qx + ring;
       for (int cy = std::max(y0, 0); cy <= std::min(y1, ny - 1); ++cy) {
@@ -108,17 +116,26 @@ void FindNearestNeighbors(const std::vector<Eigen::Vector2d>& points, int k,
           if (cx < 0 || cx >= nx) continue;
           const int c = cy * nx + cx;
           for (int s = cell_start[c]; s < cell_start[c + 1]; ++s) {
-            const int j = cell_points[s];
-            if (j == i) continue;
-            top.Offer((points[j] - q).squaredNorm(), j);
+            if (s == qs) continue;
+            const double dx = sorted_x[s] - px, dy = sorted_y[s] - py;
+            top.Offer(dx * dx + dy * dy, sorted_id[s]);
           }
         }
       }
-      // Points in cells of ring r + 1 or beyond are at least r cells away.
-      if (top.count == k) {
-        const double bound = ring * cell_min;
-        if (top.dist[k - 1] <= bound * bound) break;
-      }
+      // Every point not yet seen lies in a cell outside the searched block
+      // (points beyond the grid were put in its border cells, which only
+      // moves them farther out): at least the distance to the block's
+      // nearest side that has cells beyond it.
+      const double left = x0 > 0 ? px - (x_lo + x0 * cell_x) : kInfinity;
+      const double right =
+          x1 < nx - 1 ? (x_lo + (x1 + 1) * cell_x) - px : kInfinity;
+      const double top_side = y0 > 0 ? py - (y_lo + y0 * cell_y) : kInfinity;
+      const double bottom =
+          y1 < ny - 1 ? (y_lo + (y1 + 1) * cell_y) - py : kInfinity;
+      const double bound = std::min({left, right, top_side, bottom});
+      if (bound == kInfinity) break;  // the block covers the grid
+      if (top.count == k && bound > 0 && top.dist[k - 1] <= bound * bound)
+        break;
     }
     std::copy(best_index.begin(), best_index.begin() + top.count,
               neighbors->begin() + static_cast<size_t>(i) * k);
