@@ -6,7 +6,6 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
-#include <unordered_map>
 
 #include "detection/corner_filters.h"
 #include "detection/hessian_response.h"
@@ -79,6 +78,12 @@ bool DetectorOptions::Check(std::string* why) const {
         min_saddle_sigma_px <= max_saddle_sigma_px &&
         max_saddle_sigma_px <= 16.0)) {
     return fail("need 0.5 <= min_saddle_sigma_px <= max_saddle_sigma_px <= 16");
+  }
+  if (saddle_max_iterations < 1 || saddle_max_iterations > 100) {
+    return fail("saddle_max_iterations must be in [1, 100]");
+  }
+  if (!(saddle_convergence_px > 0.0)) {
+    return fail("saddle_convergence_px must be > 0");
   }
   if (max_iterations < 1 || max_iterations > 100) {
     return fail("max_iterations must be in [1, 100]");
@@ -255,35 +260,42 @@ class PointGrid {
   PointGrid(double cell, int width, int height)
       : cell_(std::max(cell, 1.0)),
         cols_(static_cast<int>(width / cell_) + 1),
-        rows_(static_cast<int>(height / cell_) + 1) {}
+        rows_(static_cast<int>(height / cell_) + 1),
+        cells_(static_cast<size_t>(cols_) * rows_) {}
 
   void Add(const Eigen::Vector2d& p, int index) {
-    cells_[Key(p)].push_back(index);
+    cells_[static_cast<size_t>(CellOf(p.y(), rows_)) * cols_ +
+           CellOf(p.x(), cols_)]
+        .push_back(index);
   }
 
-  // Calls f(index) for every stored point in cells within `radius` of p.
+  // Calls f(index) for every stored point in cells within `radius` of p
+  // (points outside the image sit in the border cells).
   template <typename F>
   void ForNear(const Eigen::Vector2d& p, double radius, F f) const {
-    const int cx0 = CellOf(p.x() - radius), cx1 = CellOf(p.x() + radius);
-    const int cy0 = CellOf(p.y() - radius), cy1 = CellOf(p.y() + radius);
+    const int cx0 = CellOf(p.x() - radius, cols_);
+    const int cx1 = CellOf(p.x() + radius, cols_);
+    const int cy0 = CellOf(p.y() - radius, rows_);
+    const int cy1 = CellOf(p.y() + radius, rows_);
     for (int cy = cy0; cy <= cy1; ++cy) {
       for (int cx = cx0; cx <= cx1; ++cx) {
-        auto it = cells_.find(static_cast<int64_t>(cy) * (cols_ + 2) + cx);
-        if (it == cells_.end()) continue;
-        for (int index : it->second) f(index);
+        for (int index : cells_[static_cast<size_t>(cy) * cols_ + cx]) {
+          f(index);
+        }
       }
     }
   }
 
  private:
-  int CellOf(double v) const { return static_cast<int>(std::floor(v / cell_)); }
-  int64_t Key(const Eigen::Vector2d& p) const {
-    return static_cast<int64_t>(CellOf(p.y())) * (cols_ + 2) + CellOf(p.x());
+  int CellOf(double v, int count) const {
+    const double cell = std::floor(v / cell_);
+    if (!(cell >= 0.0)) return 0;  // also NaN
+    return cell >= count - 1 ? count - 1 : static_cast<int>(cell);
   }
   double cell_;
   int cols_;
   int rows_;
-  std::unordered_map<int64_t, std::vector<int>> cells_;
+  std::vector<std::vector<int>> cells_;
 };
 
 }  // namespace
@@ -499,13 +511,15 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
       // On the input grey values: the detector's blur would carry the
       // structures around a corner (PuzzleBoard discs) closer to it.
       const SaddleRefineResult r = RefineBySaddleFit(
-          *single, c.xy, sigma, options.max_iterations, options.convergence_px,
+          *single, c.xy, sigma, options.saddle_max_iterations,
+          options.saddle_convergence_px,
           options.max_shift_fraction * window + std::ldexp(0.5, c.level));
       if (!r.ok) {
         ++s.refine_failed;
         continue;
       }
       corner.xy = r.xy;
+      corner.orientation = r.orientation;
     }
     refined.push_back(corner);
     refined_window.push_back(window);
@@ -535,9 +549,11 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
       }
       kept_grid.Add(c.xy, static_cast<int>(kept_corners.size()));
       Corner out = c;
-      out.orientation = HessianOrientation(
-          blurred[0], c.xy,
-          options.orientation_spacing_fraction * refined_window[index]);
+      if (options.subpixel != SubpixelMethod::kSaddleFit) {
+        out.orientation = HessianOrientation(
+            blurred[0], c.xy,
+            options.orientation_spacing_fraction * refined_window[index]);
+      }
       kept_corners.push_back(out);
     }
     corners = std::move(kept_corners);

@@ -211,7 +211,7 @@ void GaussianRun(double u0, double h, int n, double* out) {
 
 template <typename Pixel>
 bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
-                int radius, Eigen::Vector2d* step) {
+                int radius, Eigen::Vector2d* step, double* orientation) {
   const int cx = static_cast<int>(std::floor(p.x() + 0.5));
   const int cy = static_cast<int>(std::floor(p.y() + 0.5));
   if (cx - radius < 0 || cy - radius < 0 || cx + radius >= image.cols ||
@@ -308,6 +308,10 @@ bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
   if (!(det < -0.05 * (hxx * hxx + hyy * hyy + 2.0 * hxy * hxy))) {
     return false;
   }
+  // Eigenvector of the larger eigenvalue of [[hxx, hxy], [hxy, hyy]].
+  double angle = 0.5 * std::atan2(2.0 * hxy, hxx - hyy);
+  if (angle <= -M_PI / 2) angle += M_PI;
+  *orientation = angle;
   *step = sigma * Eigen::Vector2d((-hyy * q[1] + hxy * q[2]) / det,
                                   (hxy * q[1] - hxx * q[2]) / det);
   return std::isfinite(step->x()) && std::isfinite(step->y());
@@ -336,13 +340,16 @@ SaddleRefineResult RefineBySaddleFit(const cv::Mat& image,
     bool ok = false;
     switch (image.depth()) {
       case CV_8U:
-        ok = SaddleStep<uint8_t>(image, p, sigma_px, radius, &step);
+        ok = SaddleStep<uint8_t>(image, p, sigma_px, radius, &step,
+                                 &result.orientation);
         break;
       case CV_16U:
-        ok = SaddleStep<uint16_t>(image, p, sigma_px, radius, &step);
+        ok = SaddleStep<uint16_t>(image, p, sigma_px, radius, &step,
+                                  &result.orientation);
         break;
       case CV_32F:
-        ok = SaddleStep<float>(image, p, sigma_px, radius, &step);
+        ok = SaddleStep<float>(image, p, sigma_px, radius, &step,
+                               &result.orientation);
         break;
       default:
         break;

@@ -33,6 +33,10 @@ struct SaddleRefineResult {
   bool ok = false;  // converged to a saddle (Hessian of the fit indefinite)
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();
   int iterations = 0;
+  // Angle in (-pi/2, pi/2] of the eigenvector of the larger (positive)
+  // eigenvalue of the last fit's Hessian: along the diagonal through the
+  // two brighter tiles (the orientation of DetectCorners).
+  double orientation = 0.0;
 };
 
 // Saddle-point fit: a quadratic a + b x + c y + d x^2 + e x y + f y^2 is
