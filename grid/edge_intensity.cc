@@ -22,14 +22,35 @@ double SampleBilinear(const cv::Mat& image, double x, double y) {
   return top + fy * (bottom - top);
 }
 
+// Bilinear without clamping: 0 <= x < cols - 1, 0 <= y < rows - 1.
+template <typename T>
+inline double SampleInside(const cv::Mat& image, double x, double y) {
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const double fx = x - x0, fy = y - y0;
+  const T* row0 = image.ptr<T>(y0) + x0;
+  const T* row1 = image.ptr<T>(y0 + 1) + x0;
+  const double top = row0[0] + fx * (double(row0[1]) - row0[0]);
+  const double bottom = row1[0] + fx * (double(row1[1]) - row1[0]);
+  return top + fy * (bottom - top);
+}
+
+bool Inside(const cv::Mat& image, const Eigen::Vector2d& p) {
+  return p.x() >= 0 && p.y() >= 0 && p.x() < image.cols - 1 &&
+         p.y() < image.rows - 1;
+}
+
 template <typename T>
 bool CrossesTile(const cv::Mat& image, const Eigen::Vector2d& a,
                  const Eigen::Vector2d& b, int n, double fraction) {
   const int third = std::max(n / 3, 1);
   double sum = 0, first = 0, last = 0;
-  for (int s = 0; s < n; ++s) {
-    const Eigen::Vector2d p = a + (b - a) * ((s + 0.5) / n);
-    const double v = SampleBilinear<T>(image, p.x(), p.y());
+  // Both ends inside: every sample between them is (no clamping needed).
+  const bool inside = Inside(image, a) && Inside(image, b);
+  const Eigen::Vector2d step = (b - a) / n;
+  Eigen::Vector2d p = a + 0.5 * step;
+  for (int s = 0; s < n; ++s, p += step) {
+    const double v = inside ? SampleInside<T>(image, p.x(), p.y())
+                            : SampleBilinear<T>(image, p.x(), p.y());
     sum += v;
     if (s < third) first += v;
     if (s >= n - third) last += v;

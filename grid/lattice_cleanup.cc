@@ -189,36 +189,43 @@ std::vector<GridComponent> ExtractComponents(
     }
   }
 
-  // Split into 4-connected label sets.
+  // Split into 4-connected label sets: a component number per corner, then
+  // the members in index order.
   std::vector<GridComponent> components;
-  std::vector<char> visited(n, 0);
+  std::vector<int> component_of(n, -1);
   std::vector<int> queue;
   queue.reserve(n);
   for (int seed : members) {
-    if (!alive[seed] || visited[seed]) continue;
+    if (!alive[seed] || component_of[seed] != -1) continue;
     queue.clear();
     queue.push_back(seed);
-    visited[seed] = 1;
+    component_of[seed] = -2;
     for (size_t q = 0; q < queue.size(); ++q) {
       for (int m : links[queue[q]]) {
-        if (m >= 0 && !visited[m]) {
-          visited[m] = 1;
+        if (m >= 0 && component_of[m] == -1) {
+          component_of[m] = -2;
           queue.push_back(m);
         }
       }
     }
+    int id = -3;  // dropped
     if (static_cast<int>(queue.size()) < options.min_component_size) {
       ++summary->num_components_dropped;
-      continue;
+    } else {
+      id = static_cast<int>(components.size());
+      components.emplace_back();
+      components.back().corner.reserve(queue.size());
     }
-    std::sort(queue.begin(), queue.end());
-    Eigen::Vector2i low = forest.label[queue[0]];
-    for (int c : queue) low = low.cwiseMin(forest.label[c]);
-    GridComponent component;
-    component.corner = queue;
-    component.ij.reserve(queue.size());
-    for (int c : queue) component.ij.push_back(forest.label[c] - low);
-    components.push_back(std::move(component));
+    for (int c : queue) component_of[c] = id;
+  }
+  for (int i : members)
+    if (component_of[i] >= 0) components[component_of[i]].corner.push_back(i);
+  for (GridComponent& component : components) {
+    Eigen::Vector2i low = forest.label[component.corner[0]];
+    for (int c : component.corner) low = low.cwiseMin(forest.label[c]);
+    component.ij.reserve(component.corner.size());
+    for (int c : component.corner)
+      component.ij.push_back(forest.label[c] - low);
   }
   std::sort(components.begin(), components.end(),
             [](const GridComponent& x, const GridComponent& y) {

@@ -11,12 +11,6 @@
 
 namespace puzzlecal {
 
-bool GridEdgeLess(const GridEdge& x, const GridEdge& y) {
-  if (x.weight != y.weight) return x.weight < y.weight;
-  if (x.a != y.a) return x.a < y.a;
-  return x.b < y.b;
-}
-
 namespace {
 
 // Why a merge was refused (kMerged: it was not).

@@ -23,7 +23,11 @@ struct GridEdge {
 };
 
 // Orders edges by weight, then by (a, b): one deterministic sort.
-bool GridEdgeLess(const GridEdge& x, const GridEdge& y);
+inline bool GridEdgeLess(const GridEdge& x, const GridEdge& y) {
+  if (x.weight != y.weight) return x.weight < y.weight;
+  if (x.a != y.a) return x.a < y.a;
+  return x.b < y.b;
+}
 
 // Corner geometry the forest reads.
 struct LatticeNodes {

@@ -56,7 +56,7 @@ void FindNearestNeighbors(const std::vector<Eigen::Vector2d>& points, int k,
   const double height = std::max(y_hi - y_lo, 1e-9);
   // About 3.3 points per cell: the 8th neighbour of a lattice point then
   // usually lies within one cell, so the 3x3 block around it suffices.
-  double cell = std::sqrt(3.3 * width * height / n);
+  double cell = std::sqrt(2.0 * width * height / n);
   if (!(cell > 0)) cell = std::max(width, height);
   constexpr int kMaxCellsPerAxis = 4096;
   const int nx = static_cast<int>(
@@ -112,8 +112,21 @@ void FindNearestNeighbors(const std::vector<Eigen::Vector2d>& points, int k,
       for (int cy = std::max(y0, 0); cy <= std::min(y1, ny - 1); ++cy) {
         const bool full_row = (cy == y0 || cy == y1);
         const int step = full_row ? 1 : std::max(x1 - x0, 1);
+        // Vertical distance from the query to this row of cells (border
+        // cells reach out to infinity: they hold the points beyond).
+        const double row_low = cy > 0 ? y_lo + cy * cell_y : -kInfinity;
+        const double row_high =
+            cy < ny - 1 ? y_lo + (cy + 1) * cell_y : kInfinity;
+        const double gap_y = std::max({0.0, row_low - py, py - row_high});
         for (int cx = x0; cx <= x1; cx += step) {
           if (cx < 0 || cx >= nx) continue;
+          if (top.count == k) {  // skip cells beyond the current k-th
+            const double col_low = cx > 0 ? x_lo + cx * cell_x : -kInfinity;
+            const double col_high =
+                cx < nx - 1 ? x_lo + (cx + 1) * cell_x : kInfinity;
+            const double gap_x = std::max({0.0, col_low - px, px - col_high});
+            if (gap_x * gap_x + gap_y * gap_y > top.dist[k - 1]) continue;
+          }
           const int c = cy * nx + cx;
           for (int s = cell_start[c]; s < cell_start[c + 1]; ++s) {
             if (s == qs) continue;
