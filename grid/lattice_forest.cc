@@ -227,6 +227,14 @@ Refusal Forest::TryMerge(const GridEdge& edge) {
 
   // b's direction kb points where a's ka + 2 points; b's kb + 1 runs along
   // a's ka + 1 or against it (then a reflection of the own axes).
+  // The reflection branch (sigma = -1) cannot be taken: both frames turn
+  // like the image (direction k + 1 is direction k turned by +90 degrees),
+  // so the dot product below equals Direction(b, kb) . Direction(a, ka),
+  // and Classify put those within 45 degrees of -e and e (e: the step a ->
+  // b), i.e. more than 90 degrees apart: it is negative. Trees therefore
+  // merge by rotations only and every label turns like the image
+  // (GridTest.AllComponentsTurnLikeTheImage); the general form is kept so
+  // that the merge stays correct for any frame convention.
   const int sigma =
       Direction(b, at_b.k + 1).dot(Direction(a, at_a.k + 1)) < 0 ? 1 : -1;
   const Dihedral b_axes_to_a_axes{sigma, Mod4(at_a.k + 2 - sigma * at_b.k)};

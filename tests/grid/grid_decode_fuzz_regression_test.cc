@@ -23,7 +23,8 @@ TEST(GridDecodeFuzzRegressionTest, CorpusKeepsGridAndDecodePromises) {
   const int replayed = fuzz::ReplayCorpus(
       "fuzz/corpus/grid_decode_fuzzer",
       [](const std::string& name, const std::vector<uint8_t>& bytes) {
-        EXPECT_EQ(fuzz::RunGridDecodeCase(bytes.data(), bytes.size()), "") << name;
+        EXPECT_EQ(fuzz::RunGridDecodeCase(bytes.data(), bytes.size()), "")
+            << name;
       });
   ASSERT_NE(replayed, -1) << "run from the repository root (ctest does)";
   EXPECT_GE(replayed, 5);

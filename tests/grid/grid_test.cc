@@ -8,6 +8,8 @@
 
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <random>
 
 #include "tests/grid/grid_test_util.h"
 
@@ -201,6 +203,112 @@ TEST(GridTest, DeterministicOutput) {
     EXPECT_EQ(first[c].corner, second[c].corner);
     EXPECT_EQ(first[c].ij, second[c].ij);
   }
+}
+
+// True when one rotation of the lattice (no reflection) plus an offset maps
+// the labels `from` onto `to` (same corners, same order).
+bool SameUpToRotation(const GridComponent& from, const GridComponent& to) {
+  if (from.corner != to.corner || from.ij.empty()) return false;
+  static const int kRotation[4][2][2] = {{{1, 0}, {0, 1}},
+                                         {{0, -1}, {1, 0}},
+                                         {{-1, 0}, {0, -1}},
+                                         {{0, 1}, {-1, 0}}};
+  for (const auto& r : kRotation) {
+    Eigen::Matrix2i m;
+    m << r[0][0], r[0][1], r[1][0], r[1][1];
+    const Eigen::Vector2i offset = to.ij[0] - m * from.ij[0];
+    bool all = true;
+    for (size_t k = 0; k < from.ij.size() && all; ++k)
+      all = to.ij[k] == m * from.ij[k] + offset;
+    if (all) return true;
+  }
+  return false;
+}
+
+// The detector's orientation is an axis, defined modulo pi (it reports it in
+// (-pi/2, pi/2]): adding or subtracting pi to any corner's orientation must
+// give the same components with the same labels up to a rotation of the
+// whole component (a tree's labels start from the axes of its first corner).
+TEST(GridTest, OrientationsCountModuloPi) {
+  int seed = 1;
+  for (const Camera& camera :
+       {grid_test::PinholeCamera(), grid_test::FisheyeCamera()}) {
+    for (int angle : {90, 40, 25}) {
+      SyntheticBoard board;
+      board.cam_from_board = LookAtBoard(board, 0.3, angle, 30, 25);
+      SyntheticOptions options;
+      options.num_clutter = 40;
+      options.seed = seed++;
+      SyntheticCorners scene = ProjectBoards(camera, {board}, options);
+      const std::vector<GridComponent> reference =
+          BuildGrid(scene.corners, cv::Mat());
+      std::mt19937 rng(seed);
+      for (Corner& corner : scene.corners) {
+        const int turn = static_cast<int>(rng() % 3) - 1;  // -1, 0, 1
+        corner.orientation += turn * M_PI;
+      }
+      const std::vector<GridComponent> turned =
+          BuildGrid(scene.corners, cv::Mat());
+      ASSERT_EQ(turned.size(), reference.size()) << angle;
+      ASSERT_FALSE(reference.empty());
+      for (size_t c = 0; c < reference.size(); ++c)
+        EXPECT_TRUE(SameUpToRotation(reference[c], turned[c])) << angle;
+      EXPECT_EQ(CheckLabels(turned, scene.truth).wrong, 0) << angle;
+    }
+  }
+}
+
+// Merges never need a reflection: every corner's own axis frame turns like
+// the image (its direction k + 1 is direction k turned by +90 degrees), and
+// the joining step lies within 45 degrees of an axis at both ends, so the
+// two frames always meet as a rotation (BuildLatticeForest's sigma is +1).
+// Hence every lattice cell of every component, on any board and through any
+// camera, turns the same way in the image: (L + i) - L to (L + j) - L has one
+// sign of the cross product everywhere. A mirrored print or a board seen
+// through a mirror gives the same labels' handedness; decode/ tells them
+// apart by the code.
+TEST(GridTest, AllComponentsTurnLikeTheImage) {
+  int seed = 100;
+  int cells = 0, turned_other_way = 0;
+  for (const Camera& camera :
+       {grid_test::PinholeCamera(), grid_test::FisheyeCamera()}) {
+    for (int angle : {90, 50, 30, 20}) {
+      for (double roll : {0.0, 45.0, 160.0}) {
+        SyntheticBoard board;
+        board.cam_from_board = LookAtBoard(board, 0.3, angle, 60, roll);
+        SyntheticBoard mirrored = board;  // the board seen from its back
+        mirrored.cam_from_board =
+            board.cam_from_board * Eigen::Isometry3d(Eigen::AngleAxisd(
+                                       M_PI, Eigen::Vector3d::UnitX()));
+        for (const SyntheticBoard& b : {board, mirrored}) {
+          SyntheticOptions options;
+          options.num_clutter = 20;
+          options.seed = seed++;
+          const SyntheticCorners scene = ProjectBoards(camera, {b}, options);
+          const std::vector<GridComponent> components =
+              BuildGrid(scene.corners, cv::Mat());
+          for (const GridComponent& component : components) {
+            std::map<std::pair<int, int>, Eigen::Vector2d> at;
+            for (size_t k = 0; k < component.corner.size(); ++k)
+              at[{component.ij[k].x(), component.ij[k].y()}] =
+                  scene.corners[component.corner[k]].xy;
+            for (const auto& [l, p] : at) {
+              const auto pi = at.find({l.first + 1, l.second});
+              const auto pj = at.find({l.first, l.second + 1});
+              if (pi == at.end() || pj == at.end()) continue;
+              const Eigen::Vector2d u = pi->second - p, v = pj->second - p;
+              ++cells;
+              if (u.x() * v.y() - u.y() * v.x() < 0) ++turned_other_way;
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(cells, 1000);
+  // The lattice's j step is +90 degrees from its i step in the image
+  // (LatticeStep order and right-handed corner frames): all cells positive.
+  EXPECT_EQ(turned_other_way, 0);
 }
 
 TEST(GridTest, BadCornersAreIgnored) {
