@@ -422,6 +422,8 @@ bool SetGridOption(const std::string& arg, GridOptions* o) {
       {"max_collinearity_sin", &o->max_collinearity_sin},
       {"max_line_spacing_ratio", &o->max_line_spacing_ratio},
       {"max_axis_deviation_deg", &o->max_axis_deviation_deg},
+      {"max_axis_deviation_with_image_deg",
+       &o->max_axis_deviation_with_image_deg},
       {"max_adjacency_length_ratio", &o->max_adjacency_length_ratio},
       {"max_axis_aspect_ratio", &o->max_axis_aspect_ratio},
       {"saddle_sample_fraction", &o->saddle_sample_fraction},

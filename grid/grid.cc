@@ -86,6 +86,9 @@ bool GridOptions::Check(std::string* why) const {
     return Fail(why, "max_line_spacing_ratio must be finite and >= 1");
   if (!(max_axis_deviation_deg > 0 && max_axis_deviation_deg <= 45))
     return Fail(why, "max_axis_deviation_deg must be in (0, 45]");
+  if (!(max_axis_deviation_with_image_deg > 0 &&
+        max_axis_deviation_with_image_deg <= 45))
+    return Fail(why, "max_axis_deviation_with_image_deg must be in (0, 45]");
   if (!(max_adjacency_length_ratio >= 1 &&
         std::isfinite(max_adjacency_length_ratio)))
     return Fail(why, "max_adjacency_length_ratio must be finite and >= 1");

@@ -84,9 +84,16 @@ struct GridOptions {
   // the two tile edges at a corner lie on either side of the eigenvectors
   // (which bisect them), at 45 - theta/2 degrees from the estimate for tile
   // edges theta degrees apart: theta = 20 (steep views under fisheye, tiles
-  // of aspect 5 and more at the rim) gives 35 degrees. Merges are verified,
-  // so a step classified wrongly is refused, not mislabelled.
+  // of aspect 5 and more at the rim) gives 35 degrees. Without an image
+  // this band also keeps out "knight" edges (1 tile along one axis, 2 along
+  // the other) of views steeper than 25 degrees, which pass the orientation
+  // filter and look like lattice steps; with an image they cross tiles and
+  // the intensity test refuses them, so the band can be narrower.
   double max_axis_deviation_deg = 38.0;
+  // The same with an image (and refuse_penalised_edges). On the deltille
+  // fisheye photos 44 instead of 38 joins 130 more corners to the largest
+  // components, with 0 wrong labels.
+  double max_axis_deviation_with_image_deg = 44.0;
   // Two corners that a merge makes lattice neighbours must be at most this
   // factor farther apart (or closer) than the tree edges on the same lattice
   // line at either corner (or, for a corner without any tree edge, the

@@ -25,10 +25,11 @@ struct AxisStep {
 
 class Forest {
  public:
-  Forest(const LatticeNodes& nodes, const GridOptions& options)
+  Forest(const LatticeNodes& nodes, const GridOptions& options,
+         double max_axis_deviation_deg)
       : nodes_(nodes),
         options_(options),
-        min_axis_cosine_(std::cos(options.max_axis_deviation_deg * M_PI / 180)),
+        min_axis_cosine_(std::cos(max_axis_deviation_deg * M_PI / 180)),
         table_(static_cast<int>(nodes.xy.size())) {
     const int n = static_cast<int>(nodes.xy.size());
     parent_.resize(n);
@@ -161,6 +162,8 @@ class Forest {
     const AxisStep at_m = Classify(m, -v);
     if (at_n.cosine < min_axis_cosine_ || at_m.cosine < min_axis_cosine_)
       return false;
+    // Parity of the two own directions, as for the joining edge (TryMerge).
+    if ((at_n.k - at_m.k) % 2 == 0) return false;
     if (frame_n.Apply(at_n.k) != d) return false;
     if (frame_[m].Apply(at_m.k) != Mod4(d + 2)) return false;
     const double dist = v.norm();
@@ -212,6 +215,11 @@ Refusal Forest::TryMerge(const GridEdge& edge) {
   const AxisStep at_b = Classify(b, -e);
   if (at_a.cosine < min_axis_cosine_ || at_b.cosine < min_axis_cosine_)
     return Refusal::kAmbiguousAxis;
+  // Lattice neighbours have Hessian axes 90 degrees apart (their dark and
+  // light tiles swap; the orientation filter keeps only such pairs), so the
+  // step and its reverse fall on own directions of different parity: equal
+  // parity means one end classified it into the wrong quadrant.
+  if ((at_a.k - at_b.k) % 2 == 0) return Refusal::kAmbiguousAxis;
 
   // Thesis eq. 4.2 at both ends, against the tree edges on the same lattice
   // line only: steep views legitimately foreshorten one axis by more than
@@ -333,7 +341,12 @@ void BuildLatticeForest(
     const std::function<bool(const GridEdge&)>& sides_flip,
     const GridOptions& options, GridSummary* summary, LatticeForest* forest,
     std::vector<GridEdgeTrace>* trace) {
-  Forest state(nodes, options);
+  // With the intensity test refusing tile-crossing edges, the ambiguity band
+  // around 45 degrees can be narrower (GridOptions).
+  const bool image_guard = crosses_tile && options.refuse_penalised_edges;
+  Forest state(nodes, options,
+               image_guard ? options.max_axis_deviation_with_image_deg
+                           : options.max_axis_deviation_deg);
   if (trace != nullptr) trace->clear();
   auto record = [&](const GridEdge& edge, Refusal decision) -> int {
     if (trace == nullptr) return -1;

@@ -169,8 +169,8 @@ TEST(GridRenderTest, StrongFisheye) {
 // image rim, darkened by vignetting (like the deltille photos): tiles shrink
 // by 3x and more along a line and squeeze to aspect 4-5 at the rim. The
 // share of detected board corners in the largest component is required per
-// view, from measured values with a margin (measured: 60 deg 88/88, 83/87,
-// 71/77; 45 deg 87/87, 46/73; 35 deg 85/86, 60/67); the views nearer the
+// view, from measured values with a margin (measured: 60 deg 88/88, 87/87,
+// 71/77; 45 deg 87/87, 50/73; 35 deg 85/86, 63/67); the views nearer the
 // centre must give all of them.
 TEST(GridRenderTest, SteepFisheyeCheckerboardIsOneComponent) {
   Board board = PuzzleBoard11x8();
