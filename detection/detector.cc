@@ -47,6 +47,9 @@ bool DetectorOptions::Check(std::string* why) const {
     return fail("min_ring_contrast must be >= 0");
   if (!(max_ring_asymmetry > 0.0))
     return fail("max_ring_asymmetry must be > 0");
+  if (!(min_contrast_factor_clean >= 1.0)) {
+    return fail("min_contrast_factor_clean must be >= 1");
+  }
   if (!(max_ring_asymmetry_clean > 0.0)) {
     return fail("max_ring_asymmetry_clean must be > 0");
   }
@@ -414,7 +417,9 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
                  (ring.asymmetry <= options.max_ring_asymmetry ||
                   (ring.asymmetry <= options.max_ring_asymmetry_clean &&
                    ring.second_harmonic_share >=
-                       options.min_ring_second_harmonic_clean)) &&
+                       options.min_ring_second_harmonic_clean &&
+                   ring.contrast >=
+                       options.min_contrast_factor_clean * min_contrast)) &&
                  ring.second_harmonic_share >=
                      options.min_ring_second_harmonic &&
                  ring.centre_offset <= options.max_ring_centre_offset;

@@ -9,16 +9,22 @@
 //     axis-aligned and on the diagonal second derivatives (k = 0.5); the
 //     corner response is the product of -S and -S_d where both are positive;
 //  3. non-maximum suppression with a radius in level pixels (so it scales with
-//     the level), above an absolute and a noise-adaptive threshold;
+//     the level), above an absolute and a noise-adaptive threshold; the
+//     response is streamed row by row into the suppression, never stored;
 //  4. the thesis's corner mask (junction kernels beat edge kernels) and a
-//     ring test (the grey values on a circle around the candidate must be
-//     centrally symmetric and dominated by the second angular harmonic);
-//  5. sub-pixel refinement at full resolution (gradient orthogonality with a
-//     window sized from the distance to the nearest neighbour corner, or the
-//     thesis's squared-grey centroid);
+//     ring test around the response centroid (the grey values on a circle
+//     must be centrally symmetric, dominated by the second angular harmonic,
+//     above the noise, with the centre half-way between dark and bright);
+//  5. sub-pixel refinement at full resolution: by default a saddle-point fit
+//     (quadratic in a Gaussian window sized from the distance to the nearest
+//     neighbour corner, on the input grey values, re-centred on its own
+//     solution); gradient orthogonality and the thesis's squared-response
+//     centroid are the alternatives;
 //  6. orientation = angle of the first Hessian eigenvector (the one of the
 //     positive eigenvalue: along the diagonal through the bright tiles), in
-//     (-pi/2, pi/2] since an eigenvector has no sign.
+//     (-pi/2, pi/2] since an eigenvector has no sign; taken from the saddle
+//     fit's Hessian, or from the second angular harmonic of a circle for the
+//     other refinements.
 
 #include <opencv2/core.hpp>
 #include <string>
@@ -88,11 +94,15 @@ struct DetectorOptions {
   // T-junction). > 0.
   double max_ring_asymmetry = 0.5;
   // A larger asymmetry, up to this bound, passes when the symmetric part is
-  // a clean second harmonic (share >= the bound below): PuzzleBoard corners
-  // of 6-10 px tiles reach 0.5-0.9 as the ring meets the discs, with shares
-  // of 0.97 and more; clutter in that band has lower shares. > 0; [0, 1].
+  // a clean second harmonic (share >= the second bound) and the contrast is
+  // at least the third bound times the contrast threshold: PuzzleBoard
+  // corners of 6-10 px tiles reach 0.5-0.9 as the ring meets the discs, and
+  // strongly curved fisheye corners about 0.6, with shares of 0.97 and more
+  // and full contrast; clutter in that band (wall texture, spots between
+  // discs) has lower shares or faint contrast. > 0; [0, 1]; >= 1.
   double max_ring_asymmetry_clean = 0.8;
   double min_ring_second_harmonic_clean = 0.95;
+  double min_contrast_factor_clean = 3.0;
   // Minimum share of the symmetric ring energy in the second harmonic (0.81
   // for an ideal square-wave corner, lower for blobs and lines). In [0, 1].
   double min_ring_second_harmonic = 0.5;
@@ -103,12 +113,14 @@ struct DetectorOptions {
   // the input (robust estimate from differences to the 4-neighbour mean,
   // grey normalised like the image): faint saddle-shaped noise inside
   // bright tiles stays out. >= 0; 0 off.
-  double ring_noise_factor = 2.0;
+  double ring_noise_factor = 3.0;
 
   // --- sub-pixel refinement (always at full resolution) ---
   SubpixelMethod subpixel = SubpixelMethod::kSaddleFit;
-  // Half-size of the refinement window as a fraction of the distance to the
-  // nearest other corner (a tile edge); clamped to the two bounds below. > 0.
+  // Gradient orthogonality: half-size of its window as a fraction of the
+  // distance to the nearest other corner (a tile edge); clamped to the two
+  // bounds below. This window also bounds how far any refinement may move a
+  // corner (max_shift_fraction). > 0.
   double window_fraction_of_neighbor = 0.3;
   // Bounds of the window half-size in full-resolution pixels; the upper one is
   // also used for a corner without neighbours. 2 <= min <= max <= 64.
@@ -119,8 +131,10 @@ struct DetectorOptions {
   // nearest other corner, in (0, 1], clamped to the two bounds below
   // (full-resolution pixels, 0.5 <= min <= max <= 16). PuzzleBoard discs
   // start a third of a tile from the corner: above about 0.14 their
-  // Gaussian tail pulls the fit by tenths of a pixel.
-  double saddle_sigma_fraction = 0.13;
+  // Gaussian tail pulls the fit by tenths of a pixel; on strongly curved
+  // fisheye corners larger windows also lose the point symmetry the fit
+  // relies on (deltille photos: calibration RMS 0.41 px at 0.1, 0.45 at 0.3).
+  double saddle_sigma_fraction = 0.1;
   double min_saddle_sigma_px = 0.7;
   double max_saddle_sigma_px = 6.0;
   // Re-centrings of the saddle fit (each moves the window to the last
@@ -132,7 +146,8 @@ struct DetectorOptions {
   double saddle_convergence_px = 0.05;
   // Newton iterations of the gradient-orthogonality fixed point. >= 1.
   int max_iterations = 6;
-  // Stop when the update is shorter than this (pixels). > 0.
+  // Gradient orthogonality stops when the update is shorter than this
+  // (pixels). > 0.
   double convergence_px = 0.005;
   // Drop a corner whose refined position moved more than this fraction of the
   // window half-size from its start (a failed refinement). > 0.
@@ -141,7 +156,7 @@ struct DetectorOptions {
   // stronger one stays). >= 0.
   double merge_distance_px = 1.5;
 
-  // --- orientation ---
+  // --- orientation (refinements other than the saddle fit) ---
   // Radius (full-resolution pixels) of the circle on which the orientation
   // is measured (second angular harmonic = Hessian eigenvector at that
   // scale), as a fraction of the refinement window half-size; at least 1 px.

@@ -4,20 +4,22 @@
 // dark vignetted images, small tiles, PuzzleBoard discs), orientation
 // against the truth geometry, and bad input.
 
+#include "detection/detector.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
-#include <Eigen/Geometry>
-#include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
-
 #include "calib/camera_models.h"
 #include "decode/board.h"
-#include "detection/detector.h"
 #include "sim/render.h"
+#include "sim/scenes.h"
 
 namespace puzzlecal {
 namespace {
@@ -41,8 +43,8 @@ Eigen::Isometry3d CentredPose(const Board& board, double focal_px,
   Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
   cam_from_board.linear() = rotation;
   cam_from_board.translation() =
-      Eigen::Vector3d(offset_px.x() * z / focal_px, offset_px.y() * z / focal_px,
-                      z) -
+      Eigen::Vector3d(offset_px.x() * z / focal_px,
+                      offset_px.y() * z / focal_px, z) -
       rotation * centre;
   return cam_from_board;
 }
@@ -52,8 +54,9 @@ Camera Pinhole(int width, int height, double focal_px) {
   camera.model = CameraModelId::kPinholeRadtan;
   camera.width = width;
   camera.height = height;
-  camera.params = {focal_px, focal_px, width / 2.0 - 0.37, height / 2.0 + 0.21,
-                   0,        0,        0,         0,          0};
+  camera.params = {
+      focal_px, focal_px, width / 2.0 - 0.37, height / 2.0 + 0.21, 0, 0, 0,
+      0,        0};
   return camera;
 }
 
@@ -111,7 +114,8 @@ bool CleanlyVisible(const TruthCorner& t, const cv::Mat& image,
   if (!t.visible) return false;
   const double margin = 3.0;
   if (t.xy.x() < margin || t.xy.y() < margin ||
-      t.xy.x() > image.cols - 1 - margin || t.xy.y() > image.rows - 1 - margin) {
+      t.xy.x() > image.cols - 1 - margin ||
+      t.xy.y() > image.rows - 1 - margin) {
     return false;
   }
   const double clearance = std::max(3.0, 0.3 * tile_px);
@@ -221,10 +225,9 @@ Score ScoreDetections(const std::vector<Corner>& corners,
       const double expected_angle =
           WhiteDiagonalAngle(t, i, render.variant.inverted);
       if (std::isfinite(expected_angle)) {
-        score.max_orientation_error_deg =
-            std::max(score.max_orientation_error_deg,
-                     AxisDifferenceDeg(corners[match].orientation,
-                                       expected_angle));
+        score.max_orientation_error_deg = std::max(
+            score.max_orientation_error_deg,
+            AxisDifferenceDeg(corners[match].orientation, expected_angle));
       }
     }
   }
@@ -310,8 +313,7 @@ TEST(DetectorTest, WidePinholeWithOccludersAndBoardCutByBorder) {
   const Score score =
       ScoreDetections(corners, truth, board, image, render, 8.0, true);
   EXPECT_GT(score.expected, 150);
-  EXPECT_GE(score.Recall(), 0.995)
-      << score.found << " of " << score.expected;
+  EXPECT_GE(score.Recall(), 0.995) << score.found << " of " << score.expected;
   EXPECT_LE(score.FalseRate(), 0.005) << score.false_on_board << " false";
   EXPECT_LT(score.Rms(), 0.05);
   EXPECT_LT(score.max_orientation_error_deg, 10.0);
@@ -338,16 +340,15 @@ TEST(DetectorTest, StrongFisheye) {
   const Score score = ScoreDetections(DetectCorners(image), truth, board, image,
                                       render, 8.0, true);
   EXPECT_GT(score.expected, 200);
-  // Measured: 366 of 368 (99.46 %), below the 99.5 % goal by one corner;
-  // both misses sit where the fisheye squeezes tiles to ~13 px.
-  EXPECT_GE(score.Recall(), 0.99)
-      << score.found << " of " << score.expected;
+  // Measured: 368 of 368 (the ring test's centroid centring and
+  // clean-harmonic band found the two corners squeezed to ~13 px tiles).
+  EXPECT_GE(score.Recall(), 0.995) << score.found << " of " << score.expected;
   EXPECT_LE(score.FalseRate(), 0.005) << score.false_on_board << " false";
-  // PuzzleBoard discs at 13-20 px tiles come within the refinement window
-  // (disc edges start a third of a tile from the corner, blurred); the
-  // measured RMS is 0.31 px here against 0.08 px for a plain checkerboard.
-  EXPECT_LT(score.Rms(), 0.4);
-  EXPECT_LT(score.max_orientation_error_deg, 12.0);
+  // Measured RMS 0.037 px, orientation within 1.8 degrees (the saddle fit's
+  // window stays clear of the PuzzleBoard discs; gradient orthogonality
+  // with a window of 0.3 tiles gave 0.31 px here).
+  EXPECT_LT(score.Rms(), 0.08);
+  EXPECT_LT(score.max_orientation_error_deg, 6.0);
 }
 
 TEST(DetectorTest, TiltSeriesTo20Degrees) {
@@ -396,8 +397,7 @@ TEST(DetectorTest, DarkVignettedImageLikeDeltillePhotos) {
   const Score score = ScoreDetections(DetectCorners(image), truth, board, image,
                                       render, 8.0, true);
   EXPECT_GE(score.expected, 80);
-  EXPECT_GE(score.Recall(), 0.995)
-      << score.found << " of " << score.expected;
+  EXPECT_GE(score.Recall(), 0.995) << score.found << " of " << score.expected;
   EXPECT_LE(score.FalseRate(), 0.005);
 }
 
@@ -462,6 +462,206 @@ TEST(DetectorTest, InvertedContrastFlipsOrientationByNinetyDegrees) {
   EXPECT_LT(score.max_orientation_error_deg, 6.0);
 }
 
+// --- refinement under heavy blur and noise, PuzzleBoard discs, small tiles ---
+
+// Checkerboard views with tiles of 20-60 px (the accuracy table's set-up):
+// RMS and largest error of the default refinement against truth.
+struct BlurNoiseResult {
+  double rms = 0.0;
+  double max_error = 0.0;
+  int expected = 0;
+  int found = 0;
+};
+
+BlurNoiseResult RefineUnderBlurAndNoise(double blur, double noise) {
+  const Board board = MakeBoard(BoardType::kCheckerboard, 11, 8);
+  BlurNoiseResult result;
+  double sum_sq = 0.0;
+  for (int v = 0; v < 4; ++v) {
+    const double tile_px = 20.0 + 40.0 * v / 3.0;
+    const Camera camera = Pinhole(static_cast<int>(tile_px * 15),
+                                  static_cast<int>(tile_px * 12), 800.0);
+    const Eigen::Isometry3d pose = CentredPose(
+        board, 800.0, tile_px, 0.12 * ((v % 3) - 1), 0.15 + 0.37 * v);
+    RenderOptions render;
+    render.blur_sigma_px = blur;
+    render.noise_sigma = noise;
+    render.seed = 1000 + v;
+    RenderTruth truth;
+    const cv::Mat image = RenderBoard(board, camera, pose, render, &truth);
+    const std::vector<Corner> corners = DetectCorners(image);
+    for (const TruthCorner& t : truth.corners) {
+      if (!CleanlyVisible(t, image, render, tile_px)) continue;
+      ++result.expected;
+      double best = std::numeric_limits<double>::infinity();
+      for (const Corner& c : corners)
+        best = std::min(best, (c.xy - t.xy).norm());
+      // Anything within a third of a tile counts, so a drifting refinement
+      // shows up as a large error rather than a miss.
+      if (best > tile_px / 3.0) continue;
+      ++result.found;
+      sum_sq += best * best;
+      result.max_error = std::max(result.max_error, best);
+    }
+  }
+  result.rms = result.found > 0 ? std::sqrt(sum_sq / result.found) : 0.0;
+  return result;
+}
+
+TEST(DetectorTest, NoDriftUnderHeavyBlurAndNoise) {
+  // Measured on these views: blur 2 px / noise 3 %: RMS 0.047 px, max
+  // 0.14 px; blur 3 px / noise 5 %: RMS 0.127 px, max 0.42 px. In the
+  // accuracy bench cv::cornerSubPix from the same starts gives 0.080 and
+  // 1.12 px RMS; the gradient-orthogonality refinement drifted by pixels.
+  const BlurNoiseResult a = RefineUnderBlurAndNoise(2.0, 0.03);
+  EXPECT_EQ(a.found, a.expected);
+  EXPECT_LT(a.rms, 0.07);
+  EXPECT_LT(a.max_error, 0.3);
+  const BlurNoiseResult b = RefineUnderBlurAndNoise(3.0, 0.05);
+  EXPECT_GE(b.found, 0.99 * b.expected);
+  EXPECT_LT(b.rms, 0.18);
+  EXPECT_LT(b.max_error, 0.8);
+}
+
+// Errors against truth of every corner with local tiles >= 8 px on renders
+// like the bundled sample set (wide pinhole, 23x16 PuzzleBoard, blur 0.8 px,
+// noise 2 %, occluders).
+std::vector<double> DemoLikeErrors(int views, int* expected) {
+  SceneSpec scene;
+  scene.name = "demo_like";
+  scene.camera = WidePinholeCamera(800, 600, 90.0, -0.2);
+  scene.board = MakeBoard(BoardType::kPuzzleBoard, 23, 16);
+  scene.board.tile_size_m = 0.03;
+  scene.render.blur_sigma_px = 0.8;
+  scene.render.noise_sigma = 0.02;
+  scene.render.lighting_gradient = 0.2;
+  scene.render.vignetting = 0.2;
+  RandomViews& rv = scene.random_views;
+  rv.count = views;
+  rv.seed = 5;
+  rv.min_distance_m = 0.35;
+  rv.max_distance_m = 0.8;
+  rv.min_view_angle_deg = 35;
+  rv.max_view_angle_deg = 85;
+  rv.max_roll_deg = 45;
+  rv.max_off_axis_deg = 35;
+  rv.target_margin_tiles = 3;
+  rv.occluders_per_view = 1;
+  rv.min_occluder_radius_px = 20;
+  rv.max_occluder_radius_px = 45;
+  std::string why;
+  const std::vector<SceneView> rendered = RenderScene(scene, &why);
+  EXPECT_EQ(static_cast<int>(rendered.size()), views) << why;
+  std::vector<double> errors;
+  *expected = 0;
+  for (const SceneView& view : rendered) {
+    const std::vector<Corner> corners = DetectCorners(view.image);
+    const std::vector<TruthCorner>& t = view.truth.corners;
+    for (size_t i = 0; i < t.size(); ++i) {
+      const double tile = LocalTilePx(t, scene.board, i);
+      if (!(tile >= 8.0)) continue;
+      RenderOptions render = scene.render;
+      if (!CleanlyVisible(t[i], view.image, render, tile)) continue;
+      ++*expected;
+      double best = std::numeric_limits<double>::infinity();
+      for (const Corner& c : corners)
+        best = std::min(best, (c.xy - t[i].xy).norm());
+      if (best < std::max(1.5, std::min(3.0, 0.25 * tile)))
+        errors.push_back(best);
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  return errors;
+}
+
+TEST(DetectorTest, PuzzleBoardDiscsLeaveNoErrorTail) {
+  int expected = 0;
+  const std::vector<double> errors = DemoLikeErrors(6, &expected);
+  ASSERT_GT(expected, 500);
+  ASSERT_FALSE(errors.empty());
+  const double p50 = errors[errors.size() / 2];
+  const double p90 = errors[errors.size() * 9 / 10];
+  const double p99 = errors[errors.size() * 99 / 100];
+  // Measured on these 6 views: p50 0.029, p90 0.063, p99 0.12 px, 98.5 %
+  // found (the gradient-orthogonality refinement on the blurred image, 16
+  // views: 0.13, 0.92, 1.28 px, from discs inside its window).
+  EXPECT_LT(p50, 0.05);
+  EXPECT_LT(p90, 0.1);
+  EXPECT_LT(p99, 0.25);
+  EXPECT_GE(errors.size(), 0.97 * expected);
+}
+
+TEST(DetectorTest, PuzzleBoardRecallAtSmallTiles) {
+  // The accuracy bench's tile series (11x8 PuzzleBoard, blur 0.8 px, noise
+  // 1 %, mild tilt, two rolls). Measured recall: 10 and 8 px 100 %, 6 px
+  // 98.3 % (before the ring test's clean-harmonic band: 8 px 91 %, 6 px
+  // 81 %).
+  const Board board = MakeBoard(BoardType::kPuzzleBoard, 11, 8);
+  for (double tile_px : {6.0, 8.0, 10.0}) {
+    int expected = 0, found = 0, false_on_board = 0;
+    for (int v = 0; v < 2; ++v) {
+      const int width = static_cast<int>(tile_px * 15 + 40);
+      const int height = static_cast<int>(tile_px * 12 + 40);
+      const Camera camera = Pinhole(width, height, 1000.0);
+      const Eigen::Isometry3d pose =
+          CentredPose(board, 1000.0, tile_px, 0.15, 0.3 + 0.5 * v);
+      RenderOptions render;
+      render.blur_sigma_px = 0.8;
+      render.noise_sigma = 0.01;
+      render.seed = 7 + v;
+      RenderTruth truth;
+      const cv::Mat image = RenderBoard(board, camera, pose, render, &truth);
+      ASSERT_FALSE(image.empty());
+      const Score score = ScoreDetections(DetectCorners(image), truth, board,
+                                          image, render, 0.0, false);
+      expected += score.expected;
+      found += score.found;
+      false_on_board += score.false_on_board;
+    }
+    const double recall = static_cast<double>(found) / expected;
+    EXPECT_GE(recall, tile_px >= 8.0 ? 0.995 : 0.95)
+        << "tile " << tile_px << ": " << found << " of " << expected;
+    EXPECT_EQ(false_on_board, 0) << "tile " << tile_px;
+  }
+}
+
+TEST(DetectorTest, NoCornerInsideATileBetweenTwoDiscs) {
+  // A bright tile between two dark disc bulges is saddle-shaped at a large
+  // scale but faint (ring contrast at the noise level); such a spot came out
+  // as a corner in this view (11x8 PuzzleBoard at 0.3 m, seen at 80 degrees
+  // about an axis 20 degrees off the board's x axis, rolled 15 degrees).
+  Board board = MakeBoard(BoardType::kPuzzleBoard, 11, 8);
+  board.origin = Eigen::Vector2i(120, 40);
+  Camera camera = Pinhole(1280, 960, 1000.0);
+  camera.params = {1000.0, 1000.0, 639.5, 479.5, -0.05, 0.01, 0.0, 0.0, 0.0};
+  const double deg = M_PI / 180.0;
+  const Eigen::Matrix3d rotation =
+      (Eigen::AngleAxisd(15 * deg, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(10 * deg, Eigen::Vector3d(std::cos(20 * deg),
+                                                   std::sin(20 * deg), 0)))
+          .toRotationMatrix();
+  const Eigen::Vector3d centre =
+      board.Point(board.origin) + Eigen::Vector3d(5 * 0.02, 3.5 * 0.02, 0);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation;
+  pose.translation() = Eigen::Vector3d(0, 0, 0.3) - rotation * centre;
+  RenderOptions render;
+  render.noise_sigma = 0.02;
+  RenderTruth truth;
+  const cv::Mat image = RenderBoard(board, camera, pose, render, &truth);
+  ASSERT_FALSE(image.empty());
+  const std::vector<Corner> corners = DetectCorners(image);
+  // Every detection is an inner corner (all 88 are visible).
+  for (const Corner& c : corners) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const TruthCorner& t : truth.corners) {
+      best = std::min(best, (c.xy - t.xy).norm());
+    }
+    EXPECT_LT(best, 0.5) << "detection at " << c.xy.transpose();
+  }
+  EXPECT_EQ(corners.size(), 88u);
+}
+
 // --- input handling and determinism ---
 
 TEST(DetectorTest, SixteenBitFloatAndColourMatchEightBit) {
@@ -502,9 +702,9 @@ TEST(DetectorTest, DeterministicAndSortedByYThenX) {
     EXPECT_GT(a[i].orientation, -M_PI / 2 - 1e-12);
     EXPECT_LE(a[i].orientation, M_PI / 2);
     if (i > 0) {
-      EXPECT_TRUE(a[i - 1].xy.y() < a[i].xy.y() ||
-                  (a[i - 1].xy.y() == a[i].xy.y() &&
-                   a[i - 1].xy.x() <= a[i].xy.x()));
+      EXPECT_TRUE(
+          a[i - 1].xy.y() < a[i].xy.y() ||
+          (a[i - 1].xy.y() == a[i].xy.y() && a[i - 1].xy.x() <= a[i].xy.x()));
     }
   }
 }
@@ -517,9 +717,9 @@ TEST(DetectorTest, BadInputGivesNoCornersAndAReason) {
 
   EXPECT_TRUE(DetectCorners(cv::Mat(3, 3, CV_8UC1, cv::Scalar(7)), {}, &summary)
                   .empty());
-  EXPECT_TRUE(DetectCorners(cv::Mat(1, 500, CV_8UC1, cv::Scalar(7)), {},
-                            &summary)
-                  .empty());
+  EXPECT_TRUE(
+      DetectCorners(cv::Mat(1, 500, CV_8UC1, cv::Scalar(7)), {}, &summary)
+          .empty());
   EXPECT_TRUE(
       DetectCorners(cv::Mat(200, 300, CV_8UC1, cv::Scalar(0)), {}, &summary)
           .empty());
@@ -534,9 +734,9 @@ TEST(DetectorTest, BadInputGivesNoCornersAndAReason) {
   EXPECT_TRUE(DetectCorners(nan_image, {}, &summary).empty());
   EXPECT_TRUE(summary.ok);
 
-  EXPECT_TRUE(DetectCorners(cv::Mat(50, 50, CV_64FC1, cv::Scalar(1)), {},
-                            &summary)
-                  .empty());
+  EXPECT_TRUE(
+      DetectCorners(cv::Mat(50, 50, CV_64FC1, cv::Scalar(1)), {}, &summary)
+          .empty());
   EXPECT_FALSE(summary.ok);
   EXPECT_NE(summary.message.find("pixel type"), std::string::npos);
 
@@ -545,9 +745,9 @@ TEST(DetectorTest, BadInputGivesNoCornersAndAReason) {
   std::string why;
   EXPECT_FALSE(bad.Check(&why));
   EXPECT_NE(why.find("nms_radius_px"), std::string::npos);
-  EXPECT_TRUE(DetectCorners(cv::Mat(50, 50, CV_8UC1, cv::Scalar(1)), bad,
-                            &summary)
-                  .empty());
+  EXPECT_TRUE(
+      DetectCorners(cv::Mat(50, 50, CV_8UC1, cv::Scalar(1)), bad, &summary)
+          .empty());
   EXPECT_FALSE(summary.ok);
   EXPECT_TRUE(DetectorOptions().Check(&why)) << why;
 }
