@@ -48,7 +48,7 @@ class Forest {
     for (int i = 0; i < n; ++i) {
       parent_[i] = i;
       tail_[i] = i;
-      if (nodes.valid[i]) table_.Insert(i, label_[i], i);
+      // Single-corner trees stay out of the table (see Lookup).
     }
   }
 
@@ -61,6 +61,14 @@ class Forest {
       x = next;
     }
     return root;
+  }
+
+  // The corner at `label` in the tree with root `root`, or -1. Trees of one
+  // corner are not in the table (most trees are, until Kruskal joins them):
+  // the root is their only corner.
+  int Lookup(int root, const Eigen::Vector2i& label) const {
+    if (size_[root] == 1) return label == label_[root] ? root : -1;
+    return table_.Find(root, label);
   }
 
   // Tries to join the trees of the edge's ends; returns why not.
@@ -285,27 +293,28 @@ Refusal Forest::TryMerge(const GridEdge& edge) {
     if ((new_label.array() < near_low.array()).any() ||
         (new_label.array() > near_high.array()).any())
       continue;
-    if (table_.Find(ra, new_label) >= 0) return Refusal::kLabelCollision;
+    if (Lookup(ra, new_label) >= 0) return Refusal::kLabelCollision;
     const Dihedral new_frame = rotation.Compose(frame_[n]);
     for (int d = 0; d < 4; ++d) {
       const Eigen::Vector2i step = LatticeStep(d);
-      const int m = table_.Find(ra, new_label + step);
+      const int m = Lookup(ra, new_label + step);
       if (m < 0) continue;
       if (!AdjacencyAgrees(n, new_frame, m, d, edge.length))
         return Refusal::kNeighborContradiction;
       // The lattice line through n and m, continued on both sides.
-      const int before =
-          table_.Find(rb, label_[n] - rotation_inverse.Apply(step));
+      const int before = Lookup(rb, label_[n] - rotation_inverse.Apply(step));
       if (before >= 0 && !Collinear(before, n, m))
         return Refusal::kCollinearity;
-      const int after = table_.Find(ra, new_label + 2 * step);
+      const int after = Lookup(ra, new_label + 2 * step);
       if (after >= 0 && !Collinear(n, m, after)) return Refusal::kCollinearity;
     }
   }
 
   // Commit: relabel the smaller tree into the larger one.
+  if (size_[ra] == 1) table_.Insert(ra, label_[ra], ra);
+  const bool moved_in_table = size_[rb] > 1;
   for (int n = rb; n >= 0; n = next_[n]) {
-    table_.Erase(rb, label_[n]);
+    if (moved_in_table) table_.Erase(rb, label_[n]);
     label_[n] = rotation.Apply(label_[n]) + offset;
     frame_[n] = rotation.Compose(frame_[n]);
     table_.Insert(ra, label_[n], n);

@@ -106,10 +106,20 @@ void FindNearestNeighbors(const std::vector<Eigen::Vector2d>& points, int k,
     const int qcell = cell_index[i];
     const int qx = qcell % nx, qy = qcell / nx;
     const double px = sorted_x[qs], py = sorted_y[qs];
-    for (int ring = 0;; ++ring) {
+    // The 3 x 3 block first, one contiguous run of points per row.
+    for (int cy = std::max(qy - 1, 0); cy <= std::min(qy + 1, ny - 1); ++cy) {
+      const int end = cell_start[cy * nx + std::min(qx + 1, nx - 1) + 1];
+      for (int s = cell_start[cy * nx + std::max(qx - 1, 0)]; s < end; ++s) {
+        if (s == qs) continue;
+        const double dx = sorted_x[s] - px, dy = sorted_y[s] - py;
+        top.Offer(dx * dx + dy * dy, sorted_id[s]);
+      }
+    }
+    for (int ring = 1;; ++ring) {
       const int y0 = qy - ring, y1 = qy + ring;
       const int x0 = qx - ring, x1 = qx + ring;
-      for (int cy = std::max(y0, 0); cy <= std::min(y1, ny - 1); ++cy) {
+      for (int cy = std::max(y0, 0); cy <= std::min(y1, ny - 1) && ring > 1;
+           ++cy) {
         const bool full_row = (cy == y0 || cy == y1);
         const int step = full_row ? 1 : std::max(x1 - x0, 1);
         // Vertical distance from the query to this row of cells (border
