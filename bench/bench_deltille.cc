@@ -6,7 +6,7 @@
 //     component) is placed by the view's calibrated pose (PnP through the
 //     camera for views the calibration did not use); the 11 x 8 window of
 //     lattice points that looks most like the printed board (checkerboard
-//     saddle contrast at the projected tile centres) is the board; the pose
+//     saddles at the projected tile centres) is the board; the pose
 //     is refitted to every detection near a projected board corner and all
 //     88 corners are projected again: the pseudo-truth;
 //  4. detections within match_px of a projected corner carry its id, the
@@ -86,8 +86,8 @@ bool InImage(const Camera& camera, const Eigen::Vector2d& p) {
          p.y() <= camera.height - 1;
 }
 
-// Signed checkerboard contrast at lattice point `id`: positive for one
-// colouring, negative for the other; 0 when a tile centre is not in the image.
+// +1 or -1 (by the colouring) when lattice point `id` looks like a
+// checkerboard saddle, else 0 (also when a tile centre is not in the image).
 double SaddleScore(const cv::Mat& image, const Camera& camera,
                    const Eigen::Isometry3d& pose, double tile,
                    const Eigen::Vector2i& id) {
@@ -102,8 +102,15 @@ double SaddleScore(const cv::Mat& image, const Camera& camera,
     v[k] = Grey(image, p);
     if (v[k] < 0) return 0;
   }
+  // A saddle: each pair of opposite tiles alike, the pairs unlike (as
+  // grid/'s saddle check). Points of the ring outside the inner corners,
+  // where border tiles meet the paper, are not; counting them as 0 (not by
+  // their contrast) keeps a bright ring from outweighing a dim rim column.
   const double raw = (v[0] + v[1] - v[2] - v[3]) / 2;
-  return ((id.x() + id.y()) % 2 == 0) ? raw : -raw;
+  const double spread = std::max(std::abs(v[0] - v[1]), std::abs(v[2] - v[3]));
+  if (!(spread < std::abs(raw))) return 0;
+  const double sign = raw > 0 ? 1 : -1;
+  return ((id.x() + id.y()) % 2 == 0) ? sign : -sign;
 }
 
 struct PhotoTruth {
