@@ -124,6 +124,8 @@ struct Workspace {
   cv::Mat finite;                // float input with non-finite pixels zeroed
   std::vector<cv::Mat> blurred;  // per level, CV_32FC1, grey in [0, 1]
   std::vector<float> response_rows;  // ring of response rows
+  std::vector<float> row;            // one row of the downsampling
+  cv::Mat band;                      // blurred rows of a band of level 0
   std::vector<float> scratch;
 };
 
@@ -153,6 +155,44 @@ double MaxValue(const cv::Mat& image) {
       return max_value;
     }
   }
+}
+
+// Halves the resolution of a CV_32FC1 image: binomial [1 2 1] / 4 in x and
+// y at every second pixel (output pixel (i, j) is centred on input pixel
+// (2i, 2j); replicated border). Output size as cv::pyrDown's. Lighter than
+// pyrDown's 5x5 kernel; the input is already blurred. Writes output rows
+// [i0, i1) of `dst` (already of the output size) from `src`, which holds
+// input rows [src_first, src_first + src.rows) of an image `height` rows
+// high; the input rows 2 i - 1 .. 2 i + 1 (clamped) must be in `src`.
+void DownsampleRows(const cv::Mat& src, int src_first, int height, int i0,
+                    int i1, std::vector<float>* row, cv::Mat* dst) {
+  const int width = src.cols;
+  const int out_width = dst->cols;
+  row->resize(width);
+  float* __restrict tmp = row->data();
+  for (int i = i0; i < i1; ++i) {
+    const int y = 2 * i;
+    const float* __restrict up = src.ptr<float>(std::max(y - 1, 0) - src_first);
+    const float* __restrict mid =
+        src.ptr<float>(std::min(y, height - 1) - src_first);
+    const float* __restrict down =
+        src.ptr<float>(std::min(y + 1, height - 1) - src_first);
+    for (int x = 0; x < width; ++x) {
+      tmp[x] = 0.25f * (up[x] + 2.0f * mid[x] + down[x]);
+    }
+    float* __restrict out = dst->ptr<float>(i);
+    out[0] = 0.25f * (3.0f * tmp[0] + (width > 1 ? tmp[1] : tmp[0]));
+    for (int j = 1; j < out_width; ++j) {
+      const int x = 2 * j;
+      out[j] = 0.25f * (tmp[x - 1] + 2.0f * tmp[std::min(x, width - 1)] +
+                        tmp[std::min(x + 1, width - 1)]);
+    }
+  }
+}
+
+void Downsample(const cv::Mat& src, std::vector<float>* row, cv::Mat* dst) {
+  dst->create((src.rows + 1) / 2, (src.cols + 1) / 2, CV_32FC1);
+  DownsampleRows(src, 0, src.rows, 0, dst->rows, row, dst);
 }
 
 // Picks the one-channel, finite version of the input and the grey value
@@ -344,27 +384,46 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
   }
   std::vector<cv::Mat>& blurred = ws.blurred;
   blurred.resize(options.num_levels);
+  // Grey rows [a, b) of the input, normalised and blurred, into `out`: one
+  // separable pass from the input type straight to float, with the
+  // normalisation folded into the kernel. On a band the filter reads the
+  // input rows around it, so a band equals those rows of the whole image.
+  cv::Mat kernel, kernel_scaled;
   if (options.blur_sigma_px > 0.0) {
-    // One separable pass from the input type straight to float, with the
-    // normalisation folded into the kernel.
     const int ksize =
         2 * static_cast<int>(std::ceil(2.0 * options.blur_sigma_px)) + 1;
-    const cv::Mat kernel =
-        cv::getGaussianKernel(ksize, options.blur_sigma_px, CV_32F);
-    const cv::Mat kernel_scaled = kernel * (1.0 / s.normalizer);
-    cv::sepFilter2D(*single, blurred[0], CV_32F, kernel_scaled, kernel,
-                    cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
-  } else {
-    single->convertTo(blurred[0], CV_32F, 1.0 / s.normalizer);
+    kernel = cv::getGaussianKernel(ksize, options.blur_sigma_px, CV_32F);
+    kernel_scaled = kernel * (1.0 / s.normalizer);
   }
+  auto blur_rows = [&](int a, int b, cv::Mat* out) {
+    const cv::Mat band = single->rowRange(a, b);
+    if (options.blur_sigma_px > 0.0) {
+      cv::sepFilter2D(band, *out, CV_32F, kernel_scaled, kernel,
+                      cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
+    } else {
+      band.convertTo(*out, CV_32F, 1.0 / s.normalizer);
+    }
+  };
+  // Level 0 is streamed in bands of rows (blur, response, suppression,
+  // filters and the next level's rows while the band is in cache) unless a
+  // later step needs the whole blurred image (gradient orthogonality and
+  // the circle orientation of the other refinements).
+  const bool stream_level0 = options.first_level == 0 &&
+                             options.subpixel == SubpixelMethod::kSaddleFit;
   int levels = 1;
   for (int l = 1; l < options.num_levels; ++l) {
-    if (blurred[l - 1].cols < 2 * kMinSide ||
-        blurred[l - 1].rows < 2 * kMinSide) {
-      break;
-    }
-    cv::pyrDown(blurred[l - 1], blurred[l], cv::Size(), cv::BORDER_REPLICATE);
+    const int rows = l == 1 ? image.rows : blurred[l - 1].rows;
+    const int cols = l == 1 ? image.cols : blurred[l - 1].cols;
+    if (cols < 2 * kMinSide || rows < 2 * kMinSide) break;
     levels = l + 1;
+  }
+  if (!stream_level0) {
+    blur_rows(0, image.rows, &blurred[0]);
+    for (int l = 1; l < levels; ++l) {
+      Downsample(blurred[l - 1], &ws.row, &blurred[l]);
+    }
+  } else if (levels > 1) {
+    blurred[1].create((image.rows + 1) / 2, (image.cols + 1) / 2, CV_32FC1);
   }
   s.levels_used = std::max(0, levels - options.first_level);
   // Pixel noise of the input, grey normalised to [0, 1].
@@ -378,12 +437,138 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
   std::vector<Candidate> candidates;
   std::vector<float>& scratch = ws.scratch;
   std::vector<ResponsePeak> peaks;
-  for (int l = options.first_level; l < levels; ++l) {
+  const float k = static_cast<float>(options.trace_weight_k);
+  const double min_contrast =
+      std::max(options.min_ring_contrast, options.ring_noise_factor * noise);
+  constexpr int kMedianStep = 12;  // sampling of the noise-adaptive threshold
+  // The corner mask and the ring test on `level_image` (rows offset by
+  // `y_offset` from the level's first row); appends a candidate in
+  // full-resolution pixels when the peak passes.
+  auto filter_peak = [&](const cv::Mat& level_image, int y_offset,
+                         const ResponsePeak& peak, int l, bool* masked) {
+    *masked = false;
+    if (options.use_corner_mask &&
+        !PassesCornerMask(level_image, peak.x, peak.y)) {
+      return false;
+    }
+    *masked = true;
+    if (options.use_ring_test) {
+      const RingMeasure ring =
+          MeasureRing(level_image, peak.centroid_x, peak.centroid_y,
+                      options.ring_radius_px, options.ring_samples);
+      const bool passes =
+          ring.inside && ring.contrast >= min_contrast &&
+          (ring.asymmetry <= options.max_ring_asymmetry ||
+           (ring.asymmetry <= options.max_ring_asymmetry_clean &&
+            ring.second_harmonic_share >=
+                options.min_ring_second_harmonic_clean &&
+            ring.contrast >=
+                options.min_contrast_factor_clean * min_contrast)) &&
+          ring.second_harmonic_share >= options.min_ring_second_harmonic &&
+          ring.centre_offset <= options.max_ring_centre_offset;
+      if (!passes) return false;
+    }
+    const double scale = std::ldexp(1.0, l);
+    Candidate c;
+    c.level = l;
+    c.peak_x = peak.x;
+    c.peak_y = peak.y + y_offset;
+    c.response = std::sqrt(peak.value);
+    c.xy = Eigen::Vector2d(peak.x * scale, c.peak_y * scale);
+    // The centroid is also the start of the iterative refinements (closer
+    // than the integer peak: fewer iterations).
+    if (options.subpixel != SubpixelMethod::kNone) {
+      c.xy =
+          Eigen::Vector2d(peak.centroid_x, peak.centroid_y + y_offset) * scale;
+    }
+    candidates.push_back(c);
+    return true;
+  };
+
+  if (stream_level0) {
+    // Peaks above the absolute threshold per band, filtered while the band
+    // is in cache; the noise-adaptive threshold (from the response sampled
+    // on the way) then only drops weak peaks: a peak of the whole image is
+    // a peak above the lower threshold that exceeds the higher one.
+    constexpr int kBand = 64;
+    // Rows around a band: response (2) + suppression radius + ring test.
+    const int halo =
+        2 + std::max(options.nms_radius_px,
+                     static_cast<int>(std::ceil(options.ring_radius_px)) + 2);
+    struct Kept {
+      float value;
+      bool masked;
+      int candidate;  // index into candidates, -1 when filtered out
+    };
+    std::vector<Kept> kept;
+    scratch.clear();
+    const float absolute =
+        static_cast<float>(options.min_response * options.min_response);
+    for (int y0 = 0; y0 < image.rows; y0 += kBand) {
+      t = Clock::now();
+      const int y1 = std::min(y0 + kBand, image.rows);
+      const int a = std::max(0, y0 - halo);
+      const int b = std::min(image.rows, y1 + halo);
+      blur_rows(a, b, &ws.band);
+      if (levels > 1) {
+        DownsampleRows(ws.band, a, image.rows, (y0 + 1) / 2, (y1 + 1) / 2,
+                       &ws.row, &blurred[1]);
+      }
+      s.ms_preprocess += MsSince(t);
+
+      t = Clock::now();
+      PeakRows part;
+      part.begin = y0 - a;
+      part.end = y1 - a;
+      part.y_offset = a;
+      part.sample_step = kMedianStep;
+      part.samples = options.noise_response_factor > 0.0 ? &scratch : nullptr;
+      peaks.clear();
+      s.candidates +=
+          FindSaddlePeaksInRows(ws.band, k, absolute, options.nms_radius_px,
+                                part, &ws.response_rows, &peaks);
+      s.ms_response += MsSince(t);
+
+      t = Clock::now();
+      for (const ResponsePeak& peak : peaks) {
+        const size_t before = candidates.size();
+        bool masked = false;
+        const bool passed = filter_peak(ws.band, a, peak, 0, &masked);
+        kept.push_back(
+            {peak.value, masked, passed ? static_cast<int>(before) : -1});
+      }
+      s.ms_filter += MsSince(t);
+    }
     t = Clock::now();
-    const float k = static_cast<float>(options.trace_weight_k);
+    double threshold = options.min_response;
+    if (options.noise_response_factor > 0.0 && !scratch.empty()) {
+      auto middle = scratch.begin() + scratch.size() / 2;
+      std::nth_element(scratch.begin(), middle, scratch.end());
+      threshold = std::max(threshold,
+                           options.noise_response_factor * std::sqrt(*middle));
+    }
+    s.threshold = threshold;
+    const float squared = static_cast<float>(threshold * threshold);
+    std::vector<Candidate> strong;
+    for (const Kept& p : kept) {
+      if (!(p.value > squared)) continue;
+      ++s.after_nms;
+      s.after_mask += p.masked ? 1 : 0;
+      if (p.candidate >= 0) {
+        ++s.after_ring;
+        strong.push_back(candidates[p.candidate]);
+      }
+    }
+    candidates = std::move(strong);
+    s.ms_nms += MsSince(t);
+  }
+
+  for (int l = stream_level0 ? 1 : options.first_level; l < levels; ++l) {
+    t = Clock::now();
     double threshold = options.min_response;
     if (options.noise_response_factor > 0.0) {
-      const double median = SampledResponseMedian(blurred[l], k, 12, &scratch);
+      const double median =
+          SampledResponseMedian(blurred[l], k, kMedianStep, &scratch);
       threshold = std::max(threshold,
                            options.noise_response_factor * std::sqrt(median));
     }
@@ -399,46 +584,11 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
     s.ms_response += MsSince(t);
 
     t = Clock::now();
-    const double scale = std::ldexp(1.0, l);
-    const double min_contrast =
-        std::max(options.min_ring_contrast, options.ring_noise_factor * noise);
     for (const ResponsePeak& peak : peaks) {
-      if (options.use_corner_mask &&
-          !PassesCornerMask(blurred[l], peak.x, peak.y)) {
-        continue;
-      }
-      ++s.after_mask;
-      if (options.use_ring_test) {
-        auto passes = [&](double radius) {
-          const RingMeasure ring =
-              MeasureRing(blurred[l], peak.centroid_x, peak.centroid_y, radius,
-                          options.ring_samples);
-          return ring.inside && ring.contrast >= min_contrast &&
-                 (ring.asymmetry <= options.max_ring_asymmetry ||
-                  (ring.asymmetry <= options.max_ring_asymmetry_clean &&
-                   ring.second_harmonic_share >=
-                       options.min_ring_second_harmonic_clean &&
-                   ring.contrast >=
-                       options.min_contrast_factor_clean * min_contrast)) &&
-                 ring.second_harmonic_share >=
-                     options.min_ring_second_harmonic &&
-                 ring.centre_offset <= options.max_ring_centre_offset;
-        };
-        if (!passes(options.ring_radius_px)) continue;
-      }
-      ++s.after_ring;
-      Candidate c;
-      c.level = l;
-      c.peak_x = peak.x;
-      c.peak_y = peak.y;
-      c.response = std::sqrt(peak.value);
-      c.xy = Eigen::Vector2d(peak.x * scale, peak.y * scale);
-      // The centroid is also the start of the iterative refinements
-      // (closer than the integer peak: fewer iterations).
-      if (options.subpixel != SubpixelMethod::kNone) {
-        c.xy = Eigen::Vector2d(peak.centroid_x, peak.centroid_y) * scale;
-      }
-      candidates.push_back(c);
+      bool masked = false;
+      const bool passed = filter_peak(blurred[l], 0, peak, l, &masked);
+      s.after_mask += masked ? 1 : 0;
+      s.after_ring += passed ? 1 : 0;
     }
     s.ms_filter += MsSince(t);
   }

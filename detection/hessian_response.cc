@@ -93,9 +93,21 @@ float SampledResponseMedian(const cv::Mat& blurred, float trace_weight_k,
 int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
                     float threshold, int radius, std::vector<float>* rows,
                     std::vector<ResponsePeak>* peaks) {
+  PeakRows all;
+  all.end = blurred.rows;
+  return FindSaddlePeaksInRows(blurred, trace_weight_k, threshold, radius, all,
+                               rows, peaks);
+}
+
+int FindSaddlePeaksInRows(const cv::Mat& blurred, float trace_weight_k,
+                          float threshold, int radius, const PeakRows& part,
+                          std::vector<float>* rows,
+                          std::vector<ResponsePeak>* peaks) {
   CV_Assert(blurred.type() == CV_32FC1);
   const int width = blurred.cols;
   const int height = blurred.rows;
+  const int row_begin = std::max(part.begin, 0);
+  const int row_end = std::min(part.end, height);
   radius = std::max(radius, 1);
   const int ring = 2 * radius + 1;
   // Ring of response rows, then a ring of their horizontal 3-maxima, then
@@ -118,6 +130,12 @@ int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
       float* __restrict out =
           response_rows + static_cast<size_t>(y_new % ring) * row_size;
       ComputeSaddleResponseRow(blurred, y_new, trace_weight_k, out);
+      if (part.samples != nullptr && y_new >= row_begin && y_new < row_end &&
+          (y_new + part.y_offset) % part.sample_step == part.sample_step / 2) {
+        for (int x = part.sample_step / 2; x < width; x += part.sample_step) {
+          part.samples->push_back(out[x]);
+        }
+      }
       float* __restrict max3 =
           max3_rows + static_cast<size_t>(y_new % ring) * row_size;
       max3[0] = out[0];
@@ -127,7 +145,7 @@ int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
       }
     }
     const int y = y_new - radius;  // the row whose window is complete
-    if (y < 1 || y > height - 2) continue;
+    if (y < 1 || y > height - 2 || y < row_begin || y >= row_end) continue;
     const float* __restrict up = row_of(y - 1);
     const float* __restrict row = row_of(y);
     {

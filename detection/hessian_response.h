@@ -49,6 +49,28 @@ int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
                     float threshold, int radius, std::vector<float>* rows,
                     std::vector<ResponsePeak>* peaks);
 
+// A horizontal band of `blurred` for FindSaddlePeaksInRows: peaks are
+// reported for rows [begin, end) only; the rows around them (at least the
+// suppression radius + 2) must be real image rows for the result to equal
+// the whole image's. Optionally the response is sampled every
+// `sample_step` pixels on those rows whose index + `y_offset` (the band's
+// first row in the whole image) is sample_step / 2 modulo sample_step, at x
+// = sample_step / 2 + i sample_step: the samples of SampledResponseMedian.
+struct PeakRows {
+  int begin = 0;
+  int end = 0;
+  int y_offset = 0;
+  int sample_step = 1;
+  std::vector<float>* samples = nullptr;
+};
+
+// FindSaddlePeaks restricted to the rows of `part` (peak rows in the
+// coordinates of `blurred`).
+int FindSaddlePeaksInRows(const cv::Mat& blurred, float trace_weight_k,
+                          float threshold, int radius, const PeakRows& part,
+                          std::vector<float>* rows,
+                          std::vector<ResponsePeak>* peaks);
+
 }  // namespace puzzlecal
 
 #endif  // PUZZLECAL_DETECTION_HESSIAN_RESPONSE_H_
