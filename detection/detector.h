@@ -173,11 +173,14 @@ struct DetectorSummary {
   std::string message;  // why not, when !ok
   int width = 0;
   int height = 0;
-  int levels_used = 0;         // pyramid levels searched
-  double normalizer = 0.0;     // grey value mapped to 1.0
-  double threshold = 0.0;      // response threshold of level `first_level`
-  double noise_sigma = 0.0;    // estimated pixel noise (grey in [0, 1])
-  int candidates = 0;          // pixels above threshold, all levels
+  int levels_used = 0;       // pyramid levels searched
+  double normalizer = 0.0;   // grey value mapped to 1.0
+  double threshold = 0.0;    // response threshold of level `first_level`
+  double noise_sigma = 0.0;  // estimated pixel noise (grey in [0, 1])
+  // Pixels above the response threshold, all levels (level 0, streamed in
+  // bands, counts those above min_response: the noise-adaptive threshold is
+  // applied to its peaks after the pass).
+  int candidates = 0;
   int after_nms = 0;           // local maxima
   int after_mask = 0;          // passed the thesis corner mask
   int after_ring = 0;          // passed the ring test
