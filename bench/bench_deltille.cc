@@ -431,6 +431,8 @@ bool SetGridOption(const std::string& arg, GridOptions* o) {
       {"max_axis_deviation_deg", &o->max_axis_deviation_deg},
       {"max_axis_deviation_with_image_deg",
        &o->max_axis_deviation_with_image_deg},
+      {"max_adjacency_deviation_with_image_deg",
+       &o->max_adjacency_deviation_with_image_deg},
       {"max_adjacency_length_ratio", &o->max_adjacency_length_ratio},
       {"max_axis_aspect_ratio", &o->max_axis_aspect_ratio},
       {"saddle_sample_fraction", &o->saddle_sample_fraction},

@@ -89,6 +89,10 @@ bool GridOptions::Check(std::string* why) const {
   if (!(max_axis_deviation_with_image_deg > 0 &&
         max_axis_deviation_with_image_deg <= 45))
     return Fail(why, "max_axis_deviation_with_image_deg must be in (0, 45]");
+  if (!(max_adjacency_deviation_with_image_deg > 0 &&
+        max_adjacency_deviation_with_image_deg < 90))
+    return Fail(why,
+                "max_adjacency_deviation_with_image_deg must be in (0, 90)");
   if (!(max_adjacency_length_ratio >= 1 &&
         std::isfinite(max_adjacency_length_ratio)))
     return Fail(why, "max_adjacency_length_ratio must be finite and >= 1");

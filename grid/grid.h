@@ -94,6 +94,12 @@ struct GridOptions {
   // fisheye photos 44 instead of 38 joins 130 more corners to the largest
   // components, with 0 wrong labels.
   double max_axis_deviation_with_image_deg = 44.0;
+  // With an image, two corners that a merge makes lattice neighbours and
+  // whose step is in that ambiguous band still agree when the step lies
+  // within this angle of the own direction each one's frame expects and the
+  // image shows a tile edge between them (one such pair along the seam of
+  // two large trees otherwise refuses the whole merge).
+  double max_adjacency_deviation_with_image_deg = 50.0;
   // Two corners that a merge makes lattice neighbours must be at most this
   // factor farther apart (or closer) than the tree edges on the same lattice
   // line at either corner (or, for a corner without any tree edge, the

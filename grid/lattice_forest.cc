@@ -25,11 +25,17 @@ struct AxisStep {
 
 class Forest {
  public:
+  // `image_check` (may be null): true when the image shows a tile edge
+  // between two corners (not tile-crossing, no flip of sides).
   Forest(const LatticeNodes& nodes, const GridOptions& options,
-         double max_axis_deviation_deg)
+         double max_axis_deviation_deg,
+         const std::function<bool(const GridEdge&)>* image_check)
       : nodes_(nodes),
         options_(options),
         min_axis_cosine_(std::cos(max_axis_deviation_deg * M_PI / 180)),
+        adjacency_cosine_(std::cos(
+            options.max_adjacency_deviation_with_image_deg * M_PI / 180)),
+        image_check_(image_check),
         table_(static_cast<int>(nodes.xy.size())) {
     const int n = static_cast<int>(nodes.xy.size());
     parent_.resize(n);
@@ -169,7 +175,7 @@ class Forest {
     const AxisStep at_n = Classify(n, v);
     const AxisStep at_m = Classify(m, -v);
     if (at_n.cosine < min_axis_cosine_ || at_m.cosine < min_axis_cosine_)
-      return false;
+      return AmbiguousAdjacencyAgrees(n, frame_n, m, d, fallback_length);
     // Parity of the two own directions, as for the joining edge (TryMerge).
     if ((at_n.k - at_m.k) % 2 == 0) return false;
     if (frame_n.Apply(at_n.k) != d) return false;
@@ -179,9 +185,38 @@ class Forest {
            LengthFits(m, at_m.k, dist, fallback_length);
   }
 
+  // AdjacencyAgrees for a step near 45 degrees to an axis estimate: with the
+  // image, the frames say which own direction to expect at either end; the
+  // step must lie within max_adjacency_deviation_with_image_deg of both, the
+  // parities must differ, the lengths fit, and the image must show a tile
+  // edge between the two corners (which keeps out tile diagonals and
+  // "knight" steps). Without the image such a step is refused.
+  bool AmbiguousAdjacencyAgrees(int n, const Dihedral& frame_n, int m, int d,
+                                double fallback_length) const {
+    if (image_check_ == nullptr) return false;
+    const Eigen::Vector2d v = nodes_.xy[m] - nodes_.xy[n];
+    const double dist = v.norm();
+    const int k_n = frame_n.Inverse().Apply(d);
+    const int k_m = frame_[m].Inverse().Apply(d + 2);
+    if ((k_n - k_m) % 2 == 0) return false;
+    if (!(Direction(n, k_n).dot(v) >= adjacency_cosine_ * dist &&
+          -Direction(m, k_m).dot(v) >= adjacency_cosine_ * dist))
+      return false;
+    if (!LengthFits(n, k_n, dist, fallback_length) ||
+        !LengthFits(m, k_m, dist, fallback_length))
+      return false;
+    GridEdge edge;
+    edge.a = std::min(n, m);
+    edge.b = std::max(n, m);
+    edge.length = edge.weight = dist;
+    return (*image_check_)(edge);
+  }
+
   const LatticeNodes& nodes_;
   const GridOptions& options_;
   const double min_axis_cosine_;
+  const double adjacency_cosine_;
+  const std::function<bool(const GridEdge&)>* image_check_;
   LabelTable table_;
 
   // Union-find and member lists (a root's list starts at the root).
@@ -353,9 +388,16 @@ void BuildLatticeForest(
   // With the intensity test refusing tile-crossing edges, the ambiguity band
   // around 45 degrees can be narrower (GridOptions).
   const bool image_guard = crosses_tile && options.refuse_penalised_edges;
+  std::function<bool(const GridEdge&)> image_check;
+  if (image_guard) {
+    image_check = [&](const GridEdge& edge) {
+      return !crosses_tile(edge) && !(sides_flip && sides_flip(edge));
+    };
+  }
   Forest state(nodes, options,
                image_guard ? options.max_axis_deviation_with_image_deg
-                           : options.max_axis_deviation_deg);
+                           : options.max_axis_deviation_deg,
+               image_guard ? &image_check : nullptr);
   if (trace != nullptr) trace->clear();
   auto record = [&](const GridEdge& edge, Refusal decision) -> int {
     if (trace == nullptr) return -1;
