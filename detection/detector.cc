@@ -37,6 +37,9 @@ bool DetectorOptions::Check(std::string* why) const {
   if (nms_radius_px < 1 || nms_radius_px > 50) {
     return fail("nms_radius_px must be in [1, 50]");
   }
+  if (nms_radius_coarse_px < 1 || nms_radius_coarse_px > 50) {
+    return fail("nms_radius_coarse_px must be in [1, 50]");
+  }
   if (!(ring_radius_px >= 1.5 && ring_radius_px <= 20.0)) {
     return fail("ring_radius_px must be in [1.5, 20]");
   }
@@ -286,6 +289,11 @@ double NoiseSigma(const cv::Mat& image, int step, std::vector<float>* scratch) {
     default:
       return 0.0;
   }
+}
+
+// Suppression radius of pyramid level `level`.
+int NmsRadius(const DetectorOptions& options, int level) {
+  return level == 0 ? options.nms_radius_px : options.nms_radius_coarse_px;
 }
 
 // A verified candidate in full-resolution pixels.
@@ -579,7 +587,7 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
     peaks.clear();
     s.candidates += FindSaddlePeaks(
         blurred[l], k, static_cast<float>(threshold * threshold),
-        options.nms_radius_px, &ws.response_rows, &peaks);
+        NmsRadius(options, l), &ws.response_rows, &peaks);
     s.after_nms += static_cast<int>(peaks.size());
     s.ms_response += MsSince(t);
 
@@ -597,9 +605,10 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
   t = Clock::now();
   std::vector<Candidate> merged;
   {
-    PointGrid grid(8.0 * options.nms_radius_px, image.cols, image.rows);
+    PointGrid grid(8.0 * NmsRadius(options, 1), image.cols, image.rows);
     for (const Candidate& c : candidates) {  // already ordered by level
-      const double radius = std::ldexp(1.0, c.level) * options.nms_radius_px;
+      const double radius =
+          std::ldexp(1.0, c.level) * NmsRadius(options, c.level);
       bool taken = false;
       grid.ForNear(c.xy, radius, [&](int index) {
         if ((merged[index].xy - c.xy).norm() <= radius) taken = true;

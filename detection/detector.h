@@ -71,8 +71,12 @@ struct DetectorOptions {
 
   // --- non-maximum suppression ---
   // Radius (level pixels) of the square window in which a candidate must be
-  // the maximum. The thesis uses 10 px at one scale; 3 keeps 5 px tiles. >= 1.
-  int nms_radius_px = 3;
+  // the maximum, at full resolution and at the coarser levels. The thesis
+  // uses 10 px at one scale; 2 keeps neighbour corners of 4-5 px tiles
+  // apart (3 lost a third of them at 5 px); the coarser levels see only
+  // larger tiles, where 3 gives fewer duplicate peaks. 1..50.
+  int nms_radius_px = 2;
+  int nms_radius_coarse_px = 3;
 
   // --- candidate filters ---
   // The thesis's corner mask: at a candidate, the strongest junction kernel

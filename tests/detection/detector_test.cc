@@ -594,10 +594,10 @@ TEST(DetectorTest, PuzzleBoardDiscsLeaveNoErrorTail) {
 TEST(DetectorTest, PuzzleBoardRecallAtSmallTiles) {
   // The accuracy bench's tile series (11x8 PuzzleBoard, blur 0.8 px, noise
   // 1 %, mild tilt, two rolls). Measured recall: 10 and 8 px 100 %, 6 px
-  // 98.3 % (before the ring test's clean-harmonic band: 8 px 91 %, 6 px
-  // 81 %).
+  // 98.9 %, 5 px 97.7 % (before the ring test's clean-harmonic band and the
+  // suppression radius 2: 8 px 91 %, 6 px 81 %, 5 px 55 %).
   const Board board = MakeBoard(BoardType::kPuzzleBoard, 11, 8);
-  for (double tile_px : {6.0, 8.0, 10.0}) {
+  for (double tile_px : {5.0, 6.0, 8.0, 10.0}) {
     int expected = 0, found = 0, false_on_board = 0;
     for (int v = 0; v < 2; ++v) {
       const int width = static_cast<int>(tile_px * 15 + 40);
@@ -619,7 +619,9 @@ TEST(DetectorTest, PuzzleBoardRecallAtSmallTiles) {
       false_on_board += score.false_on_board;
     }
     const double recall = static_cast<double>(found) / expected;
-    EXPECT_GE(recall, tile_px >= 8.0 ? 0.995 : 0.95)
+    EXPECT_GE(recall, tile_px >= 8.0   ? 0.995
+                      : tile_px >= 6.0 ? 0.97
+                                       : 0.9)
         << "tile " << tile_px << ": " << found << " of " << expected;
     EXPECT_EQ(false_on_board, 0) << "tile " << tile_px;
   }
