@@ -109,6 +109,12 @@ bool GridOptions::Check(std::string* why) const {
     return Fail(why, "line_prediction_tolerance must be finite and > 0");
   if (!(saddle_sample_fraction > 0 && saddle_sample_fraction <= 0.5))
     return Fail(why, "saddle_sample_fraction must be in (0, 0.5]");
+  if (attach_rounds < 0 || attach_rounds > 100)
+    return Fail(why, "attach_rounds must be in [0, 100]");
+  if (!(attach_tolerance > 0 && attach_tolerance < 1))
+    return Fail(why, "attach_tolerance must be in (0, 1)");
+  if (attach_min_support < 1 || attach_min_support > 8)
+    return Fail(why, "attach_min_support must be in [1, 8]");
   if (min_component_size < 1)
     return Fail(why, "min_component_size must be >= 1");
   return true;
@@ -283,7 +289,7 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
   phase_start = std::chrono::steady_clock::now();
   std::vector<GridComponent> components =
       ExtractComponents(nodes.xy, summary.image_used ? image : cv::Mat(),
-                        forest, options, &summary);
+                        forest, edges, options, &summary);
   summary.cleanup_ms = MillisecondsSince(phase_start);
 
   summary.num_components = static_cast<int>(components.size());

@@ -129,6 +129,19 @@ struct GridOptions {
   // is 0.44 of the spacing (0.35 removed true rim corners of 4 deltille
   // photos; 0.5 keeps them and still removes clutter).
   double line_prediction_tolerance = 0.5;
+  // Final pass, with an image: a corner outside every component joins one
+  // at a free label next to it when the component's lattice predicts it
+  // there and its four tiles alternate (see check_saddle_pattern); corners
+  // left out by refused merges of the large, quickly changing tiles next to
+  // a fisheye lens. Predictions: quadratic extrapolation along each lattice
+  // line through the label with three corners, and the parallelogram of
+  // each tile at the label with three corners. Each must land within
+  // attach_tolerance of the local spacing, and at least attach_min_support
+  // of them must exist. Rounds: while corners join, at most this many
+  // (0 turns the pass off).
+  int attach_rounds = 8;
+  double attach_tolerance = 0.45;
+  int attach_min_support = 2;
   // Components with fewer corners are dropped (not returned).
   int min_component_size = 4;
 
@@ -168,6 +181,7 @@ struct GridSummary {
   // Final pass.
   int num_removed_not_saddle = 0;     // tiles around it do not alternate
   int num_removed_by_prediction = 0;  // corners their lines did not predict
+  int num_attached = 0;               // joined by the attach pass
   int num_components_dropped = 0;     // below min_component_size
   int num_components = 0;             // returned
   int num_labelled_corners = 0;       // corners in returned components

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 #include "grid/dihedral.h"
 #include "grid/label_table.h"
@@ -133,12 +134,219 @@ void Unlink(Links* links, int i) {
   }
 }
 
+// Lattice position lookup of one component during the attach pass: the
+// forest's table for its own corners, a short list for attached ones.
+class ComponentLookup {
+ public:
+  ComponentLookup(const LatticeForest& forest,
+                  const std::vector<int>& component_of,
+                  const std::vector<Eigen::Vector2i>& label)
+      : forest_(forest), component_of_(component_of), label_(label) {}
+
+  // The corner of component `c` (tree `tree`) at `label`, or -1.
+  int Find(int c, int tree, const Eigen::Vector2i& label) const {
+    const int m = forest_.table.Find(tree, label);
+    if (m >= 0 && component_of_[m] == c) return m;
+    for (int a : attached_)
+      if (component_of_[a] == c && label_[a] == label) return a;
+    return -1;
+  }
+  void Attach(int corner) { attached_.push_back(corner); }
+
+ private:
+  const LatticeForest& forest_;
+  const std::vector<int>& component_of_;
+  const std::vector<Eigen::Vector2i>& label_;
+  std::vector<int> attached_;
+};
+
+// How well the lattice of component c (tree `tree`) around the free label L
+// predicts a corner at p: quadratic extrapolation along each of the 4 lines
+// through L with three corners, and the parallelogram of each tile at L
+// with its three other corners; an error below `tolerance` of the local
+// spacing supports, above contradicts. Returns the largest relative error
+// of the supporting verdicts.
+double PredictAt(const std::vector<Eigen::Vector2d>& xy,
+                 const ComponentLookup& lookup, int c, int tree,
+                 const Eigen::Vector2i& L, const Eigen::Vector2d& p,
+                 double tolerance, int* supported, int* contradicted) {
+  *supported = 0;
+  *contradicted = 0;
+  double worst = 0;
+  auto verdict = [&](const Eigen::Vector2d& predicted, double spacing) {
+    if (!(spacing > 0)) return;
+    const double error = (p - predicted).norm() / spacing;
+    if (error <= tolerance) {
+      ++*supported;
+      worst = std::max(worst, error);
+    } else {
+      ++*contradicted;
+    }
+  };
+  int near[4];
+  for (int d = 0; d < 4; ++d)
+    near[d] = lookup.Find(c, tree, L + LatticeStep(d));
+  for (int d = 0; d < 4; ++d) {
+    if (near[d] < 0) continue;
+    const int q2 = lookup.Find(c, tree, L + 2 * LatticeStep(d));
+    if (q2 < 0) continue;
+    const int q3 = lookup.Find(c, tree, L + 3 * LatticeStep(d));
+    if (q3 < 0) continue;
+    verdict(3 * xy[near[d]] - 3 * xy[q2] + xy[q3],
+            (xy[near[d]] - xy[q2]).norm());
+  }
+  for (int d = 0; d < 4; ++d) {
+    const int a = near[d], b = near[Mod4(d + 1)];
+    if (a < 0 || b < 0) continue;
+    const int m = lookup.Find(c, tree, L + LatticeStep(d) + LatticeStep(d + 1));
+    if (m < 0) continue;
+    verdict(xy[a] + xy[b] - xy[m],
+            std::min((xy[a] - xy[m]).norm(), (xy[b] - xy[m]).norm()));
+  }
+  return worst;
+}
+
+// The attach pass: corners outside every component (never joined, removed,
+// or in a dropped tree) join a component at a free label next to it when
+// the component's lattice around that label predicts them there (see
+// PredictAt) and the four tiles around them alternate. Candidates are the
+// candidate edges between such a corner and a component corner. Rounds
+// repeat while corners join (a joined corner predicts the next one).
+// `label` receives the labels of all corners when any joined (else stays
+// empty).
+void AttachCorners(const std::vector<Eigen::Vector2d>& xy, const cv::Mat& image,
+                   const LatticeForest& forest,
+                   const std::vector<GridEdge>& edges,
+                   const GridOptions& options, Links* links,
+                   std::vector<int>* component_of_ptr,
+                   std::vector<Eigen::Vector2i>* label, GridSummary* summary) {
+  std::vector<int>& component_of = *component_of_ptr;
+  const int n = static_cast<int>(xy.size());
+  auto outside = [&](int i) {
+    return component_of[i] < 0 && forest.tree[i] >= 0;
+  };
+  // (outside corner, component corner) pairs.
+  std::vector<std::pair<int, int>> pairs;
+  for (const GridEdge& e : edges) {
+    if (outside(e.a) && component_of[e.b] >= 0) pairs.emplace_back(e.a, e.b);
+    if (outside(e.b) && component_of[e.a] >= 0) pairs.emplace_back(e.b, e.a);
+  }
+  if (pairs.empty()) return;
+  std::vector<Eigen::Vector2i> labels = forest.label;
+  ComponentLookup lookup(forest, component_of, labels);
+  std::vector<char> refused(n, 0);
+  struct Proposal {
+    double error;
+    int u;
+    int c;
+    int tree;
+    Eigen::Vector2i at;
+  };
+  std::vector<Proposal> proposals;
+  bool any = false;
+  for (int round = 0; round < options.attach_rounds; ++round) {
+    proposals.clear();
+    for (const auto& [u, m] : pairs) {
+      if (!outside(u) || refused[u] || component_of[m] < 0) continue;
+      const int c = component_of[m];
+      const int tree = forest.tree[m];
+      for (int d = 0; d < 4; ++d) {
+        if ((*links)[m][d] >= 0) continue;
+        const Eigen::Vector2i at = labels[m] + LatticeStep(d);
+        if (lookup.Find(c, tree, at) >= 0) continue;
+        int supported, contradicted;
+        const double error =
+            PredictAt(xy, lookup, c, tree, at, xy[u], options.attach_tolerance,
+                      &supported, &contradicted);
+        if (supported >= options.attach_min_support && contradicted == 0)
+          proposals.push_back({error, u, c, tree, at});
+      }
+    }
+    if (proposals.empty()) break;
+    std::sort(proposals.begin(), proposals.end(),
+              [](const Proposal& x, const Proposal& y) {
+                if (x.error != y.error) return x.error < y.error;
+                if (x.u != y.u) return x.u < y.u;
+                if (x.c != y.c) return x.c < y.c;
+                if (x.at.x() != y.at.x()) return x.at.x() < y.at.x();
+                return x.at.y() < y.at.y();
+              });
+    // A corner that fits two places is ambiguous and stays out; so does a
+    // place that two corners fit (duplicate detections, clutter).
+    std::vector<int> by_place(proposals.size());
+    for (size_t k = 0; k < proposals.size(); ++k)
+      by_place[k] = static_cast<int>(k);
+    auto place_less = [&](int x, int y) {
+      const Proposal& a = proposals[x];
+      const Proposal& b = proposals[y];
+      if (a.c != b.c) return a.c < b.c;
+      if (a.at.x() != b.at.x()) return a.at.x() < b.at.x();
+      if (a.at.y() != b.at.y()) return a.at.y() < b.at.y();
+      return a.u < b.u;
+    };
+    std::sort(by_place.begin(), by_place.end(), place_less);
+    std::vector<char> crowded(proposals.size(), 0);
+    for (size_t k = 0; k < by_place.size();) {
+      size_t end = k + 1;
+      bool two = false;
+      const Proposal& a = proposals[by_place[k]];
+      while (end < by_place.size() && proposals[by_place[end]].c == a.c &&
+             proposals[by_place[end]].at == a.at) {
+        two = two || proposals[by_place[end]].u != a.u;
+        ++end;
+      }
+      if (two)
+        for (size_t j = k; j < end; ++j) crowded[by_place[j]] = 1;
+      k = end;
+    }
+    std::vector<int> first(n, -1);
+    for (size_t k = 0; k < proposals.size(); ++k) {
+      const Proposal& p = proposals[k];
+      if (first[p.u] == -1) {
+        first[p.u] = static_cast<int>(k);
+      } else {
+        const Proposal& q = proposals[first[p.u]];
+        if (q.c != p.c || q.at != p.at) refused[p.u] = 1;
+      }
+    }
+    int joined = 0;
+    for (size_t k = 0; k < proposals.size(); ++k) {
+      const Proposal& p = proposals[k];
+      if (crowded[k] || refused[p.u] || !outside(p.u)) continue;
+      if (lookup.Find(p.c, p.tree, p.at) >= 0) continue;  // taken this round
+      const int previous = component_of[p.u];
+      component_of[p.u] = p.c;
+      labels[p.u] = p.at;
+      for (int d = 0; d < 4; ++d)
+        (*links)[p.u][d] = lookup.Find(p.c, p.tree, p.at + LatticeStep(d));
+      if (!LooksLikeSaddle(xy, image, *links, p.u,
+                           options.saddle_sample_fraction)) {
+        for (int d = 0; d < 4; ++d) (*links)[p.u][d] = -1;
+        component_of[p.u] = previous;
+        labels[p.u] = forest.label[p.u];
+        refused[p.u] = 1;
+        continue;
+      }
+      for (int d = 0; d < 4; ++d) {
+        const int m = (*links)[p.u][d];
+        if (m >= 0) (*links)[m][Mod4(d + 2)] = p.u;
+      }
+      lookup.Attach(p.u);
+      ++joined;
+    }
+    if (joined == 0) break;
+    summary->num_attached += joined;
+    any = true;
+  }
+  if (any) *label = std::move(labels);
+}
+
 }  // namespace
 
 std::vector<GridComponent> ExtractComponents(
     const std::vector<Eigen::Vector2d>& xy, const cv::Mat& image,
-    const LatticeForest& forest, const GridOptions& options,
-    GridSummary* summary) {
+    const LatticeForest& forest, const std::vector<GridEdge>& edges,
+    const GridOptions& options, GridSummary* summary) {
   const int n = static_cast<int>(xy.size());
   std::vector<int> members;
   members.reserve(n);
@@ -218,14 +426,21 @@ std::vector<GridComponent> ExtractComponents(
     }
     for (int c : queue) component_of[c] = id;
   }
+  const std::vector<Eigen::Vector2i>* label = &forest.label;
+  std::vector<Eigen::Vector2i> attached_label;
+  if (!image.empty() && options.attach_rounds > 0 && !components.empty()) {
+    AttachCorners(xy, image, forest, edges, options, &links, &component_of,
+                  &attached_label, summary);
+    if (!attached_label.empty()) label = &attached_label;
+  }
+
   for (int i : members)
     if (component_of[i] >= 0) components[component_of[i]].corner.push_back(i);
   for (GridComponent& component : components) {
-    Eigen::Vector2i low = forest.label[component.corner[0]];
-    for (int c : component.corner) low = low.cwiseMin(forest.label[c]);
+    Eigen::Vector2i low = (*label)[component.corner[0]];
+    for (int c : component.corner) low = low.cwiseMin((*label)[c]);
     component.ij.reserve(component.corner.size());
-    for (int c : component.corner)
-      component.ij.push_back(forest.label[c] - low);
+    for (int c : component.corner) component.ij.push_back((*label)[c] - low);
   }
   std::sort(components.begin(), components.end(),
             [](const GridComponent& x, const GridComponent& y) {
