@@ -402,14 +402,14 @@ std::string GridSummaryLine(const GridSummary& s) {
       "neighbor_weight %d tree_mean %d ambiguous_axis %d collision %d "
       "contradiction %d collinearity %d sides_flip %d; removed: not_saddle %d "
       "prediction "
-      "%d; attached %d; components %d (dropped %d)",
+      "%d; attached %d, joined %d; components %d (dropped %d)",
       s.num_edges_considered, s.num_edges_orientation_filtered,
       s.num_edges_penalised, s.num_merges, s.num_rejected_neighbor_weight,
       s.num_rejected_tree_mean_weight, s.num_rejected_ambiguous_axis,
       s.num_rejected_label_collision, s.num_rejected_neighbor_contradiction,
       s.num_rejected_collinearity, s.num_rejected_sides_flip,
       s.num_removed_not_saddle, s.num_removed_by_prediction, s.num_attached,
-      s.num_components, s.num_components_dropped);
+      s.num_components_joined, s.num_components, s.num_components_dropped);
   return line;
 }
 
@@ -439,14 +439,17 @@ bool SetGridOption(const std::string& arg, GridOptions* o) {
       {"side_offset_fraction", &o->side_offset_fraction},
       {"side_min_contrast", &o->side_min_contrast},
       {"line_prediction_tolerance", &o->line_prediction_tolerance},
-      {"attach_tolerance", &o->attach_tolerance}};
+      {"attach_tolerance", &o->attach_tolerance},
+      {"max_join_direction_deviation_deg",
+       &o->max_join_direction_deviation_deg}};
   const std::map<std::string, int*> ints = {
       {"num_neighbors", &o->num_neighbors},
       {"intensity_samples", &o->intensity_samples},
       {"kruskal_passes", &o->kruskal_passes},
       {"min_component_size", &o->min_component_size},
       {"attach_rounds", &o->attach_rounds},
-      {"attach_min_support", &o->attach_min_support}};
+      {"attach_min_support", &o->attach_min_support},
+      {"max_component_joins", &o->max_component_joins}};
   if (doubles.count(name)) {
     *doubles.at(name) = value;
   } else if (ints.count(name)) {

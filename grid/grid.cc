@@ -115,6 +115,11 @@ bool GridOptions::Check(std::string* why) const {
     return Fail(why, "attach_tolerance must be in (0, 1)");
   if (attach_min_support < 1 || attach_min_support > 8)
     return Fail(why, "attach_min_support must be in [1, 8]");
+  if (!(max_join_direction_deviation_deg > 0 &&
+        max_join_direction_deviation_deg < 90))
+    return Fail(why, "max_join_direction_deviation_deg must be in (0, 90)");
+  if (max_component_joins < 0 || max_component_joins > 1000)
+    return Fail(why, "max_component_joins must be in [0, 1000]");
   if (min_component_size < 1)
     return Fail(why, "min_component_size must be >= 1");
   return true;

@@ -142,6 +142,15 @@ struct GridOptions {
   int attach_rounds = 8;
   double attach_tolerance = 0.45;
   int attach_min_support = 2;
+  // Then (same pass) a component joins another when the other's lattice
+  // predicts one of its corners at a free label next to it as above, the
+  // image directions of both lattices at that corner agree within this
+  // angle (degrees) on both axes under exactly one lattice symmetry, no two
+  // corners meet on one label and every corner along the seam is predicted
+  // where it is (board halves split by refused merges near a fisheye lens;
+  // occluded boards). At most this many joins (0: none).
+  double max_join_direction_deviation_deg = 30.0;
+  int max_component_joins = 16;
   // Components with fewer corners are dropped (not returned).
   int min_component_size = 4;
 
@@ -182,6 +191,7 @@ struct GridSummary {
   int num_removed_not_saddle = 0;     // tiles around it do not alternate
   int num_removed_by_prediction = 0;  // corners their lines did not predict
   int num_attached = 0;               // joined by the attach pass
+  int num_components_joined = 0;      // joined by the attach pass
   int num_components_dropped = 0;     // below min_component_size
   int num_components = 0;             // returned
   int num_labelled_corners = 0;       // corners in returned components

@@ -206,35 +206,175 @@ double PredictAt(const std::vector<Eigen::Vector2d>& xy,
   return worst;
 }
 
-// The attach pass: corners outside every component (never joined, removed,
-// or in a dropped tree) join a component at a free label next to it when
-// the component's lattice around that label predicts them there (see
-// PredictAt) and the four tiles around them alternate. Candidates are the
-// candidate edges between such a corner and a component corner. Rounds
-// repeat while corners join (a joined corner predicts the next one).
-// `label` receives the labels of all corners when any joined (else stays
-// empty).
-void AttachCorners(const std::vector<Eigen::Vector2d>& xy, const cv::Mat& image,
-                   const LatticeForest& forest,
-                   const std::vector<GridEdge>& edges,
-                   const GridOptions& options, Links* links,
-                   std::vector<int>* component_of_ptr,
-                   std::vector<Eigen::Vector2i>* label, GridSummary* summary) {
+// One component joins another at the first place (in order of prediction
+// error) where the other's lattice predicts one of its corners (see
+// PredictAt), when the lattice directions of both at that corner agree on
+// both axes under one symmetry, no two corners meet on one label and the
+// predictions at every label along the seam hold. The smaller component
+// joins the larger. False when none joins.
+bool JoinComponents(const std::vector<Eigen::Vector2d>& xy,
+                    const LatticeForest& forest,
+                    const std::vector<GridEdge>& edges,
+                    const GridOptions& options, int num_components,
+                    Links* links, std::vector<int>* component_of_ptr,
+                    std::vector<Eigen::Vector2i>* labels_ptr,
+                    ComponentLookup* lookup) {
+  if (num_components < 2) return false;
   std::vector<int>& component_of = *component_of_ptr;
+  std::vector<Eigen::Vector2i>& labels = *labels_ptr;
+  const int n = static_cast<int>(xy.size());
+  std::vector<int> size(num_components, 0);
+  for (int i = 0; i < n; ++i)
+    if (component_of[i] >= 0) ++size[component_of[i]];
+  struct Place {
+    double error;
+    int u;
+    int c;
+    int tree;
+    Eigen::Vector2i at;
+  };
+  std::vector<Place> places;
+  for (const GridEdge& e : edges) {
+    for (const auto& [u, m] :
+         {std::make_pair(e.a, e.b), std::make_pair(e.b, e.a)}) {
+      const int cu = component_of[u], cm = component_of[m];
+      if (cu < 0 || cm < 0 || cu == cm) continue;
+      if (size[cu] > size[cm] || (size[cu] == size[cm] && cu < cm)) continue;
+      const int tree = forest.tree[m];
+      for (int d = 0; d < 4; ++d) {
+        if ((*links)[m][d] >= 0) continue;
+        const Eigen::Vector2i at = labels[m] + LatticeStep(d);
+        if (lookup->Find(cm, tree, at) >= 0) continue;
+        int supported, contradicted;
+        const double error =
+            PredictAt(xy, *lookup, cm, tree, at, xy[u],
+                      options.attach_tolerance, &supported, &contradicted);
+        if (supported >= options.attach_min_support && contradicted == 0)
+          places.push_back({error, u, cm, tree, at});
+      }
+    }
+  }
+  std::sort(places.begin(), places.end(), [](const Place& x, const Place& y) {
+    if (x.error != y.error) return x.error < y.error;
+    if (x.u != y.u) return x.u < y.u;
+    if (x.c != y.c) return x.c < y.c;
+    if (x.at.x() != y.at.x()) return x.at.x() < y.at.x();
+    return x.at.y() < y.at.y();
+  });
+  const double min_cosine =
+      std::cos(options.max_join_direction_deviation_deg * M_PI / 180);
+  std::vector<int> members;
+  std::vector<Eigen::Vector2i> target;
+  for (const Place& place : places) {
+    const int u = place.u, c = place.c, tree = place.tree;
+    const int c2 = component_of[u];
+    // Image vectors of the lattice steps at the place: in the joining
+    // component's directions (r) and in the moving one's (w).
+    Eigen::Vector2d r[4], w[4];
+    bool has_r[4], has_w[4];
+    for (int k = 0; k < 4; ++k) {
+      const int a = lookup->Find(c, tree, place.at + LatticeStep(k));
+      const int b = lookup->Find(c, tree, place.at - LatticeStep(k));
+      has_r[k] = a >= 0 || b >= 0;
+      if (a >= 0) {
+        r[k] = xy[a] - xy[u];
+      } else if (b >= 0) {
+        r[k] = xy[u] - xy[b];
+      }
+      const int v = (*links)[u][k], v2 = (*links)[u][Mod4(k + 2)];
+      has_w[k] = v >= 0 || v2 >= 0;
+      if (v >= 0) {
+        w[k] = xy[v] - xy[u];
+      } else if (v2 >= 0) {
+        w[k] = xy[u] - xy[v2];
+      }
+    }
+    int found = 0;
+    Dihedral symmetry;
+    for (int sign : {1, -1}) {
+      for (int shift = 0; shift < 4; ++shift) {
+        const Dihedral t{sign, shift};
+        bool axis_agrees[2] = {false, false}, bad = false;
+        for (int d = 0; d < 4; ++d) {
+          const int k = t.Apply(d);
+          if (!has_w[d] || !has_r[k]) continue;
+          const double cosine =
+              r[k].dot(w[d]) / (r[k].norm() * w[d].norm() + 1e-300);
+          if (cosine >= min_cosine) {
+            axis_agrees[k % 2] = true;
+          } else {
+            bad = true;
+          }
+        }
+        if (!bad && axis_agrees[0] && axis_agrees[1]) {
+          ++found;
+          symmetry = t;
+        }
+      }
+    }
+    if (found != 1) continue;
+    members.clear();
+    target.clear();
+    for (int i = 0; i < n; ++i)
+      if (component_of[i] == c2) members.push_back(i);
+    bool ok = true;
+    for (int p : members) {
+      const Eigen::Vector2i at =
+          place.at + symmetry.Apply(Eigen::Vector2i(labels[p] - labels[u]));
+      if (lookup->Find(c, tree, at) >= 0) {
+        ok = false;
+        break;
+      }
+      target.push_back(at);
+    }
+    if (!ok) continue;
+    for (size_t q = 0; q < members.size() && ok; ++q) {
+      bool seam = false;
+      for (int k = 0; k < 4 && !seam; ++k)
+        seam = lookup->Find(c, tree, target[q] + LatticeStep(k)) >= 0;
+      if (!seam) continue;
+      int supported, contradicted;
+      PredictAt(xy, *lookup, c, tree, target[q], xy[members[q]],
+                options.attach_tolerance, &supported, &contradicted);
+      ok = contradicted == 0;
+    }
+    if (!ok) continue;
+    for (size_t q = 0; q < members.size(); ++q) {
+      component_of[members[q]] = c;
+      labels[members[q]] = target[q];
+      lookup->Attach(members[q]);
+    }
+    for (int p : members) {
+      for (int k = 0; k < 4; ++k) {
+        const int m = lookup->Find(c, tree, labels[p] + LatticeStep(k));
+        (*links)[p][k] = m;
+        if (m >= 0) (*links)[m][Mod4(k + 2)] = p;
+      }
+    }
+    return true;
+  }
+  return false;
+}
+
+// One pass of attaching outside corners (see AttachCorners); true when any
+// joined.
+bool AttachOutsideCorners(const std::vector<Eigen::Vector2d>& xy,
+                          const cv::Mat& image, const LatticeForest& forest,
+                          const std::vector<std::pair<int, int>>& pairs,
+                          const GridOptions& options, Links* links,
+                          std::vector<int>* component_of_ptr,
+                          std::vector<Eigen::Vector2i>* labels_ptr,
+                          ComponentLookup* lookup_ptr,
+                          std::vector<char>* refused_ptr,
+                          GridSummary* summary) {
+  std::vector<int>& component_of = *component_of_ptr;
+  std::vector<Eigen::Vector2i>& labels = *labels_ptr;
+  ComponentLookup& lookup = *lookup_ptr;
+  std::vector<char>& refused = *refused_ptr;
   const int n = static_cast<int>(xy.size());
   auto outside = [&](int i) {
     return component_of[i] < 0 && forest.tree[i] >= 0;
   };
-  // (outside corner, component corner) pairs.
-  std::vector<std::pair<int, int>> pairs;
-  for (const GridEdge& e : edges) {
-    if (outside(e.a) && component_of[e.b] >= 0) pairs.emplace_back(e.a, e.b);
-    if (outside(e.b) && component_of[e.a] >= 0) pairs.emplace_back(e.b, e.a);
-  }
-  if (pairs.empty()) return;
-  std::vector<Eigen::Vector2i> labels = forest.label;
-  ComponentLookup lookup(forest, component_of, labels);
-  std::vector<char> refused(n, 0);
   struct Proposal {
     double error;
     int u;
@@ -338,6 +478,52 @@ void AttachCorners(const std::vector<Eigen::Vector2d>& xy, const cv::Mat& image,
     summary->num_attached += joined;
     any = true;
   }
+  return any;
+}
+
+// The attach pass: corners outside every component (never joined, removed,
+// or in a dropped tree) join a component at a free label next to it when
+// the component's lattice around that label predicts them there (see
+// PredictAt) and the four tiles around them alternate. Candidates are the
+// candidate edges between such a corner and a component corner. Rounds
+// repeat while corners join (a joined corner predicts the next one).
+// Then components join one another (see JoinComponents), and corners are
+// attached again, up to options.max_component_joins times. `label` receives
+// the labels of all corners when any corner moved (else stays empty).
+void AttachCorners(const std::vector<Eigen::Vector2d>& xy, const cv::Mat& image,
+                   const LatticeForest& forest,
+                   const std::vector<GridEdge>& edges,
+                   const GridOptions& options, Links* links,
+                   std::vector<int>* component_of_ptr, int num_components,
+                   std::vector<Eigen::Vector2i>* label, GridSummary* summary) {
+  std::vector<int>& component_of = *component_of_ptr;
+  const int n = static_cast<int>(xy.size());
+  auto outside = [&](int i) {
+    return component_of[i] < 0 && forest.tree[i] >= 0;
+  };
+  // (outside corner, component corner) pairs.
+  std::vector<std::pair<int, int>> pairs;
+  for (const GridEdge& e : edges) {
+    if (outside(e.a) && component_of[e.b] >= 0) pairs.emplace_back(e.a, e.b);
+    if (outside(e.b) && component_of[e.a] >= 0) pairs.emplace_back(e.b, e.a);
+  }
+  if (pairs.empty() && num_components < 2) return;
+  std::vector<Eigen::Vector2i> labels = forest.label;
+  ComponentLookup lookup(forest, component_of, labels);
+  std::vector<char> refused(n, 0);
+  bool any = false;
+  for (int joins = 0; joins <= options.max_component_joins; ++joins) {
+    if (AttachOutsideCorners(xy, image, forest, pairs, options, links,
+                             &component_of, &labels, &lookup, &refused,
+                             summary))
+      any = true;
+    if (joins == options.max_component_joins ||
+        !JoinComponents(xy, forest, edges, options, num_components, links,
+                        &component_of, &labels, &lookup))
+      break;
+    ++summary->num_components_joined;
+    any = true;
+  }
   if (any) *label = std::move(labels);
 }
 
@@ -430,12 +616,18 @@ std::vector<GridComponent> ExtractComponents(
   std::vector<Eigen::Vector2i> attached_label;
   if (!image.empty() && options.attach_rounds > 0 && !components.empty()) {
     AttachCorners(xy, image, forest, edges, options, &links, &component_of,
-                  &attached_label, summary);
+                  static_cast<int>(components.size()), &attached_label,
+                  summary);
     if (!attached_label.empty()) label = &attached_label;
   }
 
   for (int i : members)
     if (component_of[i] >= 0) components[component_of[i]].corner.push_back(i);
+  components.erase(std::remove_if(components.begin(), components.end(),
+                                  [](const GridComponent& component) {
+                                    return component.corner.empty();
+                                  }),
+                   components.end());
   for (GridComponent& component : components) {
     Eigen::Vector2i low = (*label)[component.corner[0]];
     for (int c : component.corner) low = low.cwiseMin((*label)[c]);
