@@ -198,6 +198,9 @@ void Downsample(const cv::Mat& src, std::vector<float>* row, cv::Mat* dst) {
   DownsampleRows(src, 0, src.rows, 0, dst->rows, row, dst);
 }
 
+// Largest magnitude a float input pixel keeps (grey is normally in [0, 1]).
+constexpr float kMaxFloatPixel = 1e6f;
+
 // Picks the one-channel, finite version of the input and the grey value
 // that maps to 1.0. Returns false with a reason for unsupported types.
 bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
@@ -232,12 +235,18 @@ bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
       return false;
   }
   if ((*single)->depth() == CV_32F) {
-    // Non-finite pixels become 0.
+    // Non-finite pixels become 0, and magnitudes are capped at
+    // kMaxFloatPixel: the response multiplies four second derivatives, which
+    // would overflow float for values near its range.
     (*single)->copyTo(ws->finite);
     for (int y = 0; y < ws->finite.rows; ++y) {
       float* row = ws->finite.ptr<float>(y);
       for (int x = 0; x < ws->finite.cols; ++x) {
-        if (!std::isfinite(row[x])) row[x] = 0.0f;
+        if (!std::isfinite(row[x])) {
+          row[x] = 0.0f;
+        } else {
+          row[x] = std::clamp(row[x], -kMaxFloatPixel, kMaxFloatPixel);
+        }
       }
     }
     *single = &ws->finite;
@@ -722,6 +731,15 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
     }
     corners = std::move(kept_corners);
   }
+  // The promise to every caller: finite positions, responses and
+  // orientations, whatever the input held.
+  corners.erase(std::remove_if(corners.begin(), corners.end(),
+                               [](const Corner& c) {
+                                 return !c.xy.allFinite() ||
+                                        !std::isfinite(c.response) ||
+                                        !std::isfinite(c.orientation);
+                               }),
+                corners.end());
   std::sort(corners.begin(), corners.end(),
             [](const Corner& a, const Corner& b) {
               if (a.xy.y() != b.xy.y()) return a.xy.y() < b.xy.y();

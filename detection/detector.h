@@ -44,7 +44,8 @@ enum class SubpixelMethod {
 struct DetectorOptions {
   // --- preprocessing ---
   // Divide the grey image by its maximum (the thesis). When false, 8-bit and
-  // 16-bit images are divided by 255 / 65535 and float images are used as-is.
+  // 16-bit images are divided by 255 / 65535 and float images are used as-is
+  // (non-finite pixels read as 0, magnitudes capped at 1e6).
   bool normalize_by_max = true;
   // Standard deviation (pixels) of the Gaussian blur applied before the
   // derivatives; the thesis uses 1 with a 5x5 kernel. >= 0.
