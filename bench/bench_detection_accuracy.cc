@@ -290,31 +290,7 @@ int main(int argc, char** argv) {
   // blur 0.8 px, noise 2 %, 16 random views): error against truth per
   // corner with tiles >= 8 px, per refinement method, and by local tile
   // size (PuzzleBoard discs start a third of a tile from each corner).
-  SceneSpec scene;
-  scene.name = "sample";
-  scene.camera = WidePinholeCamera(800, 600, 90.0, -0.2);
-  scene.board.type = BoardType::kPuzzleBoard;
-  scene.board.cols = 23;
-  scene.board.rows = 16;
-  scene.board.origin = Eigen::Vector2i(50, 100);
-  scene.board.tile_size_m = 0.03;
-  scene.render.blur_sigma_px = 0.8;
-  scene.render.noise_sigma = 0.02;
-  scene.render.lighting_gradient = 0.2;
-  scene.render.vignetting = 0.2;
-  RandomViews& rv = scene.random_views;
-  rv.count = 16;
-  rv.seed = 5;
-  rv.min_distance_m = 0.35;
-  rv.max_distance_m = 0.8;
-  rv.min_view_angle_deg = 35;
-  rv.max_view_angle_deg = 85;
-  rv.max_roll_deg = 45;
-  rv.max_off_axis_deg = 35;
-  rv.target_margin_tiles = 3;
-  rv.occluders_per_view = 1;
-  rv.min_occluder_radius_px = 20;
-  rv.max_occluder_radius_px = 45;
+  SceneSpec scene = SampleScene(800, 600);
   std::string why;
   const std::vector<SceneView> scene_views = RenderScene(scene, &why);
   std::printf("  \"puzzleboard_demo_error\": [\n");

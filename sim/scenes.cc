@@ -493,6 +493,31 @@ SceneSpec DarkFisheyeScene(int width, int height) {
   return scene;
 }
 
+SceneSpec SampleScene(int width, int height) {
+  SceneSpec scene;
+  scene.name = "sample";
+  scene.camera = WidePinholeCamera(width, height, 90.0, -0.2);
+  scene.board = PuzzleBoard23x16();
+  scene.render.blur_sigma_px = 0.8;
+  scene.render.noise_sigma = 0.02;
+  scene.render.lighting_gradient = 0.2;
+  scene.render.vignetting = 0.2;
+  RandomViews& rv = scene.random_views;
+  rv.count = 16;
+  rv.seed = 5;
+  rv.min_distance_m = 0.35;
+  rv.max_distance_m = 0.8;
+  rv.min_view_angle_deg = 35;
+  rv.max_view_angle_deg = 85;
+  rv.max_roll_deg = 45;
+  rv.max_off_axis_deg = 35;
+  rv.target_margin_tiles = 3;
+  rv.occluders_per_view = 1;
+  rv.min_occluder_radius_px = 20;
+  rv.max_occluder_radius_px = 45;
+  return scene;
+}
+
 std::vector<std::string> StandardSceneNames() {
   return {"wide_pinhole", "strong_fisheye",       "tilt_series",
           "small_tiles",  "fisheye_checkerboard", "dark_fisheye"};

@@ -138,6 +138,12 @@ SceneSpec FisheyeCheckerboardScene(int width = 640, int height = 480);
 // Dark, strongly vignetted fisheye images with a black image circle, like
 // the deltille photos (their own size is 1600 x 1200).
 SceneSpec DarkFisheyeScene(int width = 800, int height = 600);
+// The demo's sample set (testdata/sample, recipe testdata/sample_scene.yaml):
+// a 90-degree pinhole with barrel distortion, the 23 x 16 PuzzleBoard from 16
+// seeded random poses, boards often cut by the border, one occluder per view.
+// Not one of the standard scenes: some of its views are meant to fail (a
+// board nearly edge-on, one mostly hidden).
+SceneSpec SampleScene(int width = 800, int height = 600);
 
 // Names of the standard scenes ("wide_pinhole", "strong_fisheye",
 // "tilt_series", "small_tiles", "fisheye_checkerboard", "dark_fisheye").

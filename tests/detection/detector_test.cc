@@ -527,28 +527,9 @@ TEST(DetectorTest, NoDriftUnderHeavyBlurAndNoise) {
 // like the bundled sample set (wide pinhole, 23x16 PuzzleBoard, blur 0.8 px,
 // noise 2 %, occluders).
 std::vector<double> DemoLikeErrors(int views, int* expected) {
-  SceneSpec scene;
+  SceneSpec scene = SampleScene(800, 600);
   scene.name = "demo_like";
-  scene.camera = WidePinholeCamera(800, 600, 90.0, -0.2);
-  scene.board = MakeBoard(BoardType::kPuzzleBoard, 23, 16);
-  scene.board.tile_size_m = 0.03;
-  scene.render.blur_sigma_px = 0.8;
-  scene.render.noise_sigma = 0.02;
-  scene.render.lighting_gradient = 0.2;
-  scene.render.vignetting = 0.2;
-  RandomViews& rv = scene.random_views;
-  rv.count = views;
-  rv.seed = 5;
-  rv.min_distance_m = 0.35;
-  rv.max_distance_m = 0.8;
-  rv.min_view_angle_deg = 35;
-  rv.max_view_angle_deg = 85;
-  rv.max_roll_deg = 45;
-  rv.max_off_axis_deg = 35;
-  rv.target_margin_tiles = 3;
-  rv.occluders_per_view = 1;
-  rv.min_occluder_radius_px = 20;
-  rv.max_occluder_radius_px = 45;
+  scene.random_views.count = views;
   std::string why;
   const std::vector<SceneView> rendered = RenderScene(scene, &why);
   EXPECT_EQ(static_cast<int>(rendered.size()), views) << why;
