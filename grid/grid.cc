@@ -120,6 +120,9 @@ bool GridOptions::Check(std::string* why) const {
     return Fail(why, "max_join_direction_deviation_deg must be in (0, 90)");
   if (max_component_joins < 0 || max_component_joins > 1000)
     return Fail(why, "max_component_joins must be in [0, 1000]");
+  if (!(attach_saddle_sample_fraction > 0 &&
+        attach_saddle_sample_fraction <= 0.5))
+    return Fail(why, "attach_saddle_sample_fraction must be in (0, 0.5]");
   if (min_component_size < 1)
     return Fail(why, "min_component_size must be >= 1");
   return true;

@@ -142,6 +142,12 @@ struct GridOptions {
   int attach_rounds = 8;
   double attach_tolerance = 0.45;
   int attach_min_support = 2;
+  // The tiles of an attached corner are sampled at saddle_sample_fraction or
+  // (when they do not alternate there) at this fraction of the lattice
+  // diagonals: tiles of 80-170 px next to a fisheye lens whose steps beyond
+  // the board's last corners (taken from the other side) overshoot the
+  // shrinking border tiles into the dark rim of the image circle.
+  double attach_saddle_sample_fraction = 0.15;
   // Then (same pass) a component joins another when the other's lattice
   // predicts one of its corners at a free label next to it as above, the
   // image directions of both lattices at that corner agree within this

@@ -460,7 +460,9 @@ bool AttachOutsideCorners(const std::vector<Eigen::Vector2d>& xy,
       for (int d = 0; d < 4; ++d)
         (*links)[p.u][d] = lookup.Find(p.c, p.tree, p.at + LatticeStep(d));
       if (!LooksLikeSaddle(xy, image, *links, p.u,
-                           options.saddle_sample_fraction)) {
+                           options.saddle_sample_fraction) &&
+          !LooksLikeSaddle(xy, image, *links, p.u,
+                           options.attach_saddle_sample_fraction)) {
         for (int d = 0; d < 4; ++d) (*links)[p.u][d] = -1;
         component_of[p.u] = previous;
         labels[p.u] = forest.label[p.u];
