@@ -152,9 +152,10 @@ struct GridOptions {
   // predicts one of its corners at a free label next to it as above, the
   // image directions of both lattices at that corner agree within this
   // angle (degrees) on both axes under exactly one lattice symmetry, no two
-  // corners meet on one label and every corner along the seam is predicted
-  // where it is (board halves split by refused merges near a fisheye lens;
-  // occluded boards). At most this many joins (0: none).
+  // corners meet on one label and the predictions at each corner along the
+  // seam hold more often than they fail (board halves split by refused
+  // merges near a fisheye lens; occluded boards). At most this many joins
+  // (0: none).
   double max_join_direction_deviation_deg = 30.0;
   int max_component_joins = 16;
   // Components with fewer corners are dropped (not returned).

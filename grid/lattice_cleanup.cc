@@ -209,9 +209,10 @@ double PredictAt(const std::vector<Eigen::Vector2d>& xy,
 // One component joins another at the first place (in order of prediction
 // error) where the other's lattice predicts one of its corners (see
 // PredictAt), when the lattice directions of both at that corner agree on
-// both axes under one symmetry, no two corners meet on one label and the
-// predictions at every label along the seam hold. The smaller component
-// joins the larger. False when none joins.
+// both axes under one symmetry (directions taken at the place, else from a
+// neighbour across), no two corners meet on one label and at every label
+// along the seam no prediction fails or more hold than fail. The smaller
+// component joins the larger. False when none joins.
 bool JoinComponents(const std::vector<Eigen::Vector2d>& xy,
                     const LatticeForest& forest,
                     const std::vector<GridEdge>& edges,
@@ -269,25 +270,47 @@ bool JoinComponents(const std::vector<Eigen::Vector2d>& xy,
     const int u = place.u, c = place.c, tree = place.tree;
     const int c2 = component_of[u];
     // Image vectors of the lattice steps at the place: in the joining
-    // component's directions (r) and in the moving one's (w).
+    // component's directions (r) and in the moving one's (w); from the
+    // place's own neighbours, else from a neighbour across.
+    auto joining_step = [&](const Eigen::Vector2i& at, const Eigen::Vector2d& p,
+                            int k, Eigen::Vector2d* v) {
+      const int a = lookup->Find(c, tree, at + LatticeStep(k));
+      if (a >= 0) {
+        *v = xy[a] - p;
+        return true;
+      }
+      const int b = lookup->Find(c, tree, at - LatticeStep(k));
+      if (b >= 0) {
+        *v = p - xy[b];
+        return true;
+      }
+      return false;
+    };
+    auto moving_step = [&](int base, int k, Eigen::Vector2d* v) {
+      if (base < 0) return false;
+      const int a = (*links)[base][k], b = (*links)[base][Mod4(k + 2)];
+      if (a >= 0) {
+        *v = xy[a] - xy[base];
+        return true;
+      }
+      if (b >= 0) {
+        *v = xy[base] - xy[b];
+        return true;
+      }
+      return false;
+    };
     Eigen::Vector2d r[4], w[4];
     bool has_r[4], has_w[4];
     for (int k = 0; k < 4; ++k) {
-      const int a = lookup->Find(c, tree, place.at + LatticeStep(k));
-      const int b = lookup->Find(c, tree, place.at - LatticeStep(k));
-      has_r[k] = a >= 0 || b >= 0;
-      if (a >= 0) {
-        r[k] = xy[a] - xy[u];
-      } else if (b >= 0) {
-        r[k] = xy[u] - xy[b];
+      has_r[k] = joining_step(place.at, xy[u], k, &r[k]);
+      for (int j : {k + 1, k + 3}) {
+        if (has_r[k]) break;
+        const int a = lookup->Find(c, tree, place.at + LatticeStep(j));
+        has_r[k] = a >= 0 && joining_step(labels[a], xy[a], k, &r[k]);
       }
-      const int v = (*links)[u][k], v2 = (*links)[u][Mod4(k + 2)];
-      has_w[k] = v >= 0 || v2 >= 0;
-      if (v >= 0) {
-        w[k] = xy[v] - xy[u];
-      } else if (v2 >= 0) {
-        w[k] = xy[u] - xy[v2];
-      }
+      has_w[k] = moving_step(u, k, &w[k]) ||
+                 moving_step((*links)[u][Mod4(k + 1)], k, &w[k]) ||
+                 moving_step((*links)[u][Mod4(k + 3)], k, &w[k]);
     }
     int found = 0;
     Dihedral symmetry;
@@ -336,7 +359,7 @@ bool JoinComponents(const std::vector<Eigen::Vector2d>& xy,
       int supported, contradicted;
       PredictAt(xy, *lookup, c, tree, target[q], xy[members[q]],
                 options.attach_tolerance, &supported, &contradicted);
-      ok = contradicted == 0;
+      ok = contradicted == 0 || supported > contradicted;
     }
     if (!ok) continue;
     for (size_t q = 0; q < members.size(); ++q) {
