@@ -440,6 +440,7 @@ bool SetGridOption(const std::string& arg, GridOptions* o) {
       {"side_min_contrast", &o->side_min_contrast},
       {"line_prediction_tolerance", &o->line_prediction_tolerance},
       {"attach_tolerance", &o->attach_tolerance},
+      {"attach_contradiction_tolerance", &o->attach_contradiction_tolerance},
       {"attach_saddle_sample_fraction", &o->attach_saddle_sample_fraction},
       {"max_join_direction_deviation_deg",
        &o->max_join_direction_deviation_deg}};

@@ -113,6 +113,11 @@ bool GridOptions::Check(std::string* why) const {
     return Fail(why, "attach_rounds must be in [0, 100]");
   if (!(attach_tolerance > 0 && attach_tolerance < 1))
     return Fail(why, "attach_tolerance must be in (0, 1)");
+  if (!(attach_contradiction_tolerance >= attach_tolerance &&
+        attach_contradiction_tolerance < 1))
+    return Fail(why,
+                "attach_contradiction_tolerance must be in [attach_tolerance, "
+                "1)");
   if (attach_min_support < 1 || attach_min_support > 8)
     return Fail(why, "attach_min_support must be in [1, 8]");
   if (!(max_join_direction_deviation_deg > 0 &&

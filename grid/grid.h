@@ -141,6 +141,11 @@ struct GridOptions {
   // (0 turns the pass off).
   int attach_rounds = 8;
   double attach_tolerance = 0.45;
+  // A prediction contradicts only when it misses by more than this fraction
+  // of the spacing (between the two it counts neither way: true corners
+  // next to a fisheye lens miss by up to 0.55, a neighbouring lattice
+  // position by 1 and more).
+  double attach_contradiction_tolerance = 0.65;
   int attach_min_support = 2;
   // The tiles of an attached corner are sampled at saddle_sample_fraction or
   // (when they do not alternate there) at this fraction of the lattice

@@ -163,23 +163,24 @@ class ComponentLookup {
 // How well the lattice of component c (tree `tree`) around the free label L
 // predicts a corner at p: quadratic extrapolation along each of the 4 lines
 // through L with three corners, and the parallelogram of each tile at L
-// with its three other corners; an error below `tolerance` of the local
-// spacing supports, above contradicts. Returns the largest relative error
-// of the supporting verdicts.
+// with its three other corners; an error up to `support` of the local
+// spacing supports, above `contradict` contradicts (in between: neither).
+// Returns the largest relative error of the supporting verdicts.
 double PredictAt(const std::vector<Eigen::Vector2d>& xy,
                  const ComponentLookup& lookup, int c, int tree,
                  const Eigen::Vector2i& L, const Eigen::Vector2d& p,
-                 double tolerance, int* supported, int* contradicted) {
+                 double support, double contradict, int* supported,
+                 int* contradicted) {
   *supported = 0;
   *contradicted = 0;
   double worst = 0;
   auto verdict = [&](const Eigen::Vector2d& predicted, double spacing) {
     if (!(spacing > 0)) return;
     const double error = (p - predicted).norm() / spacing;
-    if (error <= tolerance) {
+    if (error <= support) {
       ++*supported;
       worst = std::max(worst, error);
-    } else {
+    } else if (error > contradict) {
       ++*contradicted;
     }
   };
@@ -247,9 +248,9 @@ bool JoinComponents(const std::vector<Eigen::Vector2d>& xy,
         const Eigen::Vector2i at = labels[m] + LatticeStep(d);
         if (lookup->Find(cm, tree, at) >= 0) continue;
         int supported, contradicted;
-        const double error =
-            PredictAt(xy, *lookup, cm, tree, at, xy[u],
-                      options.attach_tolerance, &supported, &contradicted);
+        const double error = PredictAt(
+            xy, *lookup, cm, tree, at, xy[u], options.attach_tolerance,
+            options.attach_contradiction_tolerance, &supported, &contradicted);
         if (supported >= options.attach_min_support && contradicted == 0)
           places.push_back({error, u, cm, tree, at});
       }
@@ -358,7 +359,9 @@ bool JoinComponents(const std::vector<Eigen::Vector2d>& xy,
       if (!seam) continue;
       int supported, contradicted;
       PredictAt(xy, *lookup, c, tree, target[q], xy[members[q]],
-                options.attach_tolerance, &supported, &contradicted);
+                options.attach_tolerance,
+                options.attach_contradiction_tolerance, &supported,
+                &contradicted);
       ok = contradicted == 0 || supported > contradicted;
     }
     if (!ok) continue;
@@ -418,9 +421,9 @@ bool AttachOutsideCorners(const std::vector<Eigen::Vector2d>& xy,
         const Eigen::Vector2i at = labels[m] + LatticeStep(d);
         if (lookup.Find(c, tree, at) >= 0) continue;
         int supported, contradicted;
-        const double error =
-            PredictAt(xy, lookup, c, tree, at, xy[u], options.attach_tolerance,
-                      &supported, &contradicted);
+        const double error = PredictAt(
+            xy, lookup, c, tree, at, xy[u], options.attach_tolerance,
+            options.attach_contradiction_tolerance, &supported, &contradicted);
         if (supported >= options.attach_min_support && contradicted == 0)
           proposals.push_back({error, u, c, tree, at});
       }
