@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <unordered_map>
 #include <utility>
 
 #include "grid/dihedral.h"
@@ -135,7 +136,8 @@ void Unlink(Links* links, int i) {
 }
 
 // Lattice position lookup of one component during the attach pass: the
-// forest's table for its own corners, a short list for attached ones.
+// forest's table for corners still at their tree's labels, a hash map for
+// attached and moved ones.
 class ComponentLookup {
  public:
   ComponentLookup(const LatticeForest& forest,
@@ -146,18 +148,30 @@ class ComponentLookup {
   // The corner of component `c` (tree `tree`) at `label`, or -1.
   int Find(int c, int tree, const Eigen::Vector2i& label) const {
     const int m = forest_.table.Find(tree, label);
-    if (m >= 0 && component_of_[m] == c) return m;
-    for (int a : attached_)
-      if (component_of_[a] == c && label_[a] == label) return a;
-    return -1;
+    if (m >= 0 && component_of_[m] == c && label_[m] == label) return m;
+    if (moved_.empty()) return -1;
+    const auto it = moved_.find(Key(c, label));
+    if (it == moved_.end()) return -1;
+    const int a = it->second;
+    return component_of_[a] == c && label_[a] == label ? a : -1;
   }
-  void Attach(int corner) { attached_.push_back(corner); }
+  // `corner` is now in component_of[corner] at label[corner].
+  void Attach(int corner) {
+    moved_[Key(component_of_[corner], label_[corner])] = corner;
+  }
 
  private:
+  static uint64_t Key(int c, const Eigen::Vector2i& label) {
+    constexpr int64_t kOffset = int64_t{1} << 21;
+    return (static_cast<uint64_t>(c) << 44) |
+           (static_cast<uint64_t>(label.x() + kOffset) << 22) |
+           static_cast<uint64_t>(label.y() + kOffset);
+  }
+
   const LatticeForest& forest_;
   const std::vector<int>& component_of_;
   const std::vector<Eigen::Vector2i>& label_;
-  std::vector<int> attached_;
+  std::unordered_map<uint64_t, int> moved_;
 };
 
 // How well the lattice of component c (tree `tree`) around the free label L
