@@ -12,7 +12,9 @@
 //   edge and verified (no two corners on one label, no contradicting
 //   neighbours, collinear lines);
 // - a final pass removes corners that their lattice lines do not predict and
-//   splits components that fall apart.
+//   splits components that fall apart; then, with an image, corners left out
+//   join a component, and components join one another, where the lattice
+//   around a free label predicts them.
 
 #include <opencv2/core.hpp>
 #include <string>
