@@ -44,6 +44,7 @@
 #include "calib/calibrate.h"
 #include "calib/initialization.h"
 #include "tests/grid/grid_test_util.h"
+#include "tests/support/deltille_data.h"
 
 namespace puzzlecal {
 namespace {
@@ -500,17 +501,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "grid options: %s\n", why.c_str());
     return 2;
   }
-  if (data_dir.empty()) {
-    const char* data = std::getenv("PUZZLECAL_DATA");
-    data_dir = data != nullptr ? data : "../shared";
-  }
-  const std::string dir = data_dir + "/deltille/fisheye";
-  std::vector<std::string> files;
-  for (int f = 0; f < 256; ++f) {
-    char name[32];
-    std::snprintf(name, sizeof name, "/%04d.png", f);
-    if (std::ifstream(dir + name).good()) files.push_back(dir + name);
-  }
+  const std::string dir = data_dir.empty()
+                              ? testing_data::DeltilleFolder()
+                              : data_dir + "/deltille/fisheye";
+  const std::vector<std::string> files = testing_data::DeltillePhotoFiles(dir);
   if (files.empty()) {
     std::printf("{\"error\": \"no photos in %s\"}\n", dir.c_str());
     return 1;

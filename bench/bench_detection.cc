@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -21,6 +22,7 @@
 #include "detection/detector.h"
 #include "grid/grid.h"
 #include "sim/render.h"
+#include "tests/support/deltille_data.h"
 
 namespace puzzlecal {
 namespace {
@@ -88,10 +90,11 @@ void DeltillePhotos(const std::string& dir) {
   std::printf("  \"deltille_fisheye\": [\n");
   int photos = 0, complete = 0, total_on = 0, total_off = 0;
   bool first = true;
-  for (int i = 0; i < 256; i += 4) {
-    char name[32];
-    std::snprintf(name, sizeof name, "%04d.png", i);
-    const cv::Mat image = cv::imread(dir + "/" + name, cv::IMREAD_GRAYSCALE);
+  for (const std::string& file : testing_data::DeltillePhotoFiles(dir)) {
+    const std::string file_name =
+        std::filesystem::path(file).filename().string();
+    const char* name = file_name.c_str();
+    const cv::Mat image = cv::imread(file, cv::IMREAD_GRAYSCALE);
     if (image.empty()) continue;
     DetectorSummary summary;
     const std::vector<Corner> corners = DetectCorners(image, {}, &summary);
@@ -153,14 +156,10 @@ int main(int argc, char** argv) {
   const cv::Mat small = RenderView(1600, 1200, 30.0);
   const cv::Mat large = RenderView(4032, 3024, 40.0);
   std::string photo_path;
-  const char* data = std::getenv("PUZZLECAL_DATA");
-  for (const char* dir : {data != nullptr ? data : "", "../shared"}) {
-    if (*dir == '\0') continue;
-    const std::string path = std::string(dir) + "/deltille/fisheye/0036.png";
-    if (!cv::imread(path, cv::IMREAD_GRAYSCALE).empty()) {
-      photo_path = path;
-      break;
-    }
+  const std::string folder = testing_data::DeltilleFolder();
+  if (!folder.empty() &&
+      !cv::imread(folder + "/0036.png", cv::IMREAD_GRAYSCALE).empty()) {
+    photo_path = folder + "/0036.png";
   }
   std::printf("{\n  \"threads\": 1,\n");
   if (!photo_path.empty()) {

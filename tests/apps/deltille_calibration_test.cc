@@ -16,21 +16,12 @@
 #include "apps/pipeline.h"
 #include "calib/calibrate.h"
 #include "calib/camera_yaml.h"
+#include "tests/support/deltille_data.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string DeltilleFolder() {
-  if (const char* data = std::getenv("PUZZLECAL_DATA")) {
-    const fs::path path = fs::path(data) / "deltille" / "fisheye";
-    if (fs::is_directory(path)) return path.string();
-  }
-  const fs::path shared = fs::path("..") / "shared" / "deltille" / "fisheye";
-  if (fs::is_directory(shared)) return shared.string();
-  return "";
-}
 
 struct DeltilleRun {
   bool ok = false;
@@ -62,11 +53,10 @@ DeltilleRun CalibrateFiles(const std::vector<std::string>& files) {
 class DeltilleCalibrationTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    folder_ = DeltilleFolder();
+    folder_ = testing_data::DeltilleFolder();
     if (folder_.empty()) {
-      GTEST_SKIP() << "deltille fisheye photos not found: download "
-                      "github.com/deltille/dataset and set PUZZLECAL_DATA to "
-                      "a folder holding deltille/fisheye/*.png";
+      GTEST_SKIP() << "deltille fisheye photos not found: "
+                   << testing_data::DeltilleHowToGet();
     }
     ImageListing listing;
     std::string error;

@@ -23,15 +23,10 @@
 
 #include "detection/detector.h"
 #include "grid/grid.h"
+#include "tests/support/deltille_data.h"
 
 namespace puzzlecal {
 namespace {
-
-std::string DeltilleDir() {
-  const char* data = std::getenv("PUZZLECAL_DATA");
-  if (data) return std::string(data) + "/deltille/fisheye";
-  return "../shared/deltille/fisheye";
-}
 
 struct ComponentVerdict {
   bool fits_box = true;
@@ -95,18 +90,10 @@ ComponentVerdict JudgeComponent(const GridComponent& component,
 }
 
 TEST(DeltilleTest, FisheyePhotosHaveConsistentComponents) {
-  const std::string dir = DeltilleDir();
-  std::vector<std::string> files;
-  for (int f = 0; f < 256; ++f) {
-    char name[32];
-    std::snprintf(name, sizeof name, "/%04d.png", f);
-    if (std::ifstream(dir + name).good()) files.push_back(dir + name);
-  }
+  const std::vector<std::string> files =
+      testing_data::DeltillePhotoFiles(testing_data::DeltilleFolder());
   if (files.empty()) {
-    GTEST_SKIP() << "no deltille photos in " << dir
-                 << " (set PUZZLECAL_DATA to the folder holding "
-                    "deltille/fisheye; the dataset is at "
-                    "github.com/deltille/dataset)";
+    GTEST_SKIP() << "no deltille photos: " << testing_data::DeltilleHowToGet();
   }
   int photos = 0, wrong_components = 0, all_88 = 0, photos_with_88 = 0;
   std::printf("photo  corners  components  largest  span    verdict\n");

@@ -90,13 +90,8 @@ RenderOutcome DetectAndLabel(const Board& board, const Camera& camera,
 }
 
 Board PuzzleBoard11x8() {
-  Board board;
-  board.type = BoardType::kPuzzleBoard;
-  board.cols = 11;
-  board.rows = 8;
-  board.origin = Eigen::Vector2i(120, 40);
-  board.tile_size_m = 0.02;
-  return board;
+  return MakeBoard(BoardType::kPuzzleBoard, 11, 8, Eigen::Vector2i(120, 40),
+                   0.02);
 }
 
 grid_test::SyntheticBoard Geometry(const Board& board) {
@@ -168,6 +163,20 @@ TEST(GridRenderTest, StrongFisheye) {
   }
 }
 
+// The deltille-like set-up of the steep fisheye tests: the 11x8 plain
+// checkerboard, a 1280x960 strong fisheye, noise and strong vignetting.
+struct SteepFisheyeSetup {
+  Board board =
+      MakeBoard(BoardType::kCheckerboard, 11, 8, Eigen::Vector2i::Zero(), 0.02);
+  Camera camera = grid_test::FisheyeCamera(1280, 960);
+  RenderOptions options = [] {
+    RenderOptions o;
+    o.noise_sigma = 0.02;
+    o.vignetting = 0.6;
+    return o;
+  }();
+};
+
 // A plain checkerboard close to a strong fisheye, seen steeply towards the
 // image rim, darkened by vignetting (like the deltille photos): tiles shrink
 // by 3x and more along a line and squeeze to aspect 4-5 at the rim. The
@@ -176,13 +185,10 @@ TEST(GridRenderTest, StrongFisheye) {
 // 71/77; 45 deg 87/87, 50/73; 35 deg 85/86, 63/67); the views nearer the
 // centre must give all of them.
 TEST(GridRenderTest, SteepFisheyeCheckerboardIsOneComponent) {
-  Board board = PuzzleBoard11x8();
-  board.type = BoardType::kCheckerboard;
-  board.origin = Eigen::Vector2i(0, 0);
-  const Camera camera = grid_test::FisheyeCamera(1280, 960);
-  RenderOptions options;
-  options.noise_sigma = 0.02;
-  options.vignetting = 0.6;
+  const SteepFisheyeSetup setup;
+  const Board& board = setup.board;
+  const Camera& camera = setup.camera;
+  const RenderOptions& options = setup.options;
   struct View {
     int angle;
     Eigen::Vector3d offset;
@@ -221,13 +227,10 @@ TEST(GridRenderTest, SteepFisheyeCheckerboardIsOneComponent) {
 // corners 27 -> 88, 36 -> 87, 28 -> 86 at 60, 45, 35 degrees; from 20
 // corners 27 -> 84, 36 -> 74, 28 -> 30).
 TEST(GridRenderTest, AttachPassJoinsLeftOutCornersAndComponents) {
-  Board board = PuzzleBoard11x8();
-  board.type = BoardType::kCheckerboard;
-  board.origin = Eigen::Vector2i(0, 0);
-  const Camera camera = grid_test::FisheyeCamera(1280, 960);
-  RenderOptions options;
-  options.noise_sigma = 0.02;
-  options.vignetting = 0.6;
+  const SteepFisheyeSetup setup;
+  const Board& board = setup.board;
+  const Camera& camera = setup.camera;
+  const RenderOptions& options = setup.options;
   GridOptions strict;
   strict.neighbor_weight_ratio = 1.2;
   strict.tree_mean_weight_ratio_min = 1 / 1.2;
