@@ -21,7 +21,7 @@
 #include "apps/image_io.h"
 #include "apps/pipeline.h"
 #include "apps/subcommand.h"
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {

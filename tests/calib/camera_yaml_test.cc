@@ -9,7 +9,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {
@@ -291,24 +291,6 @@ TEST_F(CameraYamlTest, FormatNames) {
   }
   CameraFileFormat parsed;
   EXPECT_FALSE(CameraFileFormatFromName("json", &parsed));
-}
-
-TEST_F(CameraYamlTest, AtomicWriteReplacesAndReportsFailures) {
-  const std::string path = Path("atomic.txt");
-  std::string error;
-  ASSERT_TRUE(WriteFileAtomically(path, "first", &error)) << error;
-  ASSERT_TRUE(WriteFileAtomically(path, "second", &error)) << error;
-  std::ifstream in(path);
-  std::string contents((std::istreambuf_iterator<char>(in)),
-                       std::istreambuf_iterator<char>());
-  EXPECT_EQ(contents, "second");
-  const std::string bad = dir_ + "/no_such_folder/file.txt";
-  EXPECT_FALSE(WriteFileAtomically(bad, "x", &error));
-  EXPECT_NE(error.find(bad), std::string::npos) << error;
-  EXPECT_NE(error.find("No such file"), std::string::npos) << error;
-  EXPECT_FALSE(WriteFileAtomically(dir_, "x", &error));
-  EXPECT_NE(error.find("folder"), std::string::npos) << error;
-  EXPECT_FALSE(WriteFileAtomically("", "x", &error));
 }
 
 }  // namespace
