@@ -16,6 +16,9 @@ namespace {
 // per corner and reused by every solve.
 class GradientPatch {
  public:
+  explicit GradientPatch(GradientRefineScratch* scratch)
+      : gxx_(scratch->gxx), gxy_(scratch->gxy), gyy_(scratch->gyy) {}
+
   // Fills the patch of radius `radius` around (cx, cy); false when it does
   // not fit into the image (with one pixel for the differences).
   bool Fill(const cv::Mat& image, int cx, int cy, int radius) {
@@ -120,17 +123,17 @@ class GradientPatch {
  private:
   static constexpr int kLanes = 8;
   int x0_ = 0, y0_ = 0, size_ = 0, stride_ = 0;
-  // Gradient products per pixel, rows of `stride_` floats; reused between
-  // corners.
-  std::vector<float> gxx_, gxy_, gyy_;
+  // Gradient products per pixel, rows of `stride_` floats (the caller's
+  // scratch).
+  std::vector<float>& gxx_;
+  std::vector<float>& gxy_;
+  std::vector<float>& gyy_;
 };
 }  // namespace
 
-GradientRefineResult RefineByGradientOrthogonality(const cv::Mat& image,
-                                                   const Eigen::Vector2d& start,
-                                                   int half_window,
-                                                   int max_iterations,
-                                                   double convergence_px) {
+GradientRefineResult RefineByGradientOrthogonality(
+    const cv::Mat& image, const Eigen::Vector2d& start, int half_window,
+    int max_iterations, double convergence_px, GradientRefineScratch* scratch) {
   GradientRefineResult result;
   result.xy = start;
   if (!std::isfinite(start.x()) || !std::isfinite(start.y()) ||
@@ -139,7 +142,8 @@ GradientRefineResult RefineByGradientOrthogonality(const cv::Mat& image,
     return result;
   }
   // Room for the window plus a few pixels of movement.
-  static thread_local GradientPatch patch;
+  GradientRefineScratch local_scratch;
+  GradientPatch patch(scratch != nullptr ? scratch : &local_scratch);
   const double h = half_window;
   if (!patch.Fill(image, static_cast<int>(std::lround(start.x())),
                   static_cast<int>(std::lround(start.y())), half_window + 3)) {
