@@ -10,6 +10,7 @@
 #include "detection/corner_filters.h"
 #include "detection/hessian_response.h"
 #include "detection/subpixel.h"
+#include "detection/vector_clones.h"
 
 namespace puzzlecal {
 
@@ -155,8 +156,10 @@ double MaxValue(const cv::Mat& image) {
 // [i0, i1) of `dst` (already of the output size) from `src`, which holds
 // input rows [src_first, src_first + src.rows) of an image `height` rows
 // high; the input rows 2 i - 1 .. 2 i + 1 (clamped) must be in `src`.
-void DownsampleRows(const cv::Mat& src, int src_first, int height, int i0,
-                    int i1, std::vector<float>* row, cv::Mat* dst) {
+PUZZLECAL_VECTOR_CLONES void DownsampleRows(const cv::Mat& src, int src_first,
+                                            int height, int i0, int i1,
+                                            std::vector<float>* row,
+                                            cv::Mat* dst) {
   const int width = src.cols;
   const int out_width = dst->cols;
   row->resize(width);
@@ -173,7 +176,13 @@ void DownsampleRows(const cv::Mat& src, int src_first, int height, int i0,
     }
     float* __restrict out = dst->ptr<float>(i);
     out[0] = 0.25f * (3.0f * tmp[0] + (width > 1 ? tmp[1] : tmp[0]));
-    for (int j = 1; j < out_width; ++j) {
+    // Interior outputs (2 j + 1 inside the row) without clamping, so the
+    // loop vectorises; the last one or two clamp at the border.
+    const int interior_end = std::min(out_width, std::max(1, width / 2));
+    for (int j = 1; j < interior_end; ++j) {
+      out[j] = 0.25f * (tmp[2 * j - 1] + 2.0f * tmp[2 * j] + tmp[2 * j + 1]);
+    }
+    for (int j = interior_end; j < out_width; ++j) {
       const int x = 2 * j;
       out[j] = 0.25f * (tmp[x - 1] + 2.0f * tmp[std::min(x, width - 1)] +
                         tmp[std::min(x + 1, width - 1)]);

@@ -4,15 +4,7 @@
 #include <cstdint>
 #include <cstring>
 
-// The per-pixel loops gain from 256-bit vectors; with GCC on x86-64 they
-// are compiled twice and the AVX2 version is picked at load time when the
-// processor has it (the default build targets baseline x86-64).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PUZZLECAL_VECTOR_CLONES \
-  __attribute__((target_clones("avx2", "default")))
-#else
-#define PUZZLECAL_VECTOR_CLONES
-#endif
+#include "detection/vector_clones.h"
 
 namespace puzzlecal {
 
