@@ -14,94 +14,116 @@
 
 namespace puzzlecal {
 
+namespace {
+
+// The first preprocessing, pyramid, response and suppression field out of
+// range, or nullptr.
+const char* PyramidResponseError(const DetectorOptions& o) {
+  if (!(o.blur_sigma_px >= 0.0 && o.blur_sigma_px <= 20.0)) {
+    return "blur_sigma_px must be in [0, 20]";
+  }
+  if (o.num_levels < 1 || o.num_levels > 6) return "num_levels must be 1..6";
+  if (o.first_level < 0 || o.first_level >= o.num_levels) {
+    return "first_level must be in [0, num_levels)";
+  }
+  if (!(o.trace_weight_k >= 0.0 && std::isfinite(o.trace_weight_k))) {
+    return "trace_weight_k must be >= 0";
+  }
+  if (!(o.min_response > 0.0 && std::isfinite(o.min_response))) {
+    return "min_response must be > 0";
+  }
+  if (!(o.noise_response_factor >= 0.0 &&
+        std::isfinite(o.noise_response_factor))) {
+    return "noise_response_factor must be >= 0";
+  }
+  if (o.nms_radius_px < 1 || o.nms_radius_px > 50) {
+    return "nms_radius_px must be in [1, 50]";
+  }
+  if (o.nms_radius_coarse_px < 1 || o.nms_radius_coarse_px > 50) {
+    return "nms_radius_coarse_px must be in [1, 50]";
+  }
+  return nullptr;
+}
+
+// The first candidate filters field out of range, or nullptr.
+const char* FilterError(const DetectorOptions& o) {
+  if (!(o.ring_radius_px >= 1.5 && o.ring_radius_px <= 20.0)) {
+    return "ring_radius_px must be in [1.5, 20]";
+  }
+  if (o.ring_samples < 8 || o.ring_samples > 64 || o.ring_samples % 4 != 0) {
+    return "ring_samples must be a multiple of 4 in [8, 64]";
+  }
+  if (!(o.min_ring_contrast >= 0.0)) return "min_ring_contrast must be >= 0";
+  if (!(o.max_ring_asymmetry > 0.0)) return "max_ring_asymmetry must be > 0";
+  if (!(o.min_contrast_factor_clean >= 1.0)) {
+    return "min_contrast_factor_clean must be >= 1";
+  }
+  if (!(o.max_ring_asymmetry_clean > 0.0)) {
+    return "max_ring_asymmetry_clean must be > 0";
+  }
+  if (!(o.min_ring_second_harmonic_clean >= 0.0 &&
+        o.min_ring_second_harmonic_clean <= 1.0)) {
+    return "min_ring_second_harmonic_clean must be in [0, 1]";
+  }
+  if (!(o.min_ring_second_harmonic >= 0.0 &&
+        o.min_ring_second_harmonic <= 1.0)) {
+    return "min_ring_second_harmonic must be in [0, 1]";
+  }
+  if (!(o.ring_noise_factor >= 0.0 && std::isfinite(o.ring_noise_factor))) {
+    return "ring_noise_factor must be >= 0";
+  }
+  if (!(o.max_ring_centre_offset > 0.0)) {
+    return "max_ring_centre_offset must be > 0";
+  }
+  return nullptr;
+}
+
+// The first sub-pixel refinement and orientation field out of range, or
+// nullptr.
+const char* RefinementError(const DetectorOptions& o) {
+  if (!(o.window_fraction_of_neighbor > 0.0 &&
+        o.window_fraction_of_neighbor <= 1.0)) {
+    return "window_fraction_of_neighbor must be in (0, 1]";
+  }
+  if (o.min_window_px < 2 || o.max_window_px > 64 ||
+      o.min_window_px > o.max_window_px) {
+    return "need 2 <= min_window_px <= max_window_px <= 64";
+  }
+  if (!(o.saddle_sigma_fraction > 0.0 && o.saddle_sigma_fraction <= 1.0)) {
+    return "saddle_sigma_fraction must be in (0, 1]";
+  }
+  if (!(o.min_saddle_sigma_px >= 0.5 &&
+        o.min_saddle_sigma_px <= o.max_saddle_sigma_px &&
+        o.max_saddle_sigma_px <= 16.0)) {
+    return "need 0.5 <= min_saddle_sigma_px <= max_saddle_sigma_px <= 16";
+  }
+  if (o.saddle_max_iterations < 1 || o.saddle_max_iterations > 100) {
+    return "saddle_max_iterations must be in [1, 100]";
+  }
+  if (!(o.saddle_convergence_px > 0.0)) {
+    return "saddle_convergence_px must be > 0";
+  }
+  if (o.max_iterations < 1 || o.max_iterations > 100) {
+    return "max_iterations must be in [1, 100]";
+  }
+  if (!(o.convergence_px > 0.0)) return "convergence_px must be > 0";
+  if (!(o.max_shift_fraction > 0.0)) return "max_shift_fraction must be > 0";
+  if (!(o.merge_distance_px >= 0.0)) return "merge_distance_px must be >= 0";
+  if (!(o.orientation_spacing_fraction > 0.0)) {
+    return "orientation_spacing_fraction must be > 0";
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 bool DetectorOptions::Check(std::string* why) const {
-  auto fail = [why](const char* text) {
-    if (why != nullptr) *why = text;
-    return false;
-  };
-  if (!(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0)) {
-    return fail("blur_sigma_px must be in [0, 20]");
-  }
-  if (num_levels < 1 || num_levels > 6) return fail("num_levels must be 1..6");
-  if (first_level < 0 || first_level >= num_levels) {
-    return fail("first_level must be in [0, num_levels)");
-  }
-  if (!(trace_weight_k >= 0.0 && std::isfinite(trace_weight_k))) {
-    return fail("trace_weight_k must be >= 0");
-  }
-  if (!(min_response > 0.0 && std::isfinite(min_response))) {
-    return fail("min_response must be > 0");
-  }
-  if (!(noise_response_factor >= 0.0 && std::isfinite(noise_response_factor))) {
-    return fail("noise_response_factor must be >= 0");
-  }
-  if (nms_radius_px < 1 || nms_radius_px > 50) {
-    return fail("nms_radius_px must be in [1, 50]");
-  }
-  if (nms_radius_coarse_px < 1 || nms_radius_coarse_px > 50) {
-    return fail("nms_radius_coarse_px must be in [1, 50]");
-  }
-  if (!(ring_radius_px >= 1.5 && ring_radius_px <= 20.0)) {
-    return fail("ring_radius_px must be in [1.5, 20]");
-  }
-  if (ring_samples < 8 || ring_samples > 64 || ring_samples % 4 != 0) {
-    return fail("ring_samples must be a multiple of 4 in [8, 64]");
-  }
-  if (!(min_ring_contrast >= 0.0))
-    return fail("min_ring_contrast must be >= 0");
-  if (!(max_ring_asymmetry > 0.0))
-    return fail("max_ring_asymmetry must be > 0");
-  if (!(min_contrast_factor_clean >= 1.0)) {
-    return fail("min_contrast_factor_clean must be >= 1");
-  }
-  if (!(max_ring_asymmetry_clean > 0.0)) {
-    return fail("max_ring_asymmetry_clean must be > 0");
-  }
-  if (!(min_ring_second_harmonic_clean >= 0.0 &&
-        min_ring_second_harmonic_clean <= 1.0)) {
-    return fail("min_ring_second_harmonic_clean must be in [0, 1]");
-  }
-  if (!(min_ring_second_harmonic >= 0.0 && min_ring_second_harmonic <= 1.0)) {
-    return fail("min_ring_second_harmonic must be in [0, 1]");
-  }
-  if (!(ring_noise_factor >= 0.0 && std::isfinite(ring_noise_factor))) {
-    return fail("ring_noise_factor must be >= 0");
-  }
-  if (!(max_ring_centre_offset > 0.0)) {
-    return fail("max_ring_centre_offset must be > 0");
-  }
-  if (!(window_fraction_of_neighbor > 0.0 &&
-        window_fraction_of_neighbor <= 1.0)) {
-    return fail("window_fraction_of_neighbor must be in (0, 1]");
-  }
-  if (min_window_px < 2 || max_window_px > 64 ||
-      min_window_px > max_window_px) {
-    return fail("need 2 <= min_window_px <= max_window_px <= 64");
-  }
-  if (!(saddle_sigma_fraction > 0.0 && saddle_sigma_fraction <= 1.0)) {
-    return fail("saddle_sigma_fraction must be in (0, 1]");
-  }
-  if (!(min_saddle_sigma_px >= 0.5 &&
-        min_saddle_sigma_px <= max_saddle_sigma_px &&
-        max_saddle_sigma_px <= 16.0)) {
-    return fail("need 0.5 <= min_saddle_sigma_px <= max_saddle_sigma_px <= 16");
-  }
-  if (saddle_max_iterations < 1 || saddle_max_iterations > 100) {
-    return fail("saddle_max_iterations must be in [1, 100]");
-  }
-  if (!(saddle_convergence_px > 0.0)) {
-    return fail("saddle_convergence_px must be > 0");
-  }
-  if (max_iterations < 1 || max_iterations > 100) {
-    return fail("max_iterations must be in [1, 100]");
-  }
-  if (!(convergence_px > 0.0)) return fail("convergence_px must be > 0");
-  if (!(max_shift_fraction > 0.0))
-    return fail("max_shift_fraction must be > 0");
-  if (!(merge_distance_px >= 0.0))
-    return fail("merge_distance_px must be >= 0");
-  if (!(orientation_spacing_fraction > 0.0)) {
-    return fail("orientation_spacing_fraction must be > 0");
+  for (const char* error : {PyramidResponseError(*this), FilterError(*this),
+                            RefinementError(*this)}) {
+    if (error != nullptr) {
+      if (why != nullptr) *why = error;
+      return false;
+    }
   }
   return true;
 }
