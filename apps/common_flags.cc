@@ -13,3 +13,7 @@ DEFINE_string(draw, "", "Folder for detection overlays (optional).");
 DEFINE_string(scene, "", "Scene recipe YAML (see configs/scenes/).");
 DEFINE_int32(threads, 0, "Worker threads; 0 = all cores.");
 DEFINE_int32(dpi, 300, "Resolution of PNG board output, dots per inch.");
+DEFINE_string(rostopic, "/cam0/image_raw",
+              "Image topic written into the kalibr camchain (cam0/rostopic).");
+DEFINE_string(camera_name, "camera",
+              "Camera name written into the ros camera_info file.");

@@ -15,5 +15,7 @@ DECLARE_string(draw);
 DECLARE_string(scene);
 DECLARE_int32(threads);
 DECLARE_int32(dpi);
+DECLARE_string(rostopic);
+DECLARE_string(camera_name);
 
 #endif  // PUZZLECAL_APPS_COMMON_FLAGS_H_

@@ -74,6 +74,8 @@ bool ParseSubcommandFlags(const Subcommand& subcommand,
       flag = arg.substr(0, equals);
       value = arg.substr(equals + 1);
     }
+    // --camera-name and --camera_name are the same flag.
+    std::replace(flag.begin(), flag.end(), '-', '_');
     gflags::CommandLineFlagInfo info;
     bool found = gflags::GetCommandLineFlagInfo(flag.c_str(), &info);
     if (!found && !has_value && flag.rfind("no", 0) == 0 &&

@@ -650,6 +650,39 @@ TEST_F(BadInputTest, UnknownModelName) {
   EXPECT_FALSE(fs::exists(camera));
 }
 
+// --format kalibr: pinhole-radtan calibrates Kalibr's 4-coefficient radtan
+// (k3 held at 0) and writes a camchain with the rostopic Kalibr's reader
+// requires; pinhole-rational, which the camchain cannot hold, is refused
+// before any image is read.
+TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  const fs::path camchain = case_dir_ / "camchain.yaml";
+  const RunResult run =
+      Calibrate(folder, camchain, "--format kalibr --rostopic /left/image_raw");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  const YAML::Node cam0 = YAML::LoadFile(camchain.string())["cam0"];
+  EXPECT_EQ(cam0["rostopic"].as<std::string>(), "/left/image_raw");
+  EXPECT_EQ(cam0["distortion_model"].as<std::string>(), "radtan");
+  const auto coeffs = cam0["distortion_coeffs"].as<std::vector<double>>();
+  ASSERT_EQ(coeffs.size(), 4u);
+  // The render's k1 = -0.08, k2 = 0.03: a 4-coefficient fit recovers them.
+  EXPECT_NEAR(coeffs[0], -0.08, 0.02);
+  const auto intrinsics = cam0["intrinsics"].as<std::vector<double>>();
+  EXPECT_NEAR(intrinsics[0], 560.0, 5.0);
+
+  const fs::path rational = case_dir_ / "rational.yaml";
+  const RunResult refused = Run(
+      "calibrate --images " + Quote(folder.string()) + " --board " +
+      Quote(BoardFile().string()) + " --model pinhole-rational --format "
+      "kalibr --out " + Quote(rational.string()));
+  EXPECT_EQ(refused.exit_code, kExitUsage) << refused.all();
+  EXPECT_NE(refused.err.find("kalibr"), std::string::npos) << refused.err;
+  EXPECT_EQ(refused.all().find("view0"), std::string::npos)
+      << "images were read before the refusal:\n" << refused.all();
+  EXPECT_FALSE(fs::exists(rational));
+}
+
 // Command-line mistakes: exit 2 with a message naming the flag or argument,
 // and nothing written.
 TEST_F(BadInputTest, BadFlagsExitTwoAndNameTheFlag) {
