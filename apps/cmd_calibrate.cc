@@ -115,17 +115,26 @@ int RunCalibrate() {
               << "'; choose one of " << CameraModelNames() << ".\n";
     return kExitUsage;
   }
+  std::string error;
   CameraFileFormat format;
   if (!CameraFileFormatFromName(FLAGS_format, &format)) {
     std::cerr << "puzzlecal calibrate: unknown format '" << FLAGS_format
               << "'; choose one of puzzlecal, opencv, ros, kalibr.\n";
     return kExitUsage;
   }
+  // The format decides the model's free parameters (Kalibr's radtan has no
+  // k3), so it is settled before any image is read.
+  CalibrationOptions calibration_options;
+  if (!CameraFormatFixedParams(format, model,
+                               &calibration_options.fixed_params, &error)) {
+    std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
+              << error << ".\n";
+    return kExitUsage;
+  }
   if (FLAGS_threads < 0) {
     std::cerr << "puzzlecal calibrate: --threads must be >= 0.\n";
     return kExitUsage;
   }
-  std::string error;
   Board board;
   if (!LoadBoardFile(FLAGS_board, &board, &error)) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
@@ -182,7 +191,6 @@ int RunCalibrate() {
   }
 
   const auto calib_start = std::chrono::steady_clock::now();
-  CalibrationOptions calibration_options;
   CalibrationResult result;
   std::string calibration_error;
   const bool calibrated =
@@ -223,7 +231,17 @@ int RunCalibrate() {
               << calibration_error << "\n";
     return kExitNoResult;
   }
-  if (!WriteCameraFile(FLAGS_out, format, result, &error)) {
+  CameraFileNames names;
+  names.camera_name = FLAGS_camera_name;
+  names.rostopic = FLAGS_rostopic;
+  std::vector<std::string> view_files(views.size());
+  for (size_t i = 0; i < images.size(); ++i) {
+    if (view_of_image[i] >= 0) view_files[view_of_image[i]] = images[i].file;
+  }
+  const CameraFileStats stats = CameraFileStatsOfResult(
+      result, view_files, board.Point(board.origin));
+  if (!WriteCameraFile(FLAGS_out, format, result.camera, stats, &error,
+                       names)) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitOutputError;
   }
@@ -245,7 +263,8 @@ int RunCalibrate() {
 
 PUZZLECAL_REGISTER_SUBCOMMAND(
     calibrate, "calibrate", "calibrate a camera from a folder of photos",
-    kUsage, {"images", "board", "model", "out", "format", "report", "threads"},
+    kUsage, {"images", "board", "model", "out", "format", "report", "threads",
+     "rostopic", "camera_name"},
     &RunCalibrate);
 
 }  // namespace
