@@ -1,8 +1,12 @@
 #include "apps/common_flags.h"
 
-DEFINE_string(images, "", "Folder of images, or one image file.");
+DEFINE_string(images, "", "Folder of images (png, jpg, tif, bmp), or one image file.");
 DEFINE_string(board, "", "Board definition YAML (see configs/boards/).");
-DEFINE_string(out, "", "Output file or folder.");
+DEFINE_string(out, "",
+              "Output. calibrate: the camera file (.yaml); detect: the "
+              "detections file (.yaml); board: the page (.svg, .pdf or .png); "
+              "render and undistort: a folder (created if missing). Files go "
+              "into an existing, writable folder.");
 DEFINE_string(model, "pinhole-radtan",
               "Camera model: pinhole-radtan, pinhole-rational or "
               "kannala-brandt.");
@@ -17,3 +21,15 @@ DEFINE_string(rostopic, "/cam0/image_raw",
               "Image topic written into the kalibr camchain (cam0/rostopic).");
 DEFINE_string(camera_name, "camera",
               "Camera name written into the ros camera_info file.");
+DEFINE_bool(quiet, false, "Print only errors and what was written.");
+DEFINE_bool(verbose, false,
+            "Print every image's outcome and the timings as well.");
+
+namespace puzzlecal {
+
+Verbosity ConsoleVerbosity() {
+  if (FLAGS_quiet) return Verbosity::kQuiet;
+  return FLAGS_verbose ? Verbosity::kVerbose : Verbosity::kNormal;
+}
+
+}  // namespace puzzlecal
