@@ -65,10 +65,9 @@ int RunBoard() {
   }
   if (ConsoleVerbosity() != Verbosity::kQuiet) {
     std::cout << FLAGS_out << ": " << layout.width_mm << " x "
-              << layout.height_mm << " mm page (" << FLAGS_page
-              << "), pattern " << layout.pattern_w_mm << " x "
-              << layout.pattern_h_mm << " mm, tile "
-              << board.tile_size_m * 1000
+              << layout.height_mm << " mm page (" << FLAGS_page << "), pattern "
+              << layout.pattern_w_mm << " x " << layout.pattern_h_mm
+              << " mm, tile " << board.tile_size_m * 1000
               << " mm. Print at 100 % (no 'fit to page'), then check the "
                  "100 mm scale bar with a ruler.\n";
   } else {

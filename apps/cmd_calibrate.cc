@@ -255,9 +255,8 @@ void PrintImageProblems(const std::vector<ReportImage>& lines) {
     if (reason.rfind(line.file + ": ", 0) == 0) {
       reason.erase(0, line.file.size() + 2);
     }
-    std::cerr << fs::path(line.file).filename().string() << ": "
-              << line.outcome << (reason.empty() ? "" : " (" + reason + ")")
-              << "\n";
+    std::cerr << fs::path(line.file).filename().string() << ": " << line.outcome
+              << (reason.empty() ? "" : " (" + reason + ")") << "\n";
   }
 }
 
@@ -287,8 +286,8 @@ int RunCalibrate() {
   // The format decides the model's free parameters (Kalibr's radtan has no
   // k3), so it is settled before any image is read.
   CalibrationOptions calibration_options;
-  if (!CameraFormatFixedParams(format, model,
-                               &calibration_options.fixed_params, &error)) {
+  if (!CameraFormatFixedParams(format, model, &calibration_options.fixed_params,
+                               &error)) {
     std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
               << error << ".\n";
     return kExitUsage;
@@ -360,8 +359,7 @@ int RunCalibrate() {
   const auto calib_start = std::chrono::steady_clock::now();
   CalibrationResult result;
   std::string calibration_error;
-  const std::string mismatch =
-      BoardMismatchMessage(images, board, FLAGS_board);
+  const std::string mismatch = BoardMismatchMessage(images, board, FLAGS_board);
   bool calibrated = false;
   if (views.empty()) {
     calibration_error = "no image gave a view";
@@ -385,8 +383,8 @@ int RunCalibrate() {
     for (size_t i = 0; i < images.size(); ++i) {
       if (view_of_image[i] >= 0) view_files[view_of_image[i]] = images[i].file;
     }
-    const CameraFileStats stats = CameraFileStatsOfResult(
-        result, view_files, board.Point(board.origin));
+    const CameraFileStats stats =
+        CameraFileStatsOfResult(result, view_files, board.Point(board.origin));
     if (!WriteCameraFile(FLAGS_out, format, result.camera, stats, &error,
                          names)) {
       std::cerr << "puzzlecal calibrate: " << error << "\n";
@@ -411,9 +409,9 @@ int RunCalibrate() {
     input.threads = threads;
     if (!WriteReportInPlace(FLAGS_report, input, &error)) {
       std::cerr << "puzzlecal calibrate: report not written: " << error
-                << (calibrated ? "\n(the camera file " + FLAGS_out +
-                                     " was written)"
-                               : "")
+                << (calibrated
+                        ? "\n(the camera file " + FLAGS_out + " was written)"
+                        : "")
                 << "\n";
       // A failed calibration stays the outcome that matters.
       if (calibrated) return kExitOutputError;
@@ -429,17 +427,17 @@ int RunCalibrate() {
   if (verbosity != Verbosity::kQuiet) {
     std::cout << result.report << "\n";
     std::cout << "views used: " << result.num_views_used << " of "
-              << images.size() << " images; corners: "
-              << result.num_corners_used << "; RMS " << std::setprecision(4)
-              << result.rms_px << " px\n";
+              << images.size()
+              << " images; corners: " << result.num_corners_used << "; RMS "
+              << std::setprecision(4) << result.rms_px << " px\n";
   }
   if (verbosity == Verbosity::kVerbose) {
     std::cout << std::setprecision(3) << "time: " << seconds_total
               << " s wall clock on " << threads
-              << " threads; summed over images: image decoding "
-              << seconds_load << " s, detection " << seconds_detect
-              << " s, grid and decode " << seconds_grid_decode
-              << " s; calibration " << seconds_calibrate << " s\n";
+              << " threads; summed over images: image decoding " << seconds_load
+              << " s, detection " << seconds_detect << " s, grid and decode "
+              << seconds_grid_decode << " s; calibration " << seconds_calibrate
+              << " s\n";
   }
   std::cout << "wrote " << FLAGS_out
             << (FLAGS_report.empty() ? "" : " and the report " + FLAGS_report)
@@ -447,11 +445,12 @@ int RunCalibrate() {
   return kExitOk;
 }
 
-PUZZLECAL_REGISTER_SUBCOMMAND(
-    calibrate, "calibrate", "calibrate a camera from a folder of photos",
-    kUsage, {"images", "board", "model", "out", "format", "report", "threads",
-     "rostopic", "camera_name"},
-    &RunCalibrate);
+PUZZLECAL_REGISTER_SUBCOMMAND(calibrate, "calibrate",
+                              "calibrate a camera from a folder of photos",
+                              kUsage,
+                              {"images", "board", "model", "out", "format",
+                               "report", "threads", "rostopic", "camera_name"},
+                              &RunCalibrate);
 
 }  // namespace
 }  // namespace puzzlecal

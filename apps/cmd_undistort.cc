@@ -52,8 +52,8 @@ int RunUndistort() {
   options.alpha = FLAGS_alpha;
   std::string error;
   if (!options.Check(&error)) {
-    std::cerr << "puzzlecal undistort: --alpha " << FLAGS_alpha << ": "
-              << error << ".\n";
+    std::cerr << "puzzlecal undistort: --alpha " << FLAGS_alpha << ": " << error
+              << ".\n";
     return kExitUsage;
   }
   Camera source;
@@ -70,8 +70,8 @@ int RunUndistort() {
   fs::create_directories(FLAGS_out, ec);
   const std::string target_path = (fs::path(FLAGS_out) / kTargetFile).string();
   if (!fs::is_directory(FLAGS_out) || !CheckOutputPath(target_path, &error)) {
-    std::cerr << "puzzlecal undistort: cannot write into '" << FLAGS_out
-              << "'" << (error.empty() ? "" : ": " + error) << "\n";
+    std::cerr << "puzzlecal undistort: cannot write into '" << FLAGS_out << "'"
+              << (error.empty() ? "" : ": " + error) << "\n";
     return kExitOutputError;
   }
 
@@ -110,8 +110,8 @@ int RunUndistort() {
     }
     ++written;
   }
-  if (!WriteCameraFile(target_path, CameraFileFormat::kPuzzlecal,
-                       chosen.target, CameraFileStats(), &error)) {
+  if (!WriteCameraFile(target_path, CameraFileFormat::kPuzzlecal, chosen.target,
+                       CameraFileStats(), &error)) {
     std::cerr << "puzzlecal undistort: " << error << "\n";
     return kExitOutputError;
   }

@@ -1,6 +1,7 @@
 #include "apps/common_flags.h"
 
-DEFINE_string(images, "", "Folder of images (png, jpg, tif, bmp), or one image file.");
+DEFINE_string(images, "",
+              "Folder of images (png, jpg, tif, bmp), or one image file.");
 DEFINE_string(board, "", "Board definition YAML (see configs/boards/).");
 DEFINE_string(out, "",
               "Output. calibrate: the camera file (.yaml); detect: the "

@@ -52,9 +52,9 @@ bool IsRequiredFlag(const Subcommand& s, const std::string& name) {
     for (size_t at = synopsis.find(needle); at != std::string::npos;
          at = synopsis.find(needle, at + 1)) {
       const size_t end = at + needle.size();
-      if (end < synopsis.size() && (std::isalnum(synopsis[end]) ||
-                                    synopsis[end] == '_' ||
-                                    synopsis[end] == '-')) {
+      if (end < synopsis.size() &&
+          (std::isalnum(synopsis[end]) || synopsis[end] == '_' ||
+           synopsis[end] == '-')) {
         continue;  // a longer flag name
       }
       int depth = 0;
@@ -216,8 +216,8 @@ int Main(int argc, char** argv) {
   // User-facing lines are plain text; library logging (Ceres, glog) only
   // shows errors unless --verbose.
   FLAGS_logtostderr = true;
-  if (!FLAGS_verbose && gflags::GetCommandLineFlagInfoOrDie("minloglevel")
-                            .is_default) {
+  if (!FLAGS_verbose &&
+      gflags::GetCommandLineFlagInfoOrDie("minloglevel").is_default) {
     FLAGS_minloglevel = google::GLOG_ERROR;
   }
   google::InitGoogleLogging(argv[0]);

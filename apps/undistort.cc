@@ -219,8 +219,8 @@ UndistortResult ChooseUndistortTarget(const Camera& source,
     for (int u = 0; u < w; u += 4) {
       Eigen::Vector2d pixel;
       covered += SourcePixel(source, (u - target.params[2]) / target.params[0],
-                             (v - target.params[3]) / target.params[1],
-                             options, &pixel);
+                             (v - target.params[3]) / target.params[1], options,
+                             &pixel);
       ++counted;
     }
   }
@@ -240,8 +240,8 @@ void MakeUndistortMaps(const Camera& source, const Camera& target,
     float* my = map_y->ptr<float>(v);
     for (int u = 0; u < target.width; ++u) {
       Eigen::Vector2d pixel;
-      const bool ok = SourcePixel(source, (u - k[2]) / k[0],
-                                  (v - k[3]) / k[1], options, &pixel);
+      const bool ok = SourcePixel(source, (u - k[2]) / k[0], (v - k[3]) / k[1],
+                                  options, &pixel);
       mx[u] = ok ? static_cast<float>(pixel.x()) : kNoSource;
       my[u] = ok ? static_cast<float>(pixel.y()) : kNoSource;
     }

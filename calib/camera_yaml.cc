@@ -690,8 +690,8 @@ CameraFileStats CameraFileStatsOfResult(
         result.cam_from_board[v].linear() * first_corner_m;
     if (v < result.view_rms_px.size()) view.rms_px = result.view_rms_px[v];
     if (v < result.inlier.size()) {
-      view.corners = static_cast<int>(std::count(
-          result.inlier[v].begin(), result.inlier[v].end(), true));
+      view.corners = static_cast<int>(
+          std::count(result.inlier[v].begin(), result.inlier[v].end(), true));
     }
     stats.views.push_back(view);
   }

@@ -109,12 +109,12 @@ constexpr double kBandWidthMm = kScaleBarMm + 25.0;
 std::vector<Rect> ScaleBar(const PageLayout& layout) {
   std::vector<Rect> shapes;
   const double x = layout.scale_bar_x_mm, y = layout.scale_bar_y_mm;
-  shapes.push_back({x, y + kTickHeightMm - kBarHeightMm, kScaleBarMm,
-                    kBarHeightMm});
+  shapes.push_back(
+      {x, y + kTickHeightMm - kBarHeightMm, kScaleBarMm, kBarHeightMm});
   for (int k = 0; k <= 10; ++k) {
     const double h = k % 5 == 0 ? kTickHeightMm : 0.5 * kTickHeightMm;
-    shapes.push_back({x + k * 10.0 - 0.5 * kTickWidthMm,
-                      y + kTickHeightMm - h, kTickWidthMm, h});
+    shapes.push_back({x + k * 10.0 - 0.5 * kTickWidthMm, y + kTickHeightMm - h,
+                      kTickWidthMm, h});
   }
   return shapes;
 }
@@ -174,7 +174,8 @@ uint32_t Crc32(const std::string& bytes) {
   uint32_t crc = 0xffffffffu;
   for (unsigned char c : bytes) {
     crc ^= c;
-    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+    for (int k = 0; k < 8; ++k)
+      crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
   }
   return crc ^ 0xffffffffu;
 }
@@ -239,7 +240,8 @@ void Draw(cairo_t* cr, const Board& board, const PageLayout& layout,
   cairo_restore(cr);
   if (!layout.has_label) return;
   cairo_set_source_rgb(cr, 0, 0, 0);
-  for (const Rect& r : ScaleBar(layout)) cairo_rectangle(cr, r.x, r.y, r.w, r.h);
+  for (const Rect& r : ScaleBar(layout))
+    cairo_rectangle(cr, r.x, r.y, r.w, r.h);
   cairo_fill(cr);
   cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
                          CAIRO_FONT_WEIGHT_NORMAL);
@@ -360,9 +362,9 @@ bool LayOutPage(const Board& board, const PrintOptions& options,
         for (char& c : sheet) c = static_cast<char>(std::toupper(c));
         if (options.page == PageSize::kLetter) sheet = "Letter";
         *why = "the board is " + Number(pw) + " x " + Number(ph) + " mm; " +
-               (sheet[0] == 'A' ? "an " : "a ") + sheet + " sheet (" + Number(w) + " x " + Number(h) +
-               " mm) holds " + Number(w - 2 * m) + " x " +
-               Number(h - 2 * m - kBandHeightMm) +
+               (sheet[0] == 'A' ? "an " : "a ") + sheet + " sheet (" +
+               Number(w) + " x " + Number(h) + " mm) holds " +
+               Number(w - 2 * m) + " x " + Number(h - 2 * m - kBandHeightMm) +
                " mm inside its margins and label, or " + Number(h - 2 * m) +
                " x " + Number(w - 2 * m - kBandHeightMm) +
                " mm in landscape: choose a larger page, --page fit, or a "

@@ -1,9 +1,9 @@
 #ifndef PUZZLECAL_SIM_PRINT_BOARD_H_
 #define PUZZLECAL_SIM_PRINT_BOARD_H_
 
-// Printable boards, laid out as docs/puzzleboard.md's 'Printed boards' section says: the
-// page is W x H tiles (W x H = cols x rows corners), corner (x0 + i, y0 + j)
-// sits at ((i + 1/2) s, (j + 1/2) s) from the top-left page corner, the
+// Printable boards, laid out as docs/puzzleboard.md's 'Printed boards' section
+// says: the page is W x H tiles (W x H = cols x rows corners), corner (x0 + i,
+// y0 + j) sits at ((i + 1/2) s, (j + 1/2) s) from the top-left page corner, the
 // border tiles are half tiles, and every edge between two printed corners
 // carries a disc of diameter s/3 (white for bit 1). A plain checkerboard page
 // holds (cols + 1) x (rows + 1) full tiles. The pattern is printed alone or
@@ -66,8 +66,8 @@ struct PageLayout {
   double width_mm = 0, height_mm = 0;  // the sheet (landscape if it fits so)
   double pattern_x_mm = 0, pattern_y_mm = 0;  // the pattern's top-left
   double pattern_w_mm = 0, pattern_h_mm = 0;
-  bool has_label = false;  // false for kPatternOnly
-  double label_y_mm = 0;   // baseline of the label line
+  bool has_label = false;                         // false for kPatternOnly
+  double label_y_mm = 0;                          // baseline of the label line
   double scale_bar_x_mm = 0, scale_bar_y_mm = 0;  // left end, top of the bar
   std::string label;  // "NAME: puzzleboard, 23 x 16 corners, tile 30 mm, ..."
 };

@@ -6,9 +6,9 @@
 // The images are rendered here (sim/render.h) into a temporary folder; the
 // program is the one built beside this test (<build>/apps/puzzlecal).
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -168,12 +168,14 @@ int CountOf(const std::string& text, const std::string& needle) {
   return count;
 }
 
-// True when a line starts like a glog line ("W20261201 19:38:04.99 123 f.cc:1]").
+// True when a line starts like a glog line ("W20261201 19:38:04.99 123
+// f.cc:1]").
 bool HasLogPrefix(const std::string& text) {
   std::istringstream lines(text);
   std::string line;
   while (std::getline(lines, line)) {
-    if (line.size() > 9 && std::string("IWEF").find(line[0]) != std::string::npos &&
+    if (line.size() > 9 &&
+        std::string("IWEF").find(line[0]) != std::string::npos &&
         std::all_of(line.begin() + 1, line.begin() + 9,
                     [](char c) { return std::isdigit(c) != 0; })) {
       return true;
@@ -702,14 +704,16 @@ TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
   EXPECT_NEAR(intrinsics[0], 560.0, 5.0);
 
   const fs::path rational = case_dir_ / "rational.yaml";
-  const RunResult refused = Run(
-      "calibrate --images " + Quote(folder.string()) + " --board " +
-      Quote(BoardFile().string()) + " --model pinhole-rational --format "
-      "kalibr --out " + Quote(rational.string()));
+  const RunResult refused = Run("calibrate --images " + Quote(folder.string()) +
+                                " --board " + Quote(BoardFile().string()) +
+                                " --model pinhole-rational --format "
+                                "kalibr --out " +
+                                Quote(rational.string()));
   EXPECT_EQ(refused.exit_code, kExitUsage) << refused.all();
   EXPECT_NE(refused.err.find("kalibr"), std::string::npos) << refused.err;
   EXPECT_EQ(refused.all().find("view0"), std::string::npos)
-      << "images were read before the refusal:\n" << refused.all();
+      << "images were read before the refusal:\n"
+      << refused.all();
   EXPECT_FALSE(fs::exists(rational));
 }
 
@@ -737,20 +741,21 @@ TEST_F(BadInputTest, WrongBoardFileNamesTheBoard) {
     const fs::path board = case_dir_ / c.name;
     WriteFile(board, c.yaml);
     const fs::path camera = case_dir_ / "camera.yaml";
-    const RunResult run = Run(
-        "calibrate --images " + Quote(folder.string()) + " --board " +
-        Quote(board.string()) + " --out " + Quote(camera.string()) +
-        " --report " + Quote((case_dir_ / "report").string()));
+    const RunResult run =
+        Run("calibrate --images " + Quote(folder.string()) + " --board " +
+            Quote(board.string()) + " --out " + Quote(camera.string()) +
+            " --report " + Quote((case_dir_ / "report").string()));
     EXPECT_EQ(run.exit_code, kExitNoResult) << c.name << "\n" << run.all();
     EXPECT_NE(run.err.find("5 of 5 images show many corners but none matches "
-                           "the code of " + board.string() +
+                           "the code of " +
+                           board.string() +
                            " at any position: check cols, rows and origin"),
               std::string::npos)
-        << c.name << "\n" << run.err;
+        << c.name << "\n"
+        << run.err;
     EXPECT_EQ(run.all().find("must be positive"), std::string::npos)
         << run.all();
-    EXPECT_EQ(run.all().find("add more views"), std::string::npos)
-        << run.all();
+    EXPECT_EQ(run.all().find("add more views"), std::string::npos) << run.all();
     EXPECT_FALSE(fs::exists(camera));
   }
 }
@@ -788,7 +793,8 @@ TEST_F(BadInputTest, OutputsCheckedFirstAndReportReplaced) {
   fs::create_directories(report);
   WriteFile(report / "overlay_from_an_old_run.png", "old");
   WriteFile(report / "summary.md", "old summary");
-  RunResult run = Calibrate(folder, camera, "--report " + Quote(report.string()));
+  RunResult run =
+      Calibrate(folder, camera, "--report " + Quote(report.string()));
   ASSERT_EQ(run.exit_code, kExitOk) << run.all();
   EXPECT_TRUE(fs::exists(camera));
   EXPECT_FALSE(fs::exists(report / "overlay_from_an_old_run.png"));
@@ -803,11 +809,13 @@ TEST_F(BadInputTest, OutputsCheckedFirstAndReportReplaced) {
   fs::create_directories(notes);
   WriteFile(notes / "my_notes.txt", "keep me");
   const fs::path camera2 = case_dir_ / "camera2.yaml";
-  run = Calibrate(folder, camera2, "--verbose --report " + Quote(notes.string()));
+  run =
+      Calibrate(folder, camera2, "--verbose --report " + Quote(notes.string()));
   EXPECT_EQ(run.exit_code, kExitOutputError) << run.all();
   EXPECT_NE(run.err.find("my_notes.txt"), std::string::npos) << run.err;
   EXPECT_EQ(run.all().find("view0.png"), std::string::npos)
-      << "images were read before the refusal:\n" << run.all();
+      << "images were read before the refusal:\n"
+      << run.all();
   EXPECT_EQ(ReadFile(notes / "my_notes.txt"), "keep me");
   EXPECT_FALSE(fs::exists(camera2));
 }
@@ -868,11 +876,11 @@ TEST_F(BadInputTest, ConsoleVersionHelpAndQuiet) {
   EXPECT_EQ(run.out.rfind("puzzlecal ", 0), 0u) << run.out;
   run = Run("help calibrate");
   EXPECT_EQ(run.exit_code, kExitOk) << run.all();
-  for (const char* line : {"--images (required)", "--board (required)",
-                           "--out (required)", "--format (default: puzzlecal)",
-                           "--rostopic (default: /cam0/image_raw)",
-                           "--camera-name (default: camera)", "--quiet",
-                           "--verbose"}) {
+  for (const char* line :
+       {"--images (required)", "--board (required)", "--out (required)",
+        "--format (default: puzzlecal)",
+        "--rostopic (default: /cam0/image_raw)",
+        "--camera-name (default: camera)", "--quiet", "--verbose"}) {
     EXPECT_NE(run.out.find(line), std::string::npos) << line << "\n" << run.out;
   }
   EXPECT_NE(run.out.find("the camera file"), std::string::npos) << run.out;

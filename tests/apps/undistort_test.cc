@@ -53,7 +53,7 @@ Camera BarrelCamera() {
 Camera SampleCamera() {
   Camera camera;
   camera.model = CameraModelId::kPinholeRadtan;
-  camera.params = {399.988, 400.383, 409.863, 294.090, -0.199917,
+  camera.params = {399.988,    400.383,     409.863,      294.090,    -0.199917,
                    0.00983836, 0.000606854, -0.000390849, 7.42599e-05};
   camera.width = 800;
   camera.height = 600;
@@ -90,8 +90,8 @@ TEST(UndistortTest, BoardLinesBecomeStraight) {
                        ("puzzlecal_undistort_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "in");
-  const Board board =
-      MakeBoard(BoardType::kPuzzleBoard, 23, 16, Eigen::Vector2i(50, 100), 0.03);
+  const Board board = MakeBoard(BoardType::kPuzzleBoard, 23, 16,
+                                Eigen::Vector2i(50, 100), 0.03);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() =
       Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -113,11 +113,11 @@ TEST(UndistortTest, BoardLinesBecomeStraight) {
                               CameraFileStats(), &error))
       << error;
 
-  const std::string command =
-      ProgramPath().string() + " undistort --camera " +
-      (dir / "camera.yaml").string() + " --images " + (dir / "in").string() +
-      " --out " + (dir / "out").string() + " > " + (dir / "log").string() +
-      " 2>&1";
+  const std::string command = ProgramPath().string() + " undistort --camera " +
+                              (dir / "camera.yaml").string() + " --images " +
+                              (dir / "in").string() + " --out " +
+                              (dir / "out").string() + " > " +
+                              (dir / "log").string() + " 2>&1";
   const int status = std::system(command.c_str());
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
   const cv::Mat undistorted =
@@ -146,7 +146,8 @@ TEST(UndistortTest, BoardLinesBecomeStraight) {
   const auto& k = target.params;
   double worst = 0;
   for (size_t i = 0; i < after.decode.observation.id.size(); ++i) {
-    const Eigen::Vector3d p = pose * board.Point(after.decode.observation.id[i]);
+    const Eigen::Vector3d p =
+        pose * board.Point(after.decode.observation.id[i]);
     const Eigen::Vector2d expected(k[0] * p.x() / p.z() + k[2],
                                    k[1] * p.y() / p.z() + k[3]);
     worst = std::max(worst, (expected - after.decode.observation.xy[i]).norm());
@@ -162,8 +163,8 @@ TEST(UndistortTest, NoSwirlWhereTheModelHasNoInverse) {
   const auto& p = source.params;
   const cv::Matx33d k(p[0], 0, p[2], 0, p[1], p[3], 0, 0, 1);
   const cv::Mat cv_k = cv::getOptimalNewCameraMatrix(
-      k, std::vector<double>{p[4], p[5], p[6], p[7], p[8]},
-      cv::Size(800, 600), 1.0);
+      k, std::vector<double>{p[4], p[5], p[6], p[7], p[8]}, cv::Size(800, 600),
+      1.0);
   EXPECT_LT(cv_k.at<double>(0, 0), 100.0);
 
   for (double alpha : {0.0, 0.5, 1.0}) {

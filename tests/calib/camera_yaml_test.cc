@@ -349,7 +349,8 @@ TEST_F(CameraYamlTest, ViewPosesReprojectTheBoardWithOpenCv) {
       cv::Matx33d r;
       cv::Vec3d t;
       for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) r(i, j) = views[v].cam_from_board.linear()(i, j);
+        for (int j = 0; j < 3; ++j)
+          r(i, j) = views[v].cam_from_board.linear()(i, j);
         t[i] = views[v].cam_from_board.translation()[i];
       }
       cv::Vec3d rvec;

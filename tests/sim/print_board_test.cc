@@ -166,8 +166,10 @@ void ReadPhys(const std::string& png, uint32_t* x, uint32_t* y) {
   *x = *y = 0;
   auto be32 = [&](size_t at) {
     return (static_cast<uint32_t>(static_cast<unsigned char>(png[at])) << 24) |
-           (static_cast<uint32_t>(static_cast<unsigned char>(png[at + 1])) << 16) |
-           (static_cast<uint32_t>(static_cast<unsigned char>(png[at + 2])) << 8) |
+           (static_cast<uint32_t>(static_cast<unsigned char>(png[at + 1]))
+            << 16) |
+           (static_cast<uint32_t>(static_cast<unsigned char>(png[at + 2]))
+            << 8) |
            static_cast<uint32_t>(static_cast<unsigned char>(png[at + 3]));
   };
   for (size_t at = 8; at + 12 <= png.size();) {
@@ -186,8 +188,8 @@ void ReadPhys(const std::string& png, uint32_t* x, uint32_t* y) {
 // where LayOutPage says (decoded corners land at their page positions), a
 // 100 mm scale bar 100 mm long, the dpi stored in pHYs.
 TEST(PrintBoardTest, A4PageHoldsThePatternLabelAndScaleBar) {
-  const Board board =
-      MakeBoard(BoardType::kPuzzleBoard, 13, 8, Eigen::Vector2i(100, 200), 0.02);
+  const Board board = MakeBoard(BoardType::kPuzzleBoard, 13, 8,
+                                Eigen::Vector2i(100, 200), 0.02);
   PrintOptions options;
   options.page = PageSize::kA4;
   options.dpi = 150;
@@ -233,8 +235,8 @@ TEST(PrintBoardTest, A4PageHoldsThePatternLabelAndScaleBar) {
   }
 
   // The scale bar: the longest black run on the bar's middle row.
-  const int row = static_cast<int>(
-      (layout.scale_bar_y_mm + 4.0 - 0.75) * px_per_mm);
+  const int row =
+      static_cast<int>((layout.scale_bar_y_mm + 4.0 - 0.75) * px_per_mm);
   int longest = 0, run = 0;
   for (int x = 0; x < page.cols; ++x) {
     run = page.at<uchar>(row, x) < 128 ? run + 1 : 0;
@@ -292,7 +294,8 @@ TEST(PrintBoardTest, SheetPresetsFitTheirSheets) {
     std::string why;
     ASSERT_TRUE(LoadBoardFile(entry.path().string(), &board, &why)) << why;
     PageLayout layout;
-    EXPECT_TRUE(LayOutPage(board, options, &layout, &why)) << name << ": " << why;
+    EXPECT_TRUE(LayOutPage(board, options, &layout, &why))
+        << name << ": " << why;
     EXPECT_EQ(board.type, BoardType::kPuzzleBoard) << name;
     ++presets;
   }
