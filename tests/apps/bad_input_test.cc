@@ -707,7 +707,7 @@ TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
   const RunResult refused = Run("calibrate --images " + Quote(folder.string()) +
                                 " --board " + Quote(BoardFile().string()) +
                                 " --model pinhole-rational --format "
-                                "kalibr --out " +
+                                "kalibr --verbose --out " +
                                 Quote(rational.string()));
   EXPECT_EQ(refused.exit_code, kExitUsage) << refused.all();
   EXPECT_NE(refused.err.find("kalibr"), std::string::npos) << refused.err;
