@@ -217,17 +217,26 @@ std::vector<CalibrationView> MakeCalibrationViews(
   *height = 0;
   std::vector<CalibrationView> views;
   view_of_image->assign(images->size(), -1);
+  // The size most usable images have (the first of them on a tie).
+  std::map<std::pair<int, int>, int> count;
+  int best = 0;
+  for (const ImageResult& image : *images) {
+    if (image.outcome != ImageOutcome::kUsable) continue;
+    const int n = ++count[{image.width, image.height}];
+    if (n > best) {
+      best = n;
+      *width = image.width;
+      *height = image.height;
+    }
+  }
   for (size_t i = 0; i < images->size(); ++i) {
     ImageResult& image = (*images)[i];
     if (image.outcome != ImageOutcome::kUsable) continue;
-    if (*width == 0) {
-      *width = image.width;
-      *height = image.height;
-    } else if (image.width != *width || image.height != *height) {
+    if (image.width != *width || image.height != *height) {
       image.outcome = ImageOutcome::kSizeMismatch;
       std::ostringstream reason;
-      reason << image.width << "x" << image.height << " differs from " << *width
-             << "x" << *height << " of the first usable image";
+      reason << image.width << "x" << image.height << " differs from the "
+             << *width << "x" << *height << " most images have";
       image.reason = reason.str();
       continue;
     }

@@ -28,7 +28,7 @@ enum class ImageOutcome {
   kNoGrid,         // no consistent lattice among the corners
   kNotDecoded,     // PuzzleBoard: no component decoded
   kTooFewCorners,  // decoded, but fewer corners than a view needs
-  kSizeMismatch,   // image size differs from the first image's
+  kSizeMismatch,   // image size differs from the one most images have
 };
 
 // "usable", "unreadable", "no corners", ...
@@ -88,8 +88,8 @@ std::vector<ImageResult> ProcessImageFiles(
     const PipelineOptions& options, int num_threads,
     const std::function<void(size_t, const ImageResult&)>& on_done = {});
 
-// The calibration views of a run: one per usable image of the size of the
-// first usable one (images of another size are marked kSizeMismatch).
+// The calibration views of a run: one per usable image of the size most
+// usable images have (images of another size are marked kSizeMismatch).
 // `view_of_image[i]` is the view index of images[i] or -1; `width`/`height`
 // return the image size (0 when no image is usable).
 std::vector<CalibrationView> MakeCalibrationViews(
