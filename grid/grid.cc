@@ -133,84 +133,91 @@ bool GridOptions::Check(std::string* why) const {
   return true;
 }
 
-std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
-                                     const cv::Mat& image,
-                                     const GridOptions& options,
-                                     GridSummary* summary_out,
-                                     std::vector<GridEdgeTrace>* trace) {
-  if (trace != nullptr) trace->clear();
-  const auto start = std::chrono::steady_clock::now();
-  GridSummary local_summary;
-  GridSummary& summary = summary_out ? *summary_out : local_summary;
-  summary = GridSummary();
-  const int n = static_cast<int>(corners.size());
-  summary.num_input_corners = n;
+namespace {
 
+// Options, image type and corner count that BuildGrid can work with; false
+// with the reason in `summary->message`.
+bool CheckGridInputs(int num_corners, const cv::Mat& image,
+                     const GridOptions& options, GridSummary* summary) {
   std::string why;
   if (!options.Check(&why)) {
-    summary.message = "invalid GridOptions: " + why;
-    return {};
+    summary->message = "invalid GridOptions: " + why;
+    return false;
   }
   if (!image.empty() && !IsSupportedGridImage(image)) {
-    summary.message =
+    summary->message =
         "unsupported image type " + std::to_string(image.type()) +
         " (expected CV_8UC1, CV_16UC1 or CV_32FC1, or an empty image)";
-    return {};
+    return false;
   }
   // Labels and tree ids must fit the label table's keys.
-  if (n > LabelTable::kMaxLabel) {
-    summary.message = "too many corners (" + std::to_string(n) + " > " +
-                      std::to_string(LabelTable::kMaxLabel) + ")";
-    return {};
+  if (num_corners > LabelTable::kMaxLabel) {
+    summary->message = "too many corners (" + std::to_string(num_corners) +
+                       " > " + std::to_string(LabelTable::kMaxLabel) + ")";
+    return false;
   }
-  summary.image_used = !image.empty();
+  return true;
+}
 
-  // Valid corners; invalid ones stay out of every edge and tree.
-  LatticeNodes nodes;
-  nodes.xy.resize(n);
-  nodes.axis.resize(n);
-  nodes.valid.assign(n, 0);
-  std::vector<Eigen::Vector2d> doubled(n, Eigen::Vector2d::Zero());
+// The corners as the forest reads them, with the doubled orientation angle
+// per corner (for the orientation filter) and the valid corners' indices and
+// positions (for the neighbour search). Invalid corners stay out of every
+// edge and tree.
+struct GridNodes {
+  LatticeNodes lattice;
+  std::vector<Eigen::Vector2d> doubled;
   std::vector<int> valid_index;
-  valid_index.reserve(n);
   std::vector<Eigen::Vector2d> valid_xy;
-  valid_xy.reserve(n);
+};
+
+GridNodes MakeGridNodes(const std::vector<Corner>& corners,
+                        const GridOptions& options, GridSummary* summary) {
+  const int n = static_cast<int>(corners.size());
+  GridNodes nodes;
+  nodes.lattice.xy.resize(n);
+  nodes.lattice.axis.resize(n);
+  nodes.lattice.valid.assign(n, 0);
+  nodes.doubled.assign(n, Eigen::Vector2d::Zero());
+  nodes.valid_index.reserve(n);
+  nodes.valid_xy.reserve(n);
   for (int i = 0; i < n; ++i) {
     const Corner& c = corners[i];
-    nodes.xy[i] = c.xy;
+    nodes.lattice.xy[i] = c.xy;
     const bool ok = std::isfinite(c.xy.x()) && std::isfinite(c.xy.y()) &&
                     std::abs(c.xy.x()) <= options.max_abs_coordinate_px &&
                     std::abs(c.xy.y()) <= options.max_abs_coordinate_px &&
                     std::isfinite(c.orientation);
     if (!ok) {
-      ++summary.num_invalid_corners;
-      nodes.xy[i].setZero();
+      ++summary->num_invalid_corners;
+      nodes.lattice.xy[i].setZero();
       continue;
     }
-    nodes.valid[i] = 1;
+    nodes.lattice.valid[i] = 1;
     const double co = std::cos(c.orientation), so = std::sin(c.orientation);
     // Orientation + 45 degrees; the doubled angle for the orientation filter.
-    nodes.axis[i] = Eigen::Vector2d(co - so, co + so) * M_SQRT1_2;
-    doubled[i] = Eigen::Vector2d(co * co - so * so, 2 * co * so);
-    valid_index.push_back(i);
-    valid_xy.push_back(c.xy);
+    nodes.lattice.axis[i] = Eigen::Vector2d(co - so, co + so) * M_SQRT1_2;
+    nodes.doubled[i] = Eigen::Vector2d(co * co - so * so, 2 * co * so);
+    nodes.valid_index.push_back(i);
+    nodes.valid_xy.push_back(c.xy);
   }
-  if (summary.num_invalid_corners > 0) {
-    summary.message = std::to_string(summary.num_invalid_corners) +
-                      " corners ignored (non-finite or beyond " +
-                      std::to_string(options.max_abs_coordinate_px) + " px)";
+  if (summary->num_invalid_corners > 0) {
+    summary->message = std::to_string(summary->num_invalid_corners) +
+                       " corners ignored (non-finite or beyond " +
+                       std::to_string(options.max_abs_coordinate_px) + " px)";
   }
+  return nodes;
+}
 
-  // k nearest neighbours -> unique candidate pairs.
-  auto phase_start = std::chrono::steady_clock::now();
+// The k nearest neighbours of every valid corner as unique (smaller, larger)
+// corner index pairs.
+std::vector<std::pair<int, int>> CandidatePairs(const GridNodes& nodes, int k) {
   std::vector<int> knn;
-  const int k = options.num_neighbors;
-  FindNearestNeighbors(valid_xy, k, &knn);
+  FindNearestNeighbors(nodes.valid_xy, k, &knn);
   // Each unordered pair once, without sorting: from the smaller index, or
   // from the larger one when the smaller does not list it.
   std::vector<std::pair<int, int>> pairs;
   pairs.reserve(knn.size());
-  for (size_t v = 0; v < valid_xy.size(); ++v) {
+  for (size_t v = 0; v < nodes.valid_xy.size(); ++v) {
     for (int m = 0; m < k; ++m) {
       const int w = knn[v * k + m];
       if (w < 0) break;
@@ -219,30 +226,35 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
         if (std::find(list, list + k, static_cast<int>(v)) != list + k)
           continue;
       }
-      const int a = valid_index[v], b = valid_index[w];
+      const int a = nodes.valid_index[v], b = nodes.valid_index[w];
       pairs.emplace_back(std::min(a, b), std::max(a, b));
     }
   }
-  summary.num_candidate_edges = static_cast<int>(pairs.size());
-  summary.neighbors_ms = MillisecondsSince(phase_start);
+  return pairs;
+}
 
-  // Orientation filter and lengths. Orientations are compared through their
-  // doubled angles: sin^2(d) = (1 - cos(2 d)) / 2.
-  phase_start = std::chrono::steady_clock::now();
+// The pairs that pass the orientation filter and are long enough, as edges
+// of weight = length (unsorted).
+std::vector<GridEdge> FilterPairs(const std::vector<std::pair<int, int>>& pairs,
+                                  const GridNodes& nodes,
+                                  const GridOptions& options,
+                                  GridSummary* summary) {
+  // Orientations are compared through their doubled angles:
+  // sin^2(d) = (1 - cos(2 d)) / 2.
   const double min_abs_sin =
       std::sin(options.min_orientation_difference_deg * M_PI / 180);
   const double max_cos_double = 1 - 2 * min_abs_sin * min_abs_sin;
   std::vector<GridEdge> edges;
   edges.reserve(pairs.size());
   for (const auto& [a, b] : pairs) {
-    const double cos_double = doubled[a].dot(doubled[b]);
+    const double cos_double = nodes.doubled[a].dot(nodes.doubled[b]);
     if (!(cos_double < max_cos_double)) {
-      ++summary.num_edges_orientation_filtered;
+      ++summary->num_edges_orientation_filtered;
       continue;
     }
-    const double length = (nodes.xy[b] - nodes.xy[a]).norm();
+    const double length = (nodes.lattice.xy[b] - nodes.lattice.xy[a]).norm();
     if (!(length >= options.min_edge_length_px) || length <= 0) {
-      ++summary.num_edges_too_short;
+      ++summary->num_edges_too_short;
       continue;
     }
     GridEdge edge;
@@ -252,35 +264,43 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
     edge.weight = length;
     edges.push_back(edge);
   }
-  // Sorted through 16-byte keys (length, then the pair), cheaper to move
-  // than the edges.
-  {
-    struct Key {
-      double length;
-      uint64_t pair;
-      bool operator<(const Key& o) const {
-        return length != o.length ? length < o.length : pair < o.pair;
-      }
-    };
-    std::vector<Key> keys(edges.size());
-    for (size_t e = 0; e < edges.size(); ++e)
-      keys[e] = {edges[e].length, (static_cast<uint64_t>(edges[e].a) << 32) |
-                                      static_cast<uint32_t>(edges[e].b)};
-    std::sort(keys.begin(), keys.end());
-    for (size_t e = 0; e < edges.size(); ++e) {
-      GridEdge& edge = edges[e];
-      edge.a = static_cast<int>(keys[e].pair >> 32);
-      edge.b = static_cast<int>(keys[e].pair & 0xffffffffu);
-      edge.length = edge.weight = keys[e].length;
-    }
-  }
-  summary.num_edges_considered = static_cast<int>(edges.size());
-  summary.weights_ms = MillisecondsSince(phase_start);
+  return edges;
+}
 
-  // Kruskal; the intensity penalty is sampled when an edge's turn comes.
-  phase_start = std::chrono::steady_clock::now();
+// Sorts edges of weight = length by GridEdgeLess, through 16-byte keys
+// (length, then the pair), cheaper to move than the edges.
+void SortEdgesByLength(std::vector<GridEdge>* edges) {
+  struct Key {
+    double length;
+    uint64_t pair;
+    bool operator<(const Key& o) const {
+      return length != o.length ? length < o.length : pair < o.pair;
+    }
+  };
+  std::vector<Key> keys(edges->size());
+  for (size_t e = 0; e < edges->size(); ++e) {
+    const GridEdge& edge = (*edges)[e];
+    keys[e] = {edge.length, (static_cast<uint64_t>(edge.a) << 32) |
+                                static_cast<uint32_t>(edge.b)};
+  }
+  std::sort(keys.begin(), keys.end());
+  for (size_t e = 0; e < edges->size(); ++e) {
+    GridEdge& edge = (*edges)[e];
+    edge.a = static_cast<int>(keys[e].pair >> 32);
+    edge.b = static_cast<int>(keys[e].pair & 0xffffffffu);
+    edge.length = edge.weight = keys[e].length;
+  }
+}
+
+// Kruskal over the sorted edges; with an image, the intensity penalty and
+// the sides test are sampled when an edge's turn comes.
+LatticeForest RunKruskal(const LatticeNodes& nodes,
+                         const std::vector<GridEdge>& edges,
+                         const cv::Mat& image, const GridOptions& options,
+                         GridSummary* summary,
+                         std::vector<GridEdgeTrace>* trace) {
   std::function<bool(const GridEdge&)> crosses_tile, sides_flip;
-  if (summary.image_used) {
+  if (!image.empty()) {
     crosses_tile = [&](const GridEdge& edge) {
       return EdgeCrossesTile(image, nodes.xy[edge.a], nodes.xy[edge.b],
                              options.intensity_samples,
@@ -295,21 +315,62 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
     }
   }
   LatticeForest forest;
-  BuildLatticeForest(nodes, edges, crosses_tile, sides_flip, options, &summary,
+  BuildLatticeForest(nodes, edges, crosses_tile, sides_flip, options, summary,
                      &forest, trace);
+  return forest;
+}
+
+// Component counts of the result.
+void SummarizeComponents(const std::vector<GridComponent>& components,
+                         GridSummary* summary) {
+  summary->num_components = static_cast<int>(components.size());
+  for (const GridComponent& c : components)
+    summary->num_labelled_corners += static_cast<int>(c.corner.size());
+  summary->largest_component =
+      components.empty() ? 0 : static_cast<int>(components[0].corner.size());
+}
+
+}  // namespace
+
+std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
+                                     const cv::Mat& image,
+                                     const GridOptions& options,
+                                     GridSummary* summary_out,
+                                     std::vector<GridEdgeTrace>* trace) {
+  if (trace != nullptr) trace->clear();
+  const auto start = std::chrono::steady_clock::now();
+  GridSummary local_summary;
+  GridSummary& summary = summary_out ? *summary_out : local_summary;
+  summary = GridSummary();
+  summary.num_input_corners = static_cast<int>(corners.size());
+  if (!CheckGridInputs(summary.num_input_corners, image, options, &summary))
+    return {};
+  summary.image_used = !image.empty();
+  const GridNodes nodes = MakeGridNodes(corners, options, &summary);
+
+  auto phase_start = std::chrono::steady_clock::now();
+  const std::vector<std::pair<int, int>> pairs =
+      CandidatePairs(nodes, options.num_neighbors);
+  summary.num_candidate_edges = static_cast<int>(pairs.size());
+  summary.neighbors_ms = MillisecondsSince(phase_start);
+
+  phase_start = std::chrono::steady_clock::now();
+  std::vector<GridEdge> edges = FilterPairs(pairs, nodes, options, &summary);
+  SortEdgesByLength(&edges);
+  summary.num_edges_considered = static_cast<int>(edges.size());
+  summary.weights_ms = MillisecondsSince(phase_start);
+
+  phase_start = std::chrono::steady_clock::now();
+  const LatticeForest forest =
+      RunKruskal(nodes.lattice, edges, image, options, &summary, trace);
   summary.kruskal_ms = MillisecondsSince(phase_start);
 
   phase_start = std::chrono::steady_clock::now();
-  std::vector<GridComponent> components =
-      ExtractComponents(nodes.xy, summary.image_used ? image : cv::Mat(),
-                        forest, edges, options, &summary);
+  std::vector<GridComponent> components = ExtractComponents(
+      nodes.lattice.xy, image, forest, edges, options, &summary);
   summary.cleanup_ms = MillisecondsSince(phase_start);
 
-  summary.num_components = static_cast<int>(components.size());
-  for (const GridComponent& c : components)
-    summary.num_labelled_corners += static_cast<int>(c.corner.size());
-  summary.largest_component =
-      components.empty() ? 0 : static_cast<int>(components[0].corner.size());
+  SummarizeComponents(components, &summary);
   summary.ok = true;
   summary.total_ms = MillisecondsSince(start);
   return components;
