@@ -55,82 +55,108 @@ const char* GridEdgeDecisionName(GridEdgeDecision decision) {
   return "unknown";
 }
 
-bool GridOptions::Check(std::string* why) const {
+bool GridCandidateOptions::Check(std::string* why) const {
   if (num_neighbors < 1 || num_neighbors > 64)
-    return Fail(why, "num_neighbors must be in [1, 64]");
+    return Fail(why, "candidates.num_neighbors must be in [1, 64]");
   if (!(min_orientation_difference_deg >= 0 &&
         min_orientation_difference_deg < 90))
-    return Fail(why, "min_orientation_difference_deg must be in [0, 90)");
+    return Fail(why,
+                "candidates.min_orientation_difference_deg must be in [0, 90)");
   if (!(min_edge_length_px >= 0 && std::isfinite(min_edge_length_px)))
-    return Fail(why, "min_edge_length_px must be finite and >= 0");
+    return Fail(why, "candidates.min_edge_length_px must be finite and >= 0");
   if (!(max_abs_coordinate_px > 0 && max_abs_coordinate_px <= 1e9))
-    return Fail(why, "max_abs_coordinate_px must be in (0, 1e9]");
+    return Fail(why, "candidates.max_abs_coordinate_px must be in (0, 1e9]");
+  return true;
+}
+
+bool GridEdgeImageOptions::Check(std::string* why) const {
   if (intensity_samples < 3 || intensity_samples > 1000)
-    return Fail(why, "intensity_samples must be in [3, 1000]");
+    return Fail(why, "image_tests.intensity_samples must be in [3, 1000]");
   if (!(intensity_difference_fraction > 0 &&
         std::isfinite(intensity_difference_fraction)))
-    return Fail(why, "intensity_difference_fraction must be finite and > 0");
+    return Fail(why,
+                "image_tests.intensity_difference_fraction must be finite and "
+                "> 0");
   if (!(penalty_factor >= 1 && std::isfinite(penalty_factor)))
-    return Fail(why, "penalty_factor must be finite and >= 1");
+    return Fail(why, "image_tests.penalty_factor must be finite and >= 1");
+  if (!(side_offset_fraction > 0 && side_offset_fraction <= 0.5))
+    return Fail(why, "image_tests.side_offset_fraction must be in (0, 0.5]");
+  if (!(side_min_contrast >= 0 && std::isfinite(side_min_contrast)))
+    return Fail(why, "image_tests.side_min_contrast must be finite and >= 0");
+  return true;
+}
+
+bool GridMergeOptions::Check(std::string* why) const {
   if (!(neighbor_weight_ratio > 1 && std::isfinite(neighbor_weight_ratio)))
-    return Fail(why, "neighbor_weight_ratio must be finite and > 1");
+    return Fail(why, "merge.neighbor_weight_ratio must be finite and > 1");
   if (!(tree_mean_weight_ratio_min > 0 && tree_mean_weight_ratio_min < 1 &&
         tree_mean_weight_ratio_max > 1 &&
         std::isfinite(tree_mean_weight_ratio_max)))
     return Fail(why,
-                "tree_mean_weight_ratio_min must be in (0, 1) and "
-                "tree_mean_weight_ratio_max finite and > 1");
+                "merge.tree_mean_weight_ratio_min must be in (0, 1) and "
+                "merge.tree_mean_weight_ratio_max finite and > 1");
   if (!(max_collinearity_sin > 0 && max_collinearity_sin <= 1))
-    return Fail(why, "max_collinearity_sin must be in (0, 1]");
+    return Fail(why, "merge.max_collinearity_sin must be in (0, 1]");
   if (!(max_line_spacing_ratio >= 1 && std::isfinite(max_line_spacing_ratio)))
-    return Fail(why, "max_line_spacing_ratio must be finite and >= 1");
+    return Fail(why, "merge.max_line_spacing_ratio must be finite and >= 1");
   if (!(max_axis_deviation_deg > 0 && max_axis_deviation_deg <= 45))
-    return Fail(why, "max_axis_deviation_deg must be in (0, 45]");
+    return Fail(why, "merge.max_axis_deviation_deg must be in (0, 45]");
   if (!(max_axis_deviation_with_image_deg > 0 &&
         max_axis_deviation_with_image_deg <= 45))
-    return Fail(why, "max_axis_deviation_with_image_deg must be in (0, 45]");
+    return Fail(why,
+                "merge.max_axis_deviation_with_image_deg must be in (0, 45]");
   if (!(max_adjacency_deviation_with_image_deg > 0 &&
         max_adjacency_deviation_with_image_deg < 90))
-    return Fail(why,
-                "max_adjacency_deviation_with_image_deg must be in (0, 90)");
+    return Fail(
+        why, "merge.max_adjacency_deviation_with_image_deg must be in (0, 90)");
   if (!(max_adjacency_length_ratio >= 1 &&
         std::isfinite(max_adjacency_length_ratio)))
-    return Fail(why, "max_adjacency_length_ratio must be finite and >= 1");
+    return Fail(why,
+                "merge.max_adjacency_length_ratio must be finite and >= 1");
   if (!(max_axis_aspect_ratio >= 1 && std::isfinite(max_axis_aspect_ratio)))
-    return Fail(why, "max_axis_aspect_ratio must be finite and >= 1");
+    return Fail(why, "merge.max_axis_aspect_ratio must be finite and >= 1");
   if (kruskal_passes < 1 || kruskal_passes > 10)
-    return Fail(why, "kruskal_passes must be in [1, 10]");
-  if (!(side_offset_fraction > 0 && side_offset_fraction <= 0.5))
-    return Fail(why, "side_offset_fraction must be in (0, 0.5]");
-  if (!(side_min_contrast >= 0 && std::isfinite(side_min_contrast)))
-    return Fail(why, "side_min_contrast must be finite and >= 0");
+    return Fail(why, "merge.kruskal_passes must be in [1, 10]");
+  return true;
+}
+
+bool GridCleanupOptions::Check(std::string* why) const {
+  if (!(saddle_sample_fraction > 0 && saddle_sample_fraction <= 0.5))
+    return Fail(why, "cleanup.saddle_sample_fraction must be in (0, 0.5]");
   if (!(line_prediction_tolerance > 0 &&
         std::isfinite(line_prediction_tolerance)))
-    return Fail(why, "line_prediction_tolerance must be finite and > 0");
-  if (!(saddle_sample_fraction > 0 && saddle_sample_fraction <= 0.5))
-    return Fail(why, "saddle_sample_fraction must be in (0, 0.5]");
-  if (attach_rounds < 0 || attach_rounds > 100)
-    return Fail(why, "attach_rounds must be in [0, 100]");
-  if (!(attach_tolerance > 0 && attach_tolerance < 1))
-    return Fail(why, "attach_tolerance must be in (0, 1)");
-  if (!(attach_contradiction_tolerance >= attach_tolerance &&
-        attach_contradiction_tolerance < 1))
     return Fail(why,
-                "attach_contradiction_tolerance must be in [attach_tolerance, "
+                "cleanup.line_prediction_tolerance must be finite and > 0");
+  if (min_component_size < 1)
+    return Fail(why, "cleanup.min_component_size must be >= 1");
+  return true;
+}
+
+bool GridAttachOptions::Check(std::string* why) const {
+  if (rounds < 0 || rounds > 100)
+    return Fail(why, "attach.rounds must be in [0, 100]");
+  if (!(tolerance > 0 && tolerance < 1))
+    return Fail(why, "attach.tolerance must be in (0, 1)");
+  if (!(contradiction_tolerance >= tolerance && contradiction_tolerance < 1))
+    return Fail(why,
+                "attach.contradiction_tolerance must be in [attach.tolerance, "
                 "1)");
-  if (attach_min_support < 1 || attach_min_support > 8)
-    return Fail(why, "attach_min_support must be in [1, 8]");
+  if (min_support < 1 || min_support > 8)
+    return Fail(why, "attach.min_support must be in [1, 8]");
+  if (!(saddle_sample_fraction > 0 && saddle_sample_fraction <= 0.5))
+    return Fail(why, "attach.saddle_sample_fraction must be in (0, 0.5]");
   if (!(max_join_direction_deviation_deg > 0 &&
         max_join_direction_deviation_deg < 90))
-    return Fail(why, "max_join_direction_deviation_deg must be in (0, 90)");
+    return Fail(why,
+                "attach.max_join_direction_deviation_deg must be in (0, 90)");
   if (max_component_joins < 0 || max_component_joins > 1000)
-    return Fail(why, "max_component_joins must be in [0, 1000]");
-  if (!(attach_saddle_sample_fraction > 0 &&
-        attach_saddle_sample_fraction <= 0.5))
-    return Fail(why, "attach_saddle_sample_fraction must be in (0, 0.5]");
-  if (min_component_size < 1)
-    return Fail(why, "min_component_size must be >= 1");
+    return Fail(why, "attach.max_component_joins must be in [0, 1000]");
   return true;
+}
+
+bool GridOptions::Check(std::string* why) const {
+  return candidates.Check(why) && image_tests.Check(why) && merge.Check(why) &&
+         cleanup.Check(why) && attach.Check(why);
 }
 
 namespace {
@@ -183,10 +209,11 @@ GridNodes MakeGridNodes(const std::vector<Corner>& corners,
   for (int i = 0; i < n; ++i) {
     const Corner& c = corners[i];
     nodes.lattice.xy[i] = c.xy;
-    const bool ok = std::isfinite(c.xy.x()) && std::isfinite(c.xy.y()) &&
-                    std::abs(c.xy.x()) <= options.max_abs_coordinate_px &&
-                    std::abs(c.xy.y()) <= options.max_abs_coordinate_px &&
-                    std::isfinite(c.orientation);
+    const bool ok =
+        std::isfinite(c.xy.x()) && std::isfinite(c.xy.y()) &&
+        std::abs(c.xy.x()) <= options.candidates.max_abs_coordinate_px &&
+        std::abs(c.xy.y()) <= options.candidates.max_abs_coordinate_px &&
+        std::isfinite(c.orientation);
     if (!ok) {
       ++summary->num_invalid_corners;
       nodes.lattice.xy[i].setZero();
@@ -201,9 +228,10 @@ GridNodes MakeGridNodes(const std::vector<Corner>& corners,
     nodes.valid_xy.push_back(c.xy);
   }
   if (summary->num_invalid_corners > 0) {
-    summary->message = std::to_string(summary->num_invalid_corners) +
-                       " corners ignored (non-finite or beyond " +
-                       std::to_string(options.max_abs_coordinate_px) + " px)";
+    summary->message =
+        std::to_string(summary->num_invalid_corners) +
+        " corners ignored (non-finite or beyond " +
+        std::to_string(options.candidates.max_abs_coordinate_px) + " px)";
   }
   return nodes;
 }
@@ -242,7 +270,7 @@ std::vector<GridEdge> FilterPairs(const std::vector<std::pair<int, int>>& pairs,
   // Orientations are compared through their doubled angles:
   // sin^2(d) = (1 - cos(2 d)) / 2.
   const double min_abs_sin =
-      std::sin(options.min_orientation_difference_deg * M_PI / 180);
+      std::sin(options.candidates.min_orientation_difference_deg * M_PI / 180);
   const double max_cos_double = 1 - 2 * min_abs_sin * min_abs_sin;
   std::vector<GridEdge> edges;
   edges.reserve(pairs.size());
@@ -253,7 +281,7 @@ std::vector<GridEdge> FilterPairs(const std::vector<std::pair<int, int>>& pairs,
       continue;
     }
     const double length = (nodes.lattice.xy[b] - nodes.lattice.xy[a]).norm();
-    if (!(length >= options.min_edge_length_px) || length <= 0) {
+    if (!(length >= options.candidates.min_edge_length_px) || length <= 0) {
       ++summary->num_edges_too_short;
       continue;
     }
@@ -303,14 +331,14 @@ LatticeForest RunKruskal(const LatticeNodes& nodes,
   if (!image.empty()) {
     crosses_tile = [&](const GridEdge& edge) {
       return EdgeCrossesTile(image, nodes.xy[edge.a], nodes.xy[edge.b],
-                             options.intensity_samples,
-                             options.intensity_difference_fraction);
+                             options.image_tests.intensity_samples,
+                             options.image_tests.intensity_difference_fraction);
     };
-    if (options.side_min_contrast > 0) {
+    if (options.image_tests.side_min_contrast > 0) {
       sides_flip = [&](const GridEdge& edge) {
         return EdgeSidesFlip(image, nodes.xy[edge.a], nodes.xy[edge.b],
-                             options.side_offset_fraction,
-                             options.side_min_contrast);
+                             options.image_tests.side_offset_fraction,
+                             options.image_tests.side_min_contrast);
       };
     }
   }
@@ -350,7 +378,7 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
 
   auto phase_start = std::chrono::steady_clock::now();
   const std::vector<std::pair<int, int>> pairs =
-      CandidatePairs(nodes, options.num_neighbors);
+      CandidatePairs(nodes, options.candidates.num_neighbors);
   summary.num_candidate_edges = static_cast<int>(pairs.size());
   summary.neighbors_ms = MillisecondsSince(phase_start);
 

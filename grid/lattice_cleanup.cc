@@ -38,15 +38,15 @@ void ScoreCorner(const std::vector<Eigen::Vector2d>& xy, const Links& links,
       const Eigen::Vector2d predicted = 3 * xy[p1] - 3 * xy[p2] + xy[p3];
       const double spacing = (xy[p1] - xy[p2]).norm();
       ok = (xy[n] - predicted).norm() <=
-           options.line_prediction_tolerance * spacing;
+           options.cleanup.line_prediction_tolerance * spacing;
     } else {
       const Eigen::Vector2d v1 = xy[n] - xy[p1];
       const Eigen::Vector2d v2 = xy[p1] - xy[p2];
       const double n1 = v1.norm(), n2 = v2.norm();
       const double cross = v1.x() * v2.y() - v1.y() * v2.x();
-      const double r = options.max_line_spacing_ratio;
+      const double r = options.merge.max_line_spacing_ratio;
       ok = n1 > 0 && n2 > 0 && v1.dot(v2) > 0 &&
-           std::abs(cross) <= options.max_collinearity_sin * n1 * n2 &&
+           std::abs(cross) <= options.merge.max_collinearity_sin * n1 * n2 &&
            n1 <= r * n2 && n1 * r >= n2;
     }
     if (ok) {
@@ -248,7 +248,7 @@ bool PlacementLess(const Placement& x, const Placement& y) {
 // candidate edges between such a corner and a component corner. Rounds
 // repeat while corners join (a joined corner predicts the next one).
 // Then components join one another (see JoinOneComponent), and corners are
-// attached again, up to options.max_component_joins times.
+// attached again, up to options.attach.max_component_joins times.
 class AttachPass {
  public:
   AttachPass(const std::vector<Eigen::Vector2d>& xy, const cv::Mat& image,
@@ -323,9 +323,10 @@ bool AttachPass::Run() {
   }
   if (pairs_.empty() && num_components_ < 2) return false;
   bool any = false;
-  for (int joins = 0; joins <= options_.max_component_joins; ++joins) {
+  for (int joins = 0; joins <= options_.attach.max_component_joins; ++joins) {
     if (AttachOutsideCorners()) any = true;
-    if (joins == options_.max_component_joins || !JoinOneComponent()) break;
+    if (joins == options_.attach.max_component_joins || !JoinOneComponent())
+      break;
     ++summary_->num_components_joined;
     any = true;
   }
@@ -333,7 +334,7 @@ bool AttachPass::Run() {
 }
 
 // Appends the placements of corner u at the free labels next to corner m in
-// m's component where at least attach_min_support predictions hold and none
+// m's component where at least attach.min_support predictions hold and none
 // contradicts.
 void AttachPass::AddPlacements(int u, int m,
                                std::vector<Placement>* out) const {
@@ -345,9 +346,9 @@ void AttachPass::AddPlacements(int u, int m,
     if (lookup_.Find(c, tree, at) >= 0) continue;
     int supported, contradicted;
     const double error = PredictAt(
-        xy_, lookup_, c, tree, at, xy_[u], options_.attach_tolerance,
-        options_.attach_contradiction_tolerance, &supported, &contradicted);
-    if (supported >= options_.attach_min_support && contradicted == 0)
+        xy_, lookup_, c, tree, at, xy_[u], options_.attach.tolerance,
+        options_.attach.contradiction_tolerance, &supported, &contradicted);
+    if (supported >= options_.attach.min_support && contradicted == 0)
       out->push_back({error, u, c, tree, at});
   }
 }
@@ -356,7 +357,7 @@ void AttachPass::AddPlacements(int u, int m,
 bool AttachPass::AttachOutsideCorners() {
   std::vector<Placement> proposals;
   bool any = false;
-  for (int round = 0; round < options_.attach_rounds; ++round) {
+  for (int round = 0; round < options_.attach.rounds; ++round) {
     const int joined = AttachRound(&proposals);
     if (joined == 0) break;
     summary_->num_attached += joined;
@@ -444,9 +445,9 @@ bool AttachPass::TryAttach(const Placement& p) {
   for (int d = 0; d < 4; ++d)
     links_[p.u][d] = lookup_.Find(p.c, p.tree, p.at + LatticeStep(d));
   if (!LooksLikeSaddle(xy_, image_, links_, p.u,
-                       options_.saddle_sample_fraction) &&
+                       options_.cleanup.saddle_sample_fraction) &&
       !LooksLikeSaddle(xy_, image_, links_, p.u,
-                       options_.attach_saddle_sample_fraction)) {
+                       options_.attach.saddle_sample_fraction)) {
     for (int d = 0; d < 4; ++d) links_[p.u][d] = -1;
     component_of_[p.u] = previous;
     labels_[p.u] = forest_.label[p.u];
@@ -543,8 +544,8 @@ bool AttachPass::MovingStep(int base, int k, Eigen::Vector2d* v) const {
 
 // The one lattice symmetry under which the image directions of the joining
 // component at the place (r) and of the moving one at the corner (w) agree
-// within max_join_direction_deviation_deg on both axes (directions from the
-// place's own neighbours, else from a neighbour across). False when none or
+// within attach.max_join_direction_deviation_deg on both axes (directions from
+// the place's own neighbours, else from a neighbour across). False when none or
 // several do.
 bool AttachPass::JoinSymmetry(const Placement& place,
                               Dihedral* symmetry) const {
@@ -563,7 +564,7 @@ bool AttachPass::JoinSymmetry(const Placement& place,
                MovingStep(links_[u][Mod4(k + 3)], k, &w[k]);
   }
   const double min_cosine =
-      std::cos(options_.max_join_direction_deviation_deg * M_PI / 180);
+      std::cos(options_.attach.max_join_direction_deviation_deg * M_PI / 180);
   int found = 0;
   for (int sign : {1, -1}) {
     for (int shift = 0; shift < 4; ++shift) {
@@ -617,8 +618,8 @@ bool AttachPass::SeamHolds(const Placement& place,
     if (!seam) continue;
     int supported, contradicted;
     PredictAt(xy_, lookup_, place.c, place.tree, target[q], xy_[members[q]],
-              options_.attach_tolerance,
-              options_.attach_contradiction_tolerance, &supported,
+              options_.attach.tolerance,
+              options_.attach.contradiction_tolerance, &supported,
               &contradicted);
     if (!(contradicted == 0 || supported > contradicted)) return false;
   }
@@ -650,7 +651,8 @@ void RemoveNonSaddles(const std::vector<Eigen::Vector2d>& xy,
                       std::vector<char>* alive, GridSummary* summary) {
   std::vector<int> not_saddle;
   for (int i : members) {
-    if (!LooksLikeSaddle(xy, image, *links, i, options.saddle_sample_fraction))
+    if (!LooksLikeSaddle(xy, image, *links, i,
+                         options.cleanup.saddle_sample_fraction))
       not_saddle.push_back(i);
   }
   for (int i : not_saddle) {
@@ -687,7 +689,8 @@ void RemoveUnpredicted(const std::vector<Eigen::Vector2d>& xy,
 
 // Splits the live corners into 4-connected label sets: `component_of` gets a
 // component number per corner (-1: not alive, -3: in a set below
-// options.min_component_size, dropped); returns that many empty components.
+// options.cleanup.min_component_size, dropped); returns that many empty
+// components.
 std::vector<GridComponent> SplitComponents(const std::vector<int>& members,
                                            const Links& links,
                                            const std::vector<char>& alive,
@@ -712,7 +715,7 @@ std::vector<GridComponent> SplitComponents(const std::vector<int>& members,
       }
     }
     int id = -3;  // dropped
-    if (static_cast<int>(queue.size()) < options.min_component_size) {
+    if (static_cast<int>(queue.size()) < options.cleanup.min_component_size) {
       ++summary->num_components_dropped;
     } else {
       id = static_cast<int>(components.size());
@@ -774,7 +777,7 @@ std::vector<GridComponent> ExtractComponents(
       links[i][d] =
           forest.table.Find(forest.tree[i], forest.label[i] + LatticeStep(d));
   }
-  if (!image.empty() && options.check_saddle_pattern)
+  if (!image.empty() && options.cleanup.check_saddle_pattern)
     RemoveNonSaddles(xy, image, members, options, &links, &alive, summary);
   RemoveUnpredicted(xy, members, options, &links, &alive, summary);
 
@@ -782,7 +785,7 @@ std::vector<GridComponent> ExtractComponents(
   std::vector<GridComponent> components =
       SplitComponents(members, links, alive, options, &component_of, summary);
   std::vector<Eigen::Vector2i> attached_label;
-  if (!image.empty() && options.attach_rounds > 0 && !components.empty()) {
+  if (!image.empty() && options.attach.rounds > 0 && !components.empty()) {
     AttachPass pass(xy, image, forest, edges, options,
                     static_cast<int>(components.size()), &links, &component_of,
                     summary);

@@ -18,10 +18,10 @@ namespace puzzlecal {
 // whose lattice lines
 // contradict them more often than they support them (repeatedly), splits
 // trees into 4-connected label sets, drops sets smaller than
-// options.min_component_size, then (with an image) attaches corners outside
-// every component where a component's lattice predicts them (`edges`: the
-// candidate edges, which pair them with component corners), shifts labels to
-// start at (0, 0) and sorts the components (largest first, ties by smallest
+// options.cleanup.min_component_size, then (with an image) attaches corners
+// outside every component where a component's lattice predicts them (`edges`:
+// the candidate edges, which pair them with component corners), shifts labels
+// to start at (0, 0) and sorts the components (largest first, ties by smallest
 // corner index).
 std::vector<GridComponent> ExtractComponents(
     const std::vector<Eigen::Vector2d>& xy, const cv::Mat& image,

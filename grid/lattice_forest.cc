@@ -34,7 +34,7 @@ class Forest {
         options_(options),
         min_axis_cosine_(std::cos(max_axis_deviation_deg * M_PI / 180)),
         adjacency_cosine_(std::cos(
-            options.max_adjacency_deviation_with_image_deg * M_PI / 180)),
+            options.merge.max_adjacency_deviation_with_image_deg * M_PI / 180)),
         image_check_(image_check),
         table_(static_cast<int>(nodes.xy.size())) {
     const int n = static_cast<int>(nodes.xy.size());
@@ -155,16 +155,16 @@ class Forest {
   }
 
   // The distance of a new lattice neighbour in own-axis direction k of `node`
-  // fits the tree edges there: within max_adjacency_length_ratio of those on
-  // the same line, else within max_axis_aspect_ratio of those across, else
-  // within max_adjacency_length_ratio of `fallback`.
+  // fits the tree edges there: within merge.max_adjacency_length_ratio of those
+  // on the same line, else within merge.max_axis_aspect_ratio of those across,
+  // else within merge.max_adjacency_length_ratio of `fallback`.
   bool LengthFits(int node, int k, double dist, double fallback) const {
     double ref = LineEdgeLength(node, k);
-    double r = options_.max_adjacency_length_ratio;
+    double r = options_.merge.max_adjacency_length_ratio;
     if (ref == 0) {
       ref = LineEdgeLength(node, k + 1);
       if (ref > 0) {
-        r = options_.max_axis_aspect_ratio;
+        r = options_.merge.max_axis_aspect_ratio;
       } else {
         ref = fallback;
       }
@@ -181,10 +181,11 @@ class Forest {
     if (!(n1 > 0 && n2 > 0)) return false;
     const double cross = v1.x() * v2.y() - v1.y() * v2.x();
     if (v1.dot(v2) <= 0) return false;
-    if (std::abs(cross) > options_.max_collinearity_sin * n1 * n2) return false;
+    if (std::abs(cross) > options_.merge.max_collinearity_sin * n1 * n2)
+      return false;
     const double ratio = n2 / n1;
-    return ratio <= options_.max_line_spacing_ratio &&
-           ratio * options_.max_line_spacing_ratio >= 1.0;
+    return ratio <= options_.merge.max_line_spacing_ratio &&
+           ratio * options_.merge.max_line_spacing_ratio >= 1.0;
   }
 
   // n (in the tree being moved, new frame `frame_n`) and m (in the kept tree)
@@ -207,8 +208,8 @@ class Forest {
 
   // AdjacencyAgrees for a step near 45 degrees to an axis estimate: with the
   // image, the frames say which own direction to expect at either end; the
-  // step must lie within max_adjacency_deviation_with_image_deg of both, the
-  // parities must differ, the lengths fit, and the image must show a tile
+  // step must lie within merge.max_adjacency_deviation_with_image_deg of both,
+  // the parities must differ, the lengths fit, and the image must show a tile
   // edge between the two corners (which keeps out tile diagonals and
   // "knight" steps). Without the image such a step is refused.
   bool AmbiguousAdjacencyAgrees(int n, const Dihedral& frame_n, int m, int d,
@@ -308,7 +309,7 @@ Refusal Forest::ClassifyJoiningEdge(MergePlan* plan) const {
 // line only: steep views legitimately foreshorten one axis by more than
 // the ratio, so edges of the other axis are not compared.
 bool Forest::NeighborWeightsFit(const MergePlan& plan) const {
-  const double wr = options_.neighbor_weight_ratio;
+  const double wr = options_.merge.neighbor_weight_ratio;
   const double w = plan.weight;
   for (const auto& [x, k] :
        {std::pair{plan.a, plan.at_a.k}, std::pair{plan.b, plan.at_b.k}}) {
@@ -366,8 +367,8 @@ bool Forest::TreeMeanWeightsFit(const MergePlan& plan) const {
     const double ratio =
         (weight_sum_[ra][axis] / edge_count_[ra][axis]) /
         (weight_sum_[rb][moved_axis] / edge_count_[rb][moved_axis]);
-    if (!(ratio > options_.tree_mean_weight_ratio_min &&
-          ratio < options_.tree_mean_weight_ratio_max))
+    if (!(ratio > options_.merge.tree_mean_weight_ratio_min &&
+          ratio < options_.merge.tree_mean_weight_ratio_max))
       return false;
   }
   return true;
@@ -557,10 +558,10 @@ RefusedEdges KruskalPasses::FirstPass(
       continue;
     }
     if (!from_heap && crosses_tile_ && crosses_tile_(edge)) {
-      edge.weight *= options_.penalty_factor;
+      edge.weight *= options_.image_tests.penalty_factor;
       edge.penalised = true;
       ++summary_->num_edges_penalised;
-      if (options_.refuse_penalised_edges) {
+      if (options_.image_tests.refuse_penalised_edges) {
         CountDecision(Refusal::kPenalised, summary_);
         RecordDecision(edge, Refusal::kPenalised, trace_);
         continue;
@@ -595,8 +596,8 @@ void KruskalPasses::Decide(const GridEdge& edge, RefusedEdges* refused) {
 // Later passes retry the refused edges (the trees have grown since), while
 // any merges.
 void KruskalPasses::Retry(RefusedEdges refused) {
-  for (int pass = 1; pass < options_.kruskal_passes && !refused.edges.empty();
-       ++pass) {
+  for (int pass = 1;
+       pass < options_.merge.kruskal_passes && !refused.edges.empty(); ++pass) {
     RefusedEdges still_refused;
     int merges_this_pass = 0;
     for (size_t e = 0; e < refused.edges.size(); ++e) {
@@ -627,7 +628,8 @@ void BuildLatticeForest(
     std::vector<GridEdgeTrace>* trace) {
   // With the intensity test refusing tile-crossing edges, the ambiguity band
   // around 45 degrees can be narrower (GridOptions).
-  const bool image_guard = crosses_tile && options.refuse_penalised_edges;
+  const bool image_guard =
+      crosses_tile && options.image_tests.refuse_penalised_edges;
   std::function<bool(const GridEdge&)> image_check;
   if (image_guard) {
     image_check = [&](const GridEdge& edge) {
@@ -635,8 +637,8 @@ void BuildLatticeForest(
     };
   }
   Forest state(nodes, options,
-               image_guard ? options.max_axis_deviation_with_image_deg
-                           : options.max_axis_deviation_deg,
+               image_guard ? options.merge.max_axis_deviation_with_image_deg
+                           : options.merge.max_axis_deviation_deg,
                image_guard ? &image_check : nullptr);
   if (trace != nullptr) trace->clear();
   KruskalPasses passes(crosses_tile, sides_flip, options, &state, summary,

@@ -79,10 +79,9 @@ CellGrid MakeCellGrid(const std::vector<Eigen::Vector2d>& points) {
   const double y_hi = Quantile(&coords, 0.99);
   const double width = std::max(x_hi - g.x_lo, 1e-9);
   const double height = std::max(y_hi - g.y_lo, 1e-9);
-  // About one point per cell (measured fastest on 3204- and 3744-corner
-  // boards against 0.5, 0.7, 2, 3.3 and 4.5 points): few candidates per
-  // cell, and the per-cell pruning against the current k-th distance skips
-  // most of the second ring.
+  // About one point per cell: few candidates per cell, and the per-cell
+  // pruning against the current k-th distance skips most of the second
+  // ring.
   double cell = std::sqrt(width * height / n);
   if (!(cell > 0)) cell = std::max(width, height);
   constexpr int kMaxCellsPerAxis = 4096;
