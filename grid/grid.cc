@@ -154,9 +154,22 @@ bool GridAttachOptions::Check(std::string* why) const {
   return true;
 }
 
+bool GridOffLatticeOptions::Check(std::string* why) const {
+  if (!(tolerance > 0 && tolerance < 1))
+    return Fail(why, "off_lattice.tolerance must be in (0, 1)");
+  if (!(agreement > 0 && agreement <= tolerance))
+    return Fail(why,
+                "off_lattice.agreement must be in (0, off_lattice.tolerance]");
+  if (min_agreeing < 2 || min_agreeing > 10)
+    return Fail(why, "off_lattice.min_agreeing must be in [2, 10]");
+  if (max_rounds < 1 || max_rounds > 10)
+    return Fail(why, "off_lattice.max_rounds must be in [1, 10]");
+  return true;
+}
+
 bool GridOptions::Check(std::string* why) const {
   return candidates.Check(why) && image_tests.Check(why) && merge.Check(why) &&
-         cleanup.Check(why) && attach.Check(why);
+         cleanup.Check(why) && attach.Check(why) && off_lattice.Check(why);
 }
 
 namespace {

@@ -14,7 +14,10 @@
 // - a final pass removes corners that their lattice lines do not predict and
 //   splits components that fall apart; then, with an image, corners left out
 //   join a component, and components join one another, where the lattice
-//   around a free label predicts them.
+//   around a free label predicts them;
+// - last, a corner removed where the predictions of its neighbours agree
+//   with each other but not with it (a false corner at a lattice position
+//   whose corner was not detected).
 
 #include <opencv2/core.hpp>
 #include <string>
@@ -218,13 +221,49 @@ struct GridAttachOptions {
   bool Check(std::string* why = nullptr) const;
 };
 
+// After the attach pass, every labelled corner must lie where the lattice
+// of its neighbours puts it: a false corner (clutter, a blob or a junction
+// next to a lattice position whose corner was not detected) can pass the
+// merge and line checks where only a few short lines reach it (at the rim
+// of a fisheye view, next to occluders). Predictions of a corner from its
+// neighbours (itself not used): per lattice line, interpolation between the
+// neighbours on both sides and quadratic extrapolation from each side with
+// three corners; per tile at the corner, the parallelogram of its three
+// other corners.
+struct GridOffLatticeOptions {
+  // Run the check. Default true.
+  bool enabled = true;
+  // A corner is removed when it lies farther than this fraction of the
+  // local spacing from the mean of the agreeing predictions (below).
+  // Default 0.3: a third of the way to the next lattice position, above the
+  // spread of true corners (detector noise amplified 1-4 times by the
+  // predictions, perspective and fisheye curvature the quadratic terms
+  // leave); in (0, 1).
+  double tolerance = 0.3;
+  // The agreeing predictions: those within this fraction of their spacing
+  // of one of them, the largest such group (the neighbours agree with each
+  // other, so the corner and not a neighbour is off). Default 0.15; in
+  // (0, tolerance].
+  double agreement = 0.15;
+  // The corner is judged only when at least this many predictions agree and
+  // they are more than half of all its predictions. Default 2 (two
+  // independent predictions); in [2, 10].
+  int min_agreeing = 2;
+  // Rounds of removal (a removal changes its neighbours' predictions).
+  // Default 3; in [1, 10].
+  int max_rounds = 3;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
 // The options of BuildGrid, one group per stage in the order they run.
 struct GridOptions {
-  GridCandidateOptions candidates;   // k-NN candidate edges and their filters
-  GridEdgeImageOptions image_tests;  // intensity penalty, sides test (image)
-  GridMergeOptions merge;            // Kruskal's merge checks
-  GridCleanupOptions cleanup;        // removal of unpredicted corners, split
-  GridAttachOptions attach;          // late joins of corners and components
+  GridCandidateOptions candidates;    // k-NN candidate edges and their filters
+  GridEdgeImageOptions image_tests;   // intensity penalty, sides test (image)
+  GridMergeOptions merge;             // Kruskal's merge checks
+  GridCleanupOptions cleanup;         // removal of unpredicted corners, split
+  GridAttachOptions attach;           // late joins of corners and components
+  GridOffLatticeOptions off_lattice;  // final check of every labelled corner
 
   // False with a reason (naming the group and field) when a field is out of
   // range.
@@ -264,6 +303,7 @@ struct GridSummary {
   int num_removed_not_saddle = 0;     // tiles around it do not alternate
   int num_removed_by_prediction = 0;  // corners their lines did not predict
   int num_attached = 0;               // joined by the attach pass
+  int num_removed_off_lattice = 0;    // off the lattice of its neighbours
   int num_components_joined = 0;      // joined by the attach pass
   int num_components_dropped = 0;     // below cleanup.min_component_size
   int num_components = 0;             // returned

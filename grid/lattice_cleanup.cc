@@ -135,6 +135,127 @@ void Unlink(Links* links, int i) {
   }
 }
 
+// One prediction of a corner's position from its lattice neighbours, with
+// the local spacing its error is measured in.
+struct Prediction {
+  Eigen::Vector2d xy;
+  double spacing;
+};
+
+// The predictions of corner n from its lattice neighbours (n itself not
+// used): per lattice line, interpolation between the neighbours on both
+// sides (cubic or quadratic through a third or fourth corner when there is
+// one) and quadratic extrapolation from each side with three corners; per
+// tile at n, the parallelogram of its three other corners.
+int PredictFromNeighbors(const std::vector<Eigen::Vector2d>& xy,
+                         const Links& links, int n, Prediction out[12]) {
+  int count = 0;
+  auto add = [&](const Eigen::Vector2d& p, double spacing) {
+    if (spacing > 0) out[count++] = {p, spacing};
+  };
+  for (int d = 0; d < 4; ++d) {
+    const int p1 = links[n][d];
+    if (p1 < 0) continue;
+    const int p2 = links[p1][d];
+    const int p3 = p2 >= 0 ? links[p2][d] : -1;
+    if (p3 >= 0)
+      add(3 * xy[p1] - 3 * xy[p2] + xy[p3], (xy[p1] - xy[p2]).norm());
+    const int q1 = links[n][Mod4(d + 2)];
+    if (d < 2 && q1 >= 0) {
+      // Lagrange interpolation at t = 0 through t = -2, -1, 1, 2 (as many as
+      // exist on the line).
+      const int q2 = links[q1][Mod4(d + 2)];
+      const double spacing = 0.5 * (xy[p1] - xy[q1]).norm();
+      if (p2 >= 0 && q2 >= 0) {
+        add((4 * (xy[p1] + xy[q1]) - xy[p2] - xy[q2]) / 6, spacing);
+      } else if (p2 >= 0) {
+        add(xy[q1] / 3 + xy[p1] - xy[p2] / 3, spacing);
+      } else if (q2 >= 0) {
+        add(xy[p1] / 3 + xy[q1] - xy[q2] / 3, spacing);
+      } else {
+        add(0.5 * (xy[p1] + xy[q1]), spacing);
+      }
+    }
+    const int b = links[n][Mod4(d + 1)];
+    if (b < 0) continue;
+    const int m = links[p1][Mod4(d + 1)];
+    if (m < 0 || links[b][d] != m) continue;
+    add(xy[p1] + xy[b] - xy[m],
+        std::min((xy[p1] - xy[m]).norm(), (xy[b] - xy[m]).norm()));
+  }
+  return count;
+}
+
+// Corner n sits off the lattice its neighbours predict: at least
+// off_lattice.min_agreeing of its predictions, and more than half of them,
+// agree with one another (within off_lattice.agreement of their spacing),
+// and n lies farther than off_lattice.tolerance of their mean spacing from
+// their mean. `error` gets that distance over the spacing (0 when too few
+// agree).
+bool OffLattice(const std::vector<Eigen::Vector2d>& xy, const Links& links,
+                int n, const GridOffLatticeOptions& options, double* error) {
+  *error = 0;
+  Prediction predictions[12];
+  const int count = PredictFromNeighbors(xy, links, n, predictions);
+  if (count < options.min_agreeing) return false;
+  // The largest group of predictions agreeing with one of them.
+  int best_size = 0;
+  Eigen::Vector2d best_mean = Eigen::Vector2d::Zero();
+  double best_spacing = 0;
+  for (int i = 0; i < count; ++i) {
+    int size = 0;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    double spacing = 0;
+    for (int j = 0; j < count; ++j) {
+      const double s = std::min(predictions[i].spacing, predictions[j].spacing);
+      if ((predictions[i].xy - predictions[j].xy).norm() >
+          options.agreement * s)
+        continue;
+      ++size;
+      sum += predictions[j].xy;
+      spacing += predictions[j].spacing;
+    }
+    if (size > best_size) {
+      best_size = size;
+      best_mean = sum / size;
+      best_spacing = spacing / size;
+    }
+  }
+  if (best_size < options.min_agreeing || 2 * best_size <= count) return false;
+  *error = (xy[n] - best_mean).norm() / best_spacing;
+  return *error > options.tolerance;
+}
+
+// Removes corners off the lattice their neighbours predict (OffLattice), in
+// rounds (all judged on the links before a round's removals): a false
+// corner next to a lattice position whose corner was not detected, which
+// passed the merge and line checks where only few predictions exist.
+// Returns how many were removed.
+int RemoveOffLatticeCorners(const std::vector<Eigen::Vector2d>& xy,
+                            const std::vector<int>& members,
+                            const GridOffLatticeOptions& options, Links* links,
+                            std::vector<int>* component_of,
+                            GridSummary* summary) {
+  int removed = 0;
+  std::vector<int> removals;
+  for (int round = 0; round < options.max_rounds; ++round) {
+    removals.clear();
+    for (int i : members) {
+      if ((*component_of)[i] < 0) continue;
+      double error;
+      if (OffLattice(xy, *links, i, options, &error)) removals.push_back(i);
+    }
+    if (removals.empty()) break;
+    for (int i : removals) {
+      Unlink(links, i);
+      (*component_of)[i] = -1;
+    }
+    removed += static_cast<int>(removals.size());
+  }
+  summary->num_removed_off_lattice += removed;
+  return removed;
+}
+
 // Lattice position lookup of one component during the attach pass: the
 // forest's table for corners still at their tree's labels, a hash map for
 // attached and moved ones.
@@ -708,7 +829,7 @@ std::vector<GridComponent> SplitComponents(const std::vector<int>& members,
     (*component_of)[seed] = -2;
     for (size_t q = 0; q < queue.size(); ++q) {
       for (int m : links[queue[q]]) {
-        if (m >= 0 && (*component_of)[m] == -1) {
+        if (m >= 0 && alive[m] && (*component_of)[m] == -1) {
           (*component_of)[m] = -2;
           queue.push_back(m);
         }
@@ -790,6 +911,15 @@ std::vector<GridComponent> ExtractComponents(
                     static_cast<int>(components.size()), &links, &component_of,
                     summary);
     if (pass.Run()) attached_label = std::move(pass.labels());
+  }
+  if (options.off_lattice.enabled &&
+      RemoveOffLatticeCorners(xy, members, options.off_lattice, &links,
+                              &component_of, summary) > 0) {
+    // Components may have fallen apart.
+    std::vector<char> kept(n, 0);
+    for (int i : members) kept[i] = component_of[i] >= 0;
+    components =
+        SplitComponents(members, links, kept, options, &component_of, summary);
   }
   FinishComponents(members, component_of,
                    attached_label.empty() ? forest.label : attached_label,
