@@ -394,6 +394,7 @@ TEST(GridTest, EachOptionGroupChecksItsFields) {
   EXPECT_TRUE(GridMergeOptions().Check(&why)) << why;
   EXPECT_TRUE(GridCleanupOptions().Check(&why)) << why;
   EXPECT_TRUE(GridAttachOptions().Check(&why)) << why;
+  EXPECT_TRUE(GridOffLatticeOptions().Check(&why)) << why;
   struct Case {
     void (*spoil)(GridOptions*);
     const char* name;
@@ -411,6 +412,8 @@ TEST(GridTest, EachOptionGroupChecksItsFields) {
        "cleanup.min_component_size"},
       {[](GridOptions* o) { o->attach.contradiction_tolerance = 0.2; },
        "attach.contradiction_tolerance"},
+      {[](GridOptions* o) { o->off_lattice.agreement = 0.5; },
+       "off_lattice.agreement"},
   };
   for (const Case& c : cases) {
     GridOptions options;
