@@ -198,6 +198,20 @@ bool OffLattice(const std::vector<Eigen::Vector2d>& xy, const Links& links,
   Prediction predictions[12];
   const int count = PredictFromNeighbors(xy, links, n, predictions);
   if (count < options.min_agreeing) return false;
+  // Any group's mean lies within agreement * s_i of its centre P_i and its
+  // mean spacing is at least the smallest spacing: a corner within
+  // tolerance * s_min - agreement * s_i of every P_i stays (the common case,
+  // without the grouping below).
+  double min_spacing = predictions[0].spacing;
+  for (int i = 1; i < count; ++i)
+    min_spacing = std::min(min_spacing, predictions[i].spacing);
+  bool near_all = true;
+  for (int i = 0; i < count && near_all; ++i) {
+    near_all = (xy[n] - predictions[i].xy).norm() +
+                   options.agreement * predictions[i].spacing <=
+               options.tolerance * min_spacing;
+  }
+  if (near_all) return false;
   // The largest group of predictions agreeing with one of them.
   int best_size = 0;
   Eigen::Vector2d best_mean = Eigen::Vector2d::Zero();
