@@ -23,6 +23,9 @@
 #include "apps/subcommand.h"
 #include "calib/calibrate.h"
 #include "calib/camera_yaml.h"
+#include "calib/evidence.h"
+#include "calib/model_selection.h"
+#include "calib/verdict.h"
 
 namespace puzzlecal {
 namespace {
@@ -109,10 +112,11 @@ int RunCalibrate() {
                  "required. Run `puzzlecal calibrate --help`.\n";
     return kExitUsage;
   }
-  CameraModelId model;
-  if (!CameraModelIdFromName(FLAGS_model, &model)) {
+  CameraModelId model = CameraModelId::kPinholeRadtan;
+  const bool auto_model = FLAGS_model == "auto";
+  if (!auto_model && !CameraModelIdFromName(FLAGS_model, &model)) {
     std::cerr << "puzzlecal calibrate: unknown model '" << FLAGS_model
-              << "'; choose one of " << CameraModelNames() << ".\n";
+              << "'; choose one of " << CameraModelNames() << " or auto.\n";
     return kExitUsage;
   }
   CameraFileFormat format;
@@ -183,12 +187,35 @@ int RunCalibrate() {
 
   const auto calib_start = std::chrono::steady_clock::now();
   CalibrationOptions calibration_options;
+  // --model auto: the candidate with the lowest held-out error
+  // (calib/model_selection.h).
+  ModelSelection selection;
+  if (auto_model) {
+    if (!SelectModel(views, width, height, calibration_options,
+                     ModelSelectionOptions(), &selection, &error)) {
+      std::cerr << selection.Table() << "puzzlecal calibrate: " << error
+                << "\n";
+      return kExitNoResult;
+    }
+    std::cout << selection.Table();
+    model = selection.candidates[selection.chosen].model;
+  }
   CalibrationResult result;
   std::string calibration_error;
   const bool calibrated =
       Calibrate(views, model, width, height, calibration_options, &result,
                 &calibration_error);
   const double seconds_calibrate = SecondsSince(calib_start);
+  // Evidence (halves, uncertainty, binned residuals) and the verdict made
+  // from it (calib/evidence.h, calib/verdict.h).
+  const EvidenceOptions evidence_options;
+  Evidence evidence;
+  Verdict verdict;
+  if (calibrated) {
+    evidence = ComputeEvidence(views, result, calibration_options,
+                               evidence_options);
+    verdict = MakeVerdict(result, evidence, evidence_options, VerdictOptions());
+  }
 
   const std::vector<ReportImage> report_images =
       ReportLines(images, view_of_image, calibrated ? &result : nullptr);
@@ -212,6 +239,11 @@ int RunCalibrate() {
     input.seconds_calibrate = seconds_calibrate;
     input.seconds_total = SecondsSince(run_start);
     input.threads = threads;
+    if (calibrated) {
+      input.evidence = &evidence;
+      input.verdict = &verdict;
+    }
+    if (auto_model) input.model_selection = selection.Table();
     if (!WriteReport(FLAGS_report, input, ReportOptions(), &error)) {
       std::cerr << "puzzlecal calibrate: report not written: " << error << "\n";
       // A failed calibration stays the outcome that matters.
@@ -223,7 +255,7 @@ int RunCalibrate() {
               << calibration_error << "\n";
     return kExitNoResult;
   }
-  if (!WriteCameraFile(FLAGS_out, format, result, &error)) {
+  if (!WriteCameraFile(FLAGS_out, format, result, &error, verdict.Line())) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitOutputError;
   }
@@ -239,6 +271,10 @@ int RunCalibrate() {
             << " s, detection " << seconds_detect << " s, grid and decode "
             << seconds_grid_decode << " s; calibration " << seconds_calibrate
             << " s\n";
+  std::cout << EvidenceText(evidence) << std::setprecision(3)
+            << "evidence: " << evidence.seconds << " s (halves "
+            << evidence.cross_validation.seconds << " s)\n";
+  std::cout << verdict.Line() << "\n";
   std::cout << "wrote " << FLAGS_out << "\n";
   return kExitOk;
 }

@@ -94,6 +94,9 @@ std::string FormatPuzzlecal(const Camera& camera,
     out << YAML::Key << "views_used" << YAML::Value << stats.num_views_used;
     out << YAML::Key << "corners_used" << YAML::Value << stats.num_corners_used;
     out << YAML::Key << "outliers" << YAML::Value << stats.num_outliers;
+    if (!stats.verdict.empty()) {
+      out << YAML::Key << "verdict" << YAML::Value << stats.verdict;
+    }
   }
   out << YAML::EndMap;
   return std::string("# puzzlecal camera calibration\n") + out.c_str() + "\n";
@@ -573,8 +576,10 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
 }
 
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
-                     const CalibrationResult& result, std::string* error) {
+                     const CalibrationResult& result, std::string* error,
+                     const std::string& verdict) {
   CameraFileStats stats;
+  stats.verdict = verdict;
   stats.has_stats = true;
   stats.param_stddev = result.param_stddev;
   stats.rms_px = result.rms_px;

@@ -36,6 +36,8 @@ struct CameraFileStats {
   int num_views_used = 0;
   int num_corners_used = 0;
   int num_outliers = 0;
+  // The calibration's verdict line (calib/verdict.h); "" writes none.
+  std::string verdict;
 };
 
 // Name written into the ros format's camera_name.
@@ -51,9 +53,11 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      const Camera& camera, const CameraFileStats& stats,
                      std::string* error);
-// The same for a calibration result (camera and its statistics).
+// The same for a calibration result (camera and its statistics) and,
+// when not empty, its verdict line.
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
-                     const CalibrationResult& result, std::string* error);
+                     const CalibrationResult& result, std::string* error,
+                     const std::string& verdict = "");
 
 // Parses camera file text in any of the four formats; `source` names the
 // text in messages. `format` (optional) returns the format found.
