@@ -902,6 +902,10 @@ cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
     }
     return map.At(fx < 0.5 ? i0 : i1, fy < 0.5 ? j0 : j1);
   };
+  cv::Mat lut(256, 1, CV_8UC1);
+  for (int i = 0; i < 256; ++i) lut.at<uint8_t>(i) = static_cast<uint8_t>(i);
+  cv::Mat lut_colour;
+  cv::applyColorMap(lut, lut_colour, cv::COLORMAP_VIRIDIS);
   if (map.cols > 0 && map.rows > 0) {
     for (int v = 0; v < a.height; ++v) {
       for (int u = 0; u < a.width; ++u) {
@@ -910,11 +914,8 @@ cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
         const double value = value_at(x, y);
         cv::Vec3b colour(170, 170, 170);
         if (std::isfinite(value)) {
-          const cv::Scalar c = plot::ColourMapValue(cv::COLORMAP_VIRIDIS,
-                                                    value / colour_max);
-          colour = cv::Vec3b(static_cast<uint8_t>(c[0]),
-                             static_cast<uint8_t>(c[1]),
-                             static_cast<uint8_t>(c[2]));
+          colour = lut_colour.at<cv::Vec3b>(static_cast<int>(
+              std::lround(std::clamp(value / colour_max, 0.0, 1.0) * 255)));
         }
         canvas.at<cv::Vec3b>(a.y + v, a.x + u) = colour;
       }

@@ -2,6 +2,7 @@
 
 #include <ceres/jet.h>
 
+#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
@@ -45,24 +46,43 @@ double FieldAngleDeg(const Eigen::Vector3d& ray) {
   return std::atan2(ray.head<2>().norm(), ray.z()) / kDeg;
 }
 
-// d pixel / d intrinsics of Model::Project at a fixed ray, by automatic
-// differentiation.
+// d pixel / d intrinsics (jacobian, 2 x n) and d pixel / d point (point, 2 x
+// 3) of Model::Project at `ray`, by automatic differentiation.
 template <typename Model>
-bool ProjectionJacobian(const double* params, const Eigen::Vector3d& ray,
-                        Eigen::MatrixXd* jacobian) {
+bool ProjectionJacobians(const double* params, const Eigen::Vector3d& ray,
+                         Eigen::MatrixXd* jacobian, Eigen::Matrix<double, 2, 3>* point) {
   constexpr int kN = Model::kNumParams;
-  using JetT = ceres::Jet<double, kN>;
+  using JetT = ceres::Jet<double, kN + 3>;
   JetT p[kN];
   for (int k = 0; k < kN; ++k) p[k] = JetT(params[k], k);
-  const JetT point[3] = {JetT(ray.x()), JetT(ray.y()), JetT(ray.z())};
+  const JetT x[3] = {JetT(ray.x(), kN), JetT(ray.y(), kN + 1),
+                     JetT(ray.z(), kN + 2)};
   JetT pixel[2];
-  if (!Model::Project(p, point, pixel)) return false;
+  if (!Model::Project(p, x, pixel)) return false;
   jacobian->resize(2, kN);
-  for (int k = 0; k < kN; ++k) {
-    (*jacobian)(0, k) = pixel[0].v[k];
-    (*jacobian)(1, k) = pixel[1].v[k];
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < kN; ++k) (*jacobian)(r, k) = pixel[r].v[k];
+    for (int k = 0; k < 3; ++k) (*point)(r, k) = pixel[r].v[kN + k];
   }
-  return jacobian->allFinite();
+  return jacobian->allFinite() && point->allFinite();
+}
+
+// At `pixel`: J = d pixel / d intrinsics with the ray held fixed, and G =
+// d pixel / d omega for a small rotation omega of the ray (ray + omega x ray).
+bool PixelJacobians(const Camera& camera, const Eigen::Vector2d& pixel,
+                    Eigen::MatrixXd* jacobian, Eigen::Matrix<double, 2, 3>* g) {
+  Eigen::Vector3d ray;
+  if (!camera.Unproject(pixel, &ray).converged) return false;
+  Eigen::Matrix<double, 2, 3> point;
+  const bool ok = DispatchCameraModel(camera.model, [&](auto model) {
+    return ProjectionJacobians<decltype(model)>(camera.params.data(), ray,
+                                                jacobian, &point);
+  });
+  if (!ok) return false;
+  Eigen::Matrix3d cross;  // omega x ray = -[ray]_x omega
+  cross << 0, ray.z(), -ray.y(), -ray.z(), 0, ray.x(), ray.y(), -ray.x(), 0;
+  *g = point * cross;
+  return true;
 }
 
 // The grid of a map for `camera`, with each sample's field angle.
@@ -95,13 +115,13 @@ Eigen::Vector2d MapPixel(const PixelMap& map, const Camera& camera, int i,
 // A map of sqrt(tr(C(p)) * factor) for the camera's covariance.
 PixelMap CovarianceTraceMap(const Camera& camera,
                             const Eigen::MatrixXd& covariance, int step,
-                            double factor) {
+                            double factor, const Eigen::MatrixXd* gauge) {
   PixelMap map = EmptyMap(camera, step);
   for (int j = 0; j < map.rows; ++j) {
     for (int i = 0; i < map.cols; ++i) {
       Eigen::Matrix2d cov;
       if (ProjectionCovariance(camera, covariance, MapPixel(map, camera, i, j),
-                               &cov)) {
+                               &cov, gauge)) {
         map.values[j * map.cols + i] =
             std::sqrt(std::max(0.0, cov.trace() * factor));
       }
@@ -129,6 +149,11 @@ ResidualBin MakeBin(double lo, double hi, const std::vector<double>& radial,
   bin.hi = hi;
   bin.count = static_cast<int>(radial.size());
   if (bin.count == 0) return bin;
+  double sum2 = 0;
+  for (size_t k = 0; k < radial.size(); ++k) {
+    sum2 += radial[k] * radial[k] + tangential[k] * tangential[k];
+  }
+  bin.rms_px = std::sqrt(sum2 / (2.0 * bin.count));
   auto mean_se = [](const std::vector<double>& x, double* mean, double* se) {
     double sum = 0;
     for (double value : x) sum += value;
@@ -160,22 +185,52 @@ bool EvidenceOptions::Check(std::string* why) const {
 
 bool ProjectionCovariance(const Camera& camera,
                           const Eigen::MatrixXd& covariance,
-                          const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov) {
+                          const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov,
+                          const Eigen::MatrixXd* gauge) {
   const int n = CameraModelNumParams(camera.model);
   if (static_cast<int>(camera.params.size()) != n || covariance.rows() != n ||
       covariance.cols() != n) {
     return false;
   }
-  Eigen::Vector3d ray;
-  if (!camera.Unproject(pixel, &ray).converged) return false;
   Eigen::MatrixXd jacobian;
-  const bool ok = DispatchCameraModel(camera.model, [&](auto model) {
-    return ProjectionJacobian<decltype(model)>(camera.params.data(), ray,
-                                               &jacobian);
-  });
-  if (!ok) return false;
+  Eigen::Matrix<double, 2, 3> g;
+  if (!PixelJacobians(camera, pixel, &jacobian, &g)) return false;
+  if (gauge != nullptr && gauge->rows() == 3 && gauge->cols() == n) {
+    jacobian -= g * *gauge;
+  }
   *cov = jacobian * covariance * jacobian.transpose();
   return cov->allFinite();
+}
+
+Eigen::MatrixXd RotationGauge(const Camera& camera, int step_px,
+                              double max_angle_deg) {
+  const int n = CameraModelNumParams(camera.model);
+  if (static_cast<int>(camera.params.size()) != n || camera.width <= 0 ||
+      camera.height <= 0 || step_px < 1) {
+    return Eigen::MatrixXd();
+  }
+  const PixelMap map = EmptyMap(camera, step_px);
+  Eigen::Matrix3d gtg = Eigen::Matrix3d::Zero();
+  Eigen::MatrixXd gtj = Eigen::MatrixXd::Zero(3, n);
+  int count = 0;
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) {
+      const double angle = map.angle_deg[j * map.cols + i];
+      if (!std::isfinite(angle) || angle > max_angle_deg) continue;
+      Eigen::MatrixXd jacobian;
+      Eigen::Matrix<double, 2, 3> g;
+      if (!PixelJacobians(camera, MapPixel(map, camera, i, j), &jacobian, &g)) {
+        continue;
+      }
+      gtg += g.transpose() * g;
+      gtj += g.transpose() * jacobian;
+      ++count;
+    }
+  }
+  if (count < 3) return Eigen::MatrixXd();
+  const Eigen::FullPivLU<Eigen::Matrix3d> lu(gtg);
+  if (!lu.isInvertible()) return Eigen::MatrixXd();
+  return lu.solve(gtj);
 }
 
 std::vector<AngleBand> SummarizeByAngle(const PixelMap& map,
@@ -294,22 +349,28 @@ ProjectionUncertainty ComputeProjectionUncertainty(
   if (!result.covariance_ok || camera.width <= 0 || camera.height <= 0) {
     return out;
   }
+  out.gauge = RotationGauge(camera, options.grid_step_px, max_angle_deg);
+  out.rotation_removed = out.gauge.size() > 0;
   out.sigma_px = CovarianceTraceMap(camera, result.covariance,
-                                    options.grid_step_px, 0.5);
+                                    options.grid_step_px, 0.5,
+                                    out.rotation_removed ? &out.gauge : nullptr);
   out.bands = SummarizeByAngle(out.sigma_px, options.band_width_deg,
                                max_angle_deg);
-  auto sigma_at = [&](const Eigen::Vector2d& pixel, double* sigma) {
+  auto sigma_at = [&](const Eigen::Vector2d& pixel, const Eigen::MatrixXd* gauge,
+                      double* sigma) {
     Eigen::Matrix2d cov;
-    if (!ProjectionCovariance(camera, result.covariance, pixel, &cov)) {
+    if (!ProjectionCovariance(camera, result.covariance, pixel, &cov, gauge)) {
       return false;
     }
     *sigma = std::sqrt(std::max(0.0, 0.5 * cov.trace()));
     return true;
   };
+  const Eigen::MatrixXd* gauge = out.rotation_removed ? &out.gauge : nullptr;
   UncertaintyPoint centre;
   centre.label = "centre";
   const Eigen::Vector2d principal(camera.params[2], camera.params[3]);
-  centre.in_image = sigma_at(principal, &centre.sigma_px);
+  centre.in_image = sigma_at(principal, gauge, &centre.sigma_px) &&
+                    sigma_at(principal, nullptr, &centre.camera_frame_sigma_px);
   out.points.push_back(centre);
   std::vector<std::pair<std::string, double>> angles;
   for (double angle : options.report_angles_deg) {
@@ -332,9 +393,15 @@ ProjectionUncertainty ComputeProjectionUncertainty(
           pixel.x() > camera.width - 1 || pixel.y() > camera.height - 1) {
         continue;
       }
-      double sigma;
-      if (!sigma_at(pixel, &sigma)) continue;
+      double sigma, fixed_frame;
+      if (!sigma_at(pixel, gauge, &sigma) ||
+          !sigma_at(pixel, nullptr, &fixed_frame)) {
+        continue;
+      }
       point.sigma_px = point.in_image ? std::max(point.sigma_px, sigma) : sigma;
+      point.camera_frame_sigma_px =
+          point.in_image ? std::max(point.camera_frame_sigma_px, fixed_frame)
+                         : fixed_frame;
       point.in_image = true;
     }
     out.points.push_back(point);
@@ -412,6 +479,42 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
   Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
   d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
   out.b_from_a = svd.matrixU() * d * svd.matrixV().transpose();
+  // Then a few Gauss-Newton steps on the pixel differences themselves, the
+  // measure the expected figures below use (RotationGauge).
+  std::vector<Eigen::Matrix<double, 2, 3>> g(map.values.size());
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) {
+      const int k = j * map.cols + i;
+      Eigen::MatrixXd unused;
+      if (valid[k] && !PixelJacobians(out.camera_b, MapPixel(map, camera, i, j),
+                                      &unused, &g[k])) {
+        valid[k] = false;
+      }
+    }
+  }
+  for (int iteration = 0; iteration < 3; ++iteration) {
+    Eigen::Matrix3d gtg = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d gtr = Eigen::Vector3d::Zero();
+    for (int j = 0; j < map.rows; ++j) {
+      for (int i = 0; i < map.cols; ++i) {
+        const int k = j * map.cols + i;
+        Eigen::Vector2d projected;
+        if (!valid[k] ||
+            !out.camera_b.Project(out.b_from_a * rays_a[k], &projected)) {
+          continue;
+        }
+        gtg += g[k].transpose() * g[k];
+        gtr += g[k].transpose() * (projected - MapPixel(map, camera, i, j));
+      }
+    }
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(gtg);
+    if (!lu.isInvertible()) break;
+    const Eigen::Vector3d omega = -lu.solve(gtr);
+    if (!omega.allFinite() || omega.norm() == 0) break;
+    out.b_from_a =
+        Eigen::AngleAxisd(omega.norm(), omega.normalized()).toRotationMatrix() *
+        out.b_from_a;
+  }
   out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDeg;
   for (int j = 0; j < map.rows; ++j) {
     for (int i = 0; i < map.cols; ++i) {
@@ -425,10 +528,18 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
   }
   out.difference_px = map;
   // Noise alone: the two halves' projection covariances add.
+  // Each half's covariance with its own rotation gauge removed over the
+  // same field, as the comparison removes the rotation between them.
+  const Eigen::MatrixXd gauge_a =
+      RotationGauge(out.camera_a, options.grid_step_px, max_angle_deg);
+  const Eigen::MatrixXd gauge_b =
+      RotationGauge(out.camera_b, options.grid_step_px, max_angle_deg);
   const PixelMap expected_a = CovarianceTraceMap(
-      out.camera_a, halves[0].covariance, options.grid_step_px, 1.0);
+      out.camera_a, halves[0].covariance, options.grid_step_px, 1.0,
+      gauge_a.size() > 0 ? &gauge_a : nullptr);
   const PixelMap expected_b = CovarianceTraceMap(
-      out.camera_b, halves[1].covariance, options.grid_step_px, 1.0);
+      out.camera_b, halves[1].covariance, options.grid_step_px, 1.0,
+      gauge_b.size() > 0 ? &gauge_b : nullptr);
   out.expected_px = map;
   for (size_t k = 0; k < map.values.size(); ++k) {
     out.expected_px.values[k] =
@@ -478,19 +589,24 @@ std::string EvidenceText(const Evidence& evidence) {
       const AngleBand& d = cv.difference_bands[b];
       const AngleBand& e = cv.expected_bands[b];
       if (d.count == 0) continue;
-      text << Printf("  %3.0f-%3.0f deg   %8.3f   %8.3f   %8.3f   %8.3f px",
-                     d.lo_deg, d.hi_deg, d.median, d.p95, e.median)
-           << Printf(" (p95 %.3f)", e.p95) << "  n=" << d.count << "\n";
+      text << Printf("  %3.0f-%3.0f deg   %8.3f   %8.3f", d.lo_deg, d.hi_deg,
+                     d.median, d.p95)
+           << Printf("   %8.3f   %8.3f px", e.median, e.p95)
+           << "  n=" << d.count << "\n";
     }
   } else {
     text << "cross-validation: " << cv.error << "\n";
   }
   const ProjectionUncertainty& u = evidence.uncertainty;
   if (u.ok) {
-    text << "projection uncertainty (1-sigma, px per axis):";
+    text << "projection uncertainty (1-sigma, px per axis; rotation gauge "
+            "removed / in the camera frame):";
     for (const UncertaintyPoint& p : u.points) {
       text << " " << p.label << " "
-           << (p.in_image ? Printf("%.3f", p.sigma_px) : "not in image") << ";";
+           << (p.in_image ? Printf("%.3f / %.3f", p.sigma_px,
+                                   p.camera_frame_sigma_px)
+                          : "not in image")
+           << ";";
     }
     text << "\n";
   } else {
@@ -503,9 +619,10 @@ std::string EvidenceText(const Evidence& evidence) {
       text << (decimals == 0 ? Printf("  %5.0f-%5.0f ", b.lo, b.hi)
                              : Printf("  %5.2f-%5.2f ", b.lo, b.hi))
            << unit
-           << Printf("  radial %+.3f +- %.3f  tangential %+.3f +- %.3f px",
+           << Printf("  radial %+.3f +- %.3f  tangential %+.3f +- %.3f  RMS "
+                     "%.3f px",
                      b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
-                     b.se_tangential_px)
+                     b.se_tangential_px, b.rms_px)
            << "  n=" << b.count << "\n";
     }
   };

@@ -107,6 +107,9 @@ struct UncertaintyPoint {
   double angle_deg = 0;
   bool in_image = false;  // some azimuth at that angle lands in the image
   double sigma_px = 0;    // the largest over the azimuths that land
+  // The same with the ray held fixed in the camera frame (no rotation
+  // removed).
+  double camera_frame_sigma_px = 0;
 };
 
 struct ProjectionUncertainty {
@@ -114,10 +117,18 @@ struct ProjectionUncertainty {
   // Per pixel: the 1-sigma of the projection of a far point seen at that
   // pixel, as the RMS over the two image axes of the 2 x 2 projection
   // covariance, sqrt(tr(C) / 2) (comparable with the per-coordinate RMS
-  // reprojection error). The ray is held fixed in the camera frame:
-  // C = J Sigma J^T with J = d pixel / d intrinsics and Sigma the
-  // intrinsics' covariance marginal over the poses.
+  // reprojection error). C = A Sigma A^T, Sigma the intrinsics' covariance
+  // marginal over the poses and A = J - G M: J = d pixel / d intrinsics
+  // with the ray held fixed, G = d pixel / d rotation of the ray, and
+  // M = (sum G^T G)^-1 sum G^T J over the observed field (`gauge`). The
+  // G M term removes the part of a parameter change that a common rotation
+  // of the camera frame undoes: a shift of cx, cy together with a rotation
+  // of every board pose moves no observation, so the camera-frame
+  // uncertainty of cx, cy is mostly not an uncertainty of the lens (mrcal
+  // reasons the same way). The camera-frame figure is kept in `points`.
   PixelMap sigma_px;
+  Eigen::MatrixXd gauge;  // M (3 x n), empty when it could not be formed
+  bool rotation_removed = false;
   std::vector<AngleBand> bands;
   std::vector<UncertaintyPoint> points;
 };
@@ -136,6 +147,8 @@ struct ResidualBin {
   double mean_tangential_px = 0;
   double se_radial_px = 0;
   double se_tangential_px = 0;
+  // RMS of the residual coordinates, sqrt(sum |r|^2 / 2n).
+  double rms_px = 0;
 };
 
 struct SystematicResiduals {
@@ -157,10 +170,19 @@ SystematicResiduals ComputeSystematicResiduals(
     const EvidenceOptions& options);
 
 // 2 x 2 covariance of the projection of the ray through `pixel` under the
-// intrinsics' covariance (ray held fixed). False when the pixel has no ray.
+// intrinsics' covariance: with the ray held fixed in the camera frame, or,
+// with `gauge` (RotationGauge), after the best-fit common rotation. False
+// when the pixel has no ray.
 bool ProjectionCovariance(const Camera& camera,
                           const Eigen::MatrixXd& covariance,
-                          const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov);
+                          const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov,
+                          const Eigen::MatrixXd* gauge = nullptr);
+
+// M = (sum G^T G)^-1 sum G^T J over the grid pixels of `camera` whose ray is
+// at most max_angle_deg off the axis (see ProjectionUncertainty): the
+// rotation that best undoes a parameter change. Empty when not formed.
+Eigen::MatrixXd RotationGauge(const Camera& camera, int step_px,
+                              double max_angle_deg);
 
 // The projection uncertainty map and figures of `result` (no solves).
 ProjectionUncertainty ComputeProjectionUncertainty(

@@ -166,8 +166,6 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   double worst_angle = 0, worst_distance = 0;
   const ResidualBin* angle_bin = nullptr;
   const ResidualBin* distance_bin = nullptr;
-  int significant_near = 0, significant_far = 0;
-  double near_max = 0, far_max = 0;
   for (const ResidualBin& bin : residuals.by_angle) {
     double worst;
     if (Systematic(bin, min_count, options, &worst) && worst > worst_angle) {
@@ -179,36 +177,37 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   for (size_t b = 0; b < nd; ++b) {
     const ResidualBin& bin = residuals.by_distance[b];
     double worst;
-    const bool near = 2 * b + 1 < nd;
-    const double magnitude =
-        std::max(std::abs(bin.mean_radial_px), std::abs(bin.mean_tangential_px));
-    (near ? near_max : far_max) = std::max(near ? near_max : far_max, magnitude);
-    if (Systematic(bin, min_count, options, &worst)) {
-      ++(near ? significant_near : significant_far);
-      if (worst > worst_distance) {
-        worst_distance = worst;
-        distance_bin = &bin;
-      }
+    if (Systematic(bin, min_count, options, &worst) && worst > worst_distance) {
+      worst_distance = worst;
+      distance_bin = &bin;
     }
   }
-  // Errors that grow as the board comes closer: systematic in the nearer
-  // half of the distance bins and larger there than in the farther half.
+  // Errors that grow as the board comes closer: the nearest bin's residual
+  // RMS well above the farthest's.
+  double near_rms = 0, far_rms = 0;
+  for (const ResidualBin& bin : residuals.by_distance) {
+    if (bin.count < min_count) continue;
+    if (near_rms == 0) near_rms = bin.rms_px;
+    far_rms = bin.rms_px;
+  }
   const bool grows_with_closeness =
-      significant_near > 0 && near_max > 1.5 * far_max;
+      nd >= 2 && far_rms > 0 && near_rms > options.closeness_rms_ratio * far_rms;
   if (angle_bin != nullptr) {
     findings.push_back({VerdictKind::kModelError,
                         "systematic " + BinText(*angle_bin, "deg", false)});
   }
   if (distance_bin != nullptr) {
+    findings.push_back({VerdictKind::kModelError,
+                        "systematic " + BinText(*distance_bin, "m", true)});
+  }
+  const bool other_model_error = !findings.empty();
+  if (grows_with_closeness &&
+      (other_model_error || near_rms > options.closeness_floor_px)) {
     findings.push_back(
         {VerdictKind::kModelError,
-         "systematic " + BinText(*distance_bin, "m", true) +
-             (grows_with_closeness
-                  ? Printf(", growing as the board comes closer (%.3f px in "
-                           "the nearer half of the distances, %.3f px in the "
-                           "farther)",
-                           near_max, far_max)
-                  : std::string())});
+         Printf("the residuals grow as the board comes closer (RMS %.3f px "
+                "for the nearest corners, %.3f px for the farthest)",
+                near_rms, far_rms)});
   }
 
   // --- bad detections ---
@@ -223,11 +222,16 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
                 "%.1f %%)",
                 100 * outlier_fraction, 100 * options.max_outlier_fraction)});
   }
+  // Per view: RMS over all corners, outliers included.
+  std::vector<double> all_rms(result.view_used.size(), 0.0);
   std::vector<double> view_rms;
   for (size_t v = 0; v < result.view_used.size(); ++v) {
-    if (result.view_used[v] && v < result.view_rms_px.size()) {
-      view_rms.push_back(result.view_rms_px[v]);
-    }
+    if (!result.view_used[v] || v >= result.residuals.size()) continue;
+    double sum2 = 0;
+    for (const Eigen::Vector2d& r : result.residuals[v]) sum2 += r.squaredNorm();
+    const size_t n = result.residuals[v].size();
+    all_rms[v] = n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
+    view_rms.push_back(all_rms[v]);
   }
   std::string bad_views;
   int num_bad_views = 0;
@@ -239,13 +243,24 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
     const double limit =
         std::max(options.view_rms_factor * median, options.view_rms_floor_px);
     for (size_t v = 0; v < result.view_used.size(); ++v) {
-      if (!result.view_used[v] || v >= result.view_rms_px.size()) continue;
-      if (result.view_rms_px[v] > limit) {
+      // A view the outlier rejection emptied (Calibrate's reason says so)
+      // is as bad as one can be.
+      if (!result.view_used[v] && v < result.view_reason.size() &&
+          result.view_reason[v].find("outlier") != std::string::npos) {
         ++num_bad_views;
         if (num_bad_views <= 5) {
           bad_views += (bad_views.empty() ? "" : ", ") + std::string("view ") +
-                       std::to_string(v) +
-                       Printf(" (%.2f px)", result.view_rms_px[v]);
+                       std::to_string(v) + " (dropped: " +
+                       result.view_reason[v] + ")";
+        }
+        continue;
+      }
+      if (!result.view_used[v] || v >= result.residuals.size()) continue;
+      if (all_rms[v] > limit) {
+        ++num_bad_views;
+        if (num_bad_views <= 5) {
+          bad_views += (bad_views.empty() ? "" : ", ") + std::string("view ") +
+                       std::to_string(v) + Printf(" (%.2f px)", all_rms[v]);
         }
       }
     }
@@ -253,8 +268,8 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
         num_bad_views <= options.max_bad_view_fraction * view_rms.size()) {
       findings.push_back(
           {VerdictKind::kBadDetections,
-           Printf("%.0f view(s) with an RMS above %.2f px (%.0f x the median "
-                  "view RMS %.3f px): ",
+           Printf("%.0f view(s) dropped or with an RMS over all corners "
+                  "above %.2f px (%.0f x the median view's %.3f px): ",
                   num_bad_views, limit, options.view_rms_factor, median) +
                bad_views});
     }
@@ -278,19 +293,19 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
                         "every parameter"});
   }
   if (evidence.uncertainty.ok) {
-    double p95 = 0, at = 0;
+    double worst = 0, at = 0;
     for (const AngleBand& band : evidence.uncertainty.bands) {
-      if (band.count > 0 && band.p95 > p95) {
-        p95 = band.p95;
+      if (band.count > 0 && band.median > worst) {
+        worst = band.median;
         at = band.lo_deg;
       }
     }
-    if (p95 > options.max_uncertainty_px) {
+    if (worst > options.max_uncertainty_px) {
       findings.push_back(
           {VerdictKind::kInsufficientData,
-           Printf("the projection uncertainty reaches %.3f px (95th "
-                  "percentile, %.0f-%.0f deg; limit %.2f px)",
-                  p95, at, at + evidence_options.band_width_deg,
+           Printf("the projection uncertainty reaches %.3f px (median at "
+                  "%.0f-%.0f deg; limit %.2f px)",
+                  worst, at, at + evidence_options.band_width_deg,
                   options.max_uncertainty_px)});
     }
   }
@@ -302,6 +317,7 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
       if (k < result.param_fixed.size() && result.param_fixed[k]) continue;
       const double sigma = result.param_stddev[k];
       const bool distortion = static_cast<int>(k) >= kDistortionBegin;
+      if (distortion && !options.check_distortion_determined) continue;
       if (sigma > std::abs(camera.params[k]) &&
           (!distortion || sigma > options.min_undetermined_distortion_stddev)) {
         findings.push_back(

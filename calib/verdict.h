@@ -39,6 +39,13 @@ struct VerdictOptions {
   // error, hence the floor. Defaults 5 and 0.05 px.
   double residual_se_factor = 5.0;
   double residual_floor_px = 0.05;
+  // Errors grow as the board comes closer when the residual RMS of the
+  // nearest distance bin exceeds closeness_rms_ratio times that of the
+  // farthest. With another model-error finding this points to a
+  // non-central lens; alone it is a model error only when the nearest
+  // bin's RMS is also above closeness_floor_px. Defaults 1.5 and 0.3 px.
+  double closeness_rms_ratio = 1.5;
+  double closeness_floor_px = 0.3;
   // A pinhole model whose corners reach beyond this field angle (degrees)
   // is on a lens wider than it can follow: the next step is
   // kannala-brandt. Default 65.
@@ -48,8 +55,9 @@ struct VerdictOptions {
   // More rejected corners than this fraction of all corners of the used
   // views. Default 0.05.
   double max_outlier_fraction = 0.05;
-  // A view whose RMS exceeds view_rms_factor times the median view RMS
-  // (and view_rms_floor_px) stands out; at most max_bad_view_fraction of
+  // A view whose RMS over all of its corners (outliers included, so a view
+  // the rejection emptied still shows) exceeds view_rms_factor times the
+  // median of that figure (and view_rms_floor_px) stands out; at most max_bad_view_fraction of
   // the views standing out is "a few views" (more is the model's or the
   // data's doing as a whole). Defaults 3, 0.2 px and 0.2.
   double view_rms_factor = 3.0;
@@ -61,12 +69,19 @@ struct VerdictOptions {
   int min_views = 8;
   // Coverage (CalibrationResult::coverage) below this. Default 0.2.
   double min_coverage = 0.2;
-  // The 95th percentile of the projection uncertainty map within the
-  // observed field above this (pixels, per axis). Default 0.25 px.
+  // The median of the projection uncertainty map in a field-angle band
+  // within the observed field above this (pixels, per axis). Default
+  // 0.25 px.
   double max_uncertainty_px = 0.25;
-  // A free parameter whose standard deviation exceeds its magnitude is
-  // undetermined. Distortion coefficients can be truly near zero, so for
-  // them the standard deviation must also exceed this. Default 0.05.
+  // A free focal length or principal point coordinate whose standard
+  // deviation exceeds its magnitude is undetermined.
+  // check_distortion_determined applies the same test to the distortion
+  // coefficients (whose standard deviation must then also exceed
+  // min_undetermined_distortion_stddev, as they can be truly near zero).
+  // Default false: coupled coefficients (the rational model's numerator
+  // and denominator) are individually undetermined while the projection
+  // they make is well determined; the projection uncertainty judges them.
+  bool check_distortion_determined = false;
   double min_undetermined_distortion_stddev = 0.05;
 
   bool Check(std::string* why = nullptr) const;
