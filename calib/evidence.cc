@@ -50,7 +50,8 @@ double FieldAngleDeg(const Eigen::Vector3d& ray) {
 // 3) of Model::Project at `ray`, by automatic differentiation.
 template <typename Model>
 bool ProjectionJacobians(const double* params, const Eigen::Vector3d& ray,
-                         Eigen::MatrixXd* jacobian, Eigen::Matrix<double, 2, 3>* point) {
+                         Eigen::MatrixXd* jacobian,
+                         Eigen::Matrix<double, 2, 3>* point) {
   constexpr int kN = Model::kNumParams;
   using JetT = ceres::Jet<double, kN + 3>;
   JetT p[kN];
@@ -283,7 +284,8 @@ SystematicResiduals ComputeSystematicResiduals(
     for (size_t i = 0; i < result.residuals[v].size(); ++i) {
       if (i >= result.inlier[v].size() || !result.inlier[v][i]) continue;
       if (i >= view.board_points.size()) continue;
-      const Eigen::Vector3d point = result.cam_from_board[v] * view.board_points[i];
+      const Eigen::Vector3d point =
+          result.cam_from_board[v] * view.board_points[i];
       const Eigen::Vector2d offset = view.image_points[i] - principal;
       const double norm = offset.norm();
       if (!(norm > 1e-9) || !point.allFinite()) continue;
@@ -299,15 +301,16 @@ SystematicResiduals ComputeSystematicResiduals(
   if (samples.empty()) return out;
   // By field angle: fixed-width bins up to the widest corner.
   const int angle_bins = std::max(
-      1, static_cast<int>(std::ceil(out.max_angle_deg / options.band_width_deg -
-                                    1e-9)));
+      1, static_cast<int>(
+             std::ceil(out.max_angle_deg / options.band_width_deg - 1e-9)));
   for (int b = 0; b < angle_bins; ++b) {
     const double lo = b * options.band_width_deg;
     const double hi = std::min(out.max_angle_deg, lo + options.band_width_deg);
     std::vector<double> radial, tangential;
     for (const Sample& s : samples) {
       const bool last = b + 1 == angle_bins;
-      if (s.angle_deg >= lo && (s.angle_deg < hi || (last && s.angle_deg <= hi))) {
+      if (s.angle_deg >= lo &&
+          (s.angle_deg < hi || (last && s.angle_deg <= hi))) {
         radial.push_back(s.radial);
         tangential.push_back(s.tangential);
       }
@@ -331,12 +334,14 @@ SystematicResiduals ComputeSystematicResiduals(
     for (const Sample& s : samples) {
       const bool last = b + 1 == options.distance_bins;
       if (s.distance_m >= edges[b] &&
-          (s.distance_m < edges[b + 1] || (last && s.distance_m <= edges[b + 1]))) {
+          (s.distance_m < edges[b + 1] ||
+           (last && s.distance_m <= edges[b + 1]))) {
         radial.push_back(s.radial);
         tangential.push_back(s.tangential);
       }
     }
-    out.by_distance.push_back(MakeBin(edges[b], edges[b + 1], radial, tangential));
+    out.by_distance.push_back(
+        MakeBin(edges[b], edges[b + 1], radial, tangential));
   }
   return out;
 }
@@ -351,13 +356,13 @@ ProjectionUncertainty ComputeProjectionUncertainty(
   }
   out.gauge = RotationGauge(camera, options.grid_step_px, max_angle_deg);
   out.rotation_removed = out.gauge.size() > 0;
-  out.sigma_px = CovarianceTraceMap(camera, result.covariance,
-                                    options.grid_step_px, 0.5,
-                                    out.rotation_removed ? &out.gauge : nullptr);
-  out.bands = SummarizeByAngle(out.sigma_px, options.band_width_deg,
-                               max_angle_deg);
-  auto sigma_at = [&](const Eigen::Vector2d& pixel, const Eigen::MatrixXd* gauge,
-                      double* sigma) {
+  out.sigma_px =
+      CovarianceTraceMap(camera, result.covariance, options.grid_step_px, 0.5,
+                         out.rotation_removed ? &out.gauge : nullptr);
+  out.bands =
+      SummarizeByAngle(out.sigma_px, options.band_width_deg, max_angle_deg);
+  auto sigma_at = [&](const Eigen::Vector2d& pixel,
+                      const Eigen::MatrixXd* gauge, double* sigma) {
     Eigen::Matrix2d cov;
     if (!ProjectionCovariance(camera, result.covariance, pixel, &cov, gauge)) {
       return false;
@@ -474,10 +479,11 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
       cross += rays_b[k] * rays_a[k].transpose();
     }
   }
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross,
-                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+      cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
+  d(2, 2) =
+      (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
   out.b_from_a = svd.matrixU() * d * svd.matrixV().transpose();
   // Then a few Gauss-Newton steps on the pixel differences themselves, the
   // measure the expected figures below use (RotationGauge).
@@ -547,8 +553,8 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
             ? std::hypot(expected_a.values[k], expected_b.values[k])
             : kNaN;
   }
-  out.difference_bands =
-      SummarizeByAngle(out.difference_px, options.band_width_deg, max_angle_deg);
+  out.difference_bands = SummarizeByAngle(
+      out.difference_px, options.band_width_deg, max_angle_deg);
   out.expected_bands =
       SummarizeByAngle(out.expected_px, options.band_width_deg, max_angle_deg);
   out.ok = true;
@@ -603,9 +609,9 @@ std::string EvidenceText(const Evidence& evidence) {
             "removed / in the camera frame):";
     for (const UncertaintyPoint& p : u.points) {
       text << " " << p.label << " "
-           << (p.in_image ? Printf("%.3f / %.3f", p.sigma_px,
-                                   p.camera_frame_sigma_px)
-                          : "not in image")
+           << (p.in_image
+                   ? Printf("%.3f / %.3f", p.sigma_px, p.camera_frame_sigma_px)
+                   : "not in image")
            << ";";
     }
     text << "\n";
@@ -619,10 +625,11 @@ std::string EvidenceText(const Evidence& evidence) {
       text << (decimals == 0 ? Printf("  %5.0f-%5.0f ", b.lo, b.hi)
                              : Printf("  %5.2f-%5.2f ", b.lo, b.hi))
            << unit
-           << Printf("  radial %+.3f +- %.3f  tangential %+.3f +- %.3f  RMS "
-                     "%.3f px",
-                     b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
-                     b.se_tangential_px, b.rms_px)
+           << Printf(
+                  "  radial %+.3f +- %.3f  tangential %+.3f +- %.3f  RMS "
+                  "%.3f px",
+                  b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
+                  b.se_tangential_px, b.rms_px)
            << "  n=" << b.count << "\n";
     }
   };

@@ -61,8 +61,9 @@ struct PixelMap {
   int step_px = 0;
   int cols = 0;
   int rows = 0;
-  std::vector<double> values;     // row-major, cols * rows
-  std::vector<double> angle_deg;  // field angle of each sample's ray (NaN: none)
+  std::vector<double> values;  // row-major, cols * rows
+  std::vector<double>
+      angle_deg;  // field angle of each sample's ray (NaN: none)
   double At(int i, int j) const { return values[j * cols + i]; }
 };
 
@@ -103,7 +104,7 @@ struct CrossValidation {
 
 // One field angle at which the uncertainty is reported.
 struct UncertaintyPoint {
-  std::string label;      // "centre", "30 deg", ..., "rim (74.2 deg)"
+  std::string label;  // "centre", "30 deg", ..., "rim (74.2 deg)"
   double angle_deg = 0;
   bool in_image = false;  // some azimuth at that angle lands in the image
   double sigma_px = 0;    // the largest over the azimuths that land

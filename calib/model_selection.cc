@@ -79,7 +79,8 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
                  ModelSelection* selection, std::string* error) {
   *selection = ModelSelection();
   std::string why;
-  if (!options.Check(&why)) return Fail("model selection options: " + why, error);
+  if (!options.Check(&why))
+    return Fail("model selection options: " + why, error);
   std::vector<CameraModelId> models;
   if (options.candidates.empty()) {
     models.assign(kAllCameraModels.begin(), kAllCameraModels.end());
@@ -163,9 +164,9 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
     for (const ModelCandidate& c : selection->candidates) {
       reasons += std::string("; ") + CameraModelName(c.model) + ": " + c.error;
     }
-    return Fail("model selection: no candidate model could be calibrated" +
-                    reasons,
-                error);
+    return Fail(
+        "model selection: no candidate model could be calibrated" + reasons,
+        error);
   }
   return true;
 }
@@ -187,8 +188,9 @@ std::string ModelSelection::Table() const {
                     c.holdout_rms_px, c.holdout_corners, c.seconds);
       table << line;
     } else {
-      std::snprintf(line, sizeof(line), "  %-27s %6d  failed: ",
-                    CameraModelName(c.model), c.num_params);
+      std::snprintf(line, sizeof(line),
+                    "  %-27s %6d  failed: ", CameraModelName(c.model),
+                    c.num_params);
       table << line << c.error << "\n";
     }
   }

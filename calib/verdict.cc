@@ -44,9 +44,9 @@ bool Systematic(const ResidualBin& bin, int min_count,
 }
 
 std::string BinText(const ResidualBin& bin, const char* unit, bool metres) {
-  const bool radial = std::abs(bin.mean_radial_px) / std::max(1e-12, bin.se_radial_px) >=
-                      std::abs(bin.mean_tangential_px) /
-                          std::max(1e-12, bin.se_tangential_px);
+  const bool radial =
+      std::abs(bin.mean_radial_px) / std::max(1e-12, bin.se_radial_px) >=
+      std::abs(bin.mean_tangential_px) / std::max(1e-12, bin.se_tangential_px);
   const double mean = radial ? bin.mean_radial_px : bin.mean_tangential_px;
   const double se = radial ? bin.se_radial_px : bin.se_tangential_px;
   return std::string(radial ? "radial" : "tangential") + " residual mean " +
@@ -108,8 +108,8 @@ bool VerdictOptions::Check(std::string* why) const {
 }
 
 std::string Verdict::Line() const {
-  return std::string("verdict: ") + VerdictKindName(kind) + " \u2014 " + reason +
-         " \u2014 " + next_step;
+  return std::string("verdict: ") + VerdictKindName(kind) + " \u2014 " +
+         reason + " \u2014 " + next_step;
 }
 
 std::string NextModel(CameraModelId model, bool grows_with_closeness,
@@ -159,7 +159,8 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
       }
     }
   }
-  if (halves_disagree) findings.push_back({VerdictKind::kModelError, halves_text});
+  if (halves_disagree)
+    findings.push_back({VerdictKind::kModelError, halves_text});
 
   // --- model error: systematic residuals ---
   const SystematicResiduals& residuals = evidence.residuals;
@@ -185,24 +186,39 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   // Errors that grow as the board comes closer: the nearest bin's residual
   // RMS well above the farthest's.
   double near_rms = 0, far_rms = 0;
+  const ResidualBin* nearest = nullptr;
   for (const ResidualBin& bin : residuals.by_distance) {
     if (bin.count < min_count) continue;
-    if (near_rms == 0) near_rms = bin.rms_px;
+    if (nearest == nullptr) {
+      nearest = &bin;
+      near_rms = bin.rms_px;
+    }
     far_rms = bin.rms_px;
   }
-  const bool grows_with_closeness =
-      nd >= 2 && far_rms > 0 && near_rms > options.closeness_rms_ratio * far_rms;
+  double nearest_worst = 0;
+  const bool nearest_systematic =
+      nd >= 2 && nearest != nullptr &&
+      Systematic(*nearest, min_count, options, &nearest_worst);
+  const bool rms_grows = nd >= 2 && far_rms > 0 &&
+                         near_rms > options.closeness_rms_ratio * far_rms;
+  const bool grows_with_closeness = nearest_systematic || rms_grows;
   if (angle_bin != nullptr) {
     findings.push_back({VerdictKind::kModelError,
                         "systematic " + BinText(*angle_bin, "deg", false)});
   }
-  if (distance_bin != nullptr) {
+  if (distance_bin != nullptr &&
+      !(nearest_systematic && distance_bin == nearest)) {
     findings.push_back({VerdictKind::kModelError,
                         "systematic " + BinText(*distance_bin, "m", true)});
   }
   const bool other_model_error = !findings.empty();
-  if (grows_with_closeness &&
-      (other_model_error || near_rms > options.closeness_floor_px)) {
+  if (nearest_systematic) {
+    findings.push_back(
+        {VerdictKind::kModelError,
+         "the corners closest to the camera carry a systematic error: " +
+             BinText(*nearest, "m", true)});
+  } else if (rms_grows &&
+             (other_model_error || near_rms > options.closeness_floor_px)) {
     findings.push_back(
         {VerdictKind::kModelError,
          Printf("the residuals grow as the board comes closer (RMS %.3f px "
@@ -228,7 +244,8 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   for (size_t v = 0; v < result.view_used.size(); ++v) {
     if (!result.view_used[v] || v >= result.residuals.size()) continue;
     double sum2 = 0;
-    for (const Eigen::Vector2d& r : result.residuals[v]) sum2 += r.squaredNorm();
+    for (const Eigen::Vector2d& r : result.residuals[v])
+      sum2 += r.squaredNorm();
     const size_t n = result.residuals[v].size();
     all_rms[v] = n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
     view_rms.push_back(all_rms[v]);
@@ -250,8 +267,8 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
         ++num_bad_views;
         if (num_bad_views <= 5) {
           bad_views += (bad_views.empty() ? "" : ", ") + std::string("view ") +
-                       std::to_string(v) + " (dropped: " +
-                       result.view_reason[v] + ")";
+                       std::to_string(v) +
+                       " (dropped: " + result.view_reason[v] + ")";
         }
         continue;
       }
@@ -320,10 +337,9 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
       if (distortion && !options.check_distortion_determined) continue;
       if (sigma > std::abs(camera.params[k]) &&
           (!distortion || sigma > options.min_undetermined_distortion_stddev)) {
-        findings.push_back(
-            {VerdictKind::kInsufficientData,
-             names[k] + Printf(" is undetermined (%.4g +- %.3g)",
-                               camera.params[k], sigma)});
+        findings.push_back({VerdictKind::kInsufficientData,
+                            names[k] + Printf(" is undetermined (%.4g +- %.3g)",
+                                              camera.params[k], sigma)});
       }
     }
   }
@@ -350,9 +366,8 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   }
   switch (verdict.kind) {
     case VerdictKind::kModelError: {
-      verdict.suggested_model =
-          NextModel(camera.model, grows_with_closeness,
-                    residuals.max_angle_deg, options);
+      verdict.suggested_model = NextModel(camera.model, grows_with_closeness,
+                                          residuals.max_angle_deg, options);
       if (verdict.suggested_model.empty()) {
         verdict.next_step =
             "no richer model is available; check the board's flatness and "
@@ -362,14 +377,14 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
         if (verdict.suggested_model == "kannala-brandt-noncentral") {
           verdict.next_step +=
               grows_with_closeness
-                  ? " (a central model cannot follow a lens whose errors grow "
-                    "as the board comes closer)"
+                  ? " (a central model cannot follow a lens whose errors "
+                    "change as the board comes closer)"
                   : " (the central model leaves structured residuals)";
         } else if (CameraModelIsPinhole(camera.model) &&
                    verdict.suggested_model == "kannala-brandt") {
-          verdict.next_step += Printf(
-              " (corners reach %.0f deg off the axis: a fisheye lens)",
-              residuals.max_angle_deg);
+          verdict.next_step +=
+              Printf(" (corners reach %.0f deg off the axis: a fisheye lens)",
+                     residuals.max_angle_deg);
         }
       }
       break;

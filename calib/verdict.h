@@ -19,7 +19,12 @@
 
 namespace puzzlecal {
 
-enum class VerdictKind { kGood, kModelError, kInsufficientData, kBadDetections };
+enum class VerdictKind {
+  kGood,
+  kModelError,
+  kInsufficientData,
+  kBadDetections
+};
 
 // "good", "model-error", "insufficient-data", "bad-detections".
 const char* VerdictKindName(VerdictKind kind);
@@ -29,8 +34,11 @@ struct VerdictOptions {
   // The halves disagree when, in a field-angle band with at least
   // EvidenceOptions::min_bin_count samples, the median difference exceeds
   // halves_factor times the median difference the two halves' covariances
-  // predict, and halves_floor_px. Defaults 4 and 0.1 px.
-  double halves_factor = 4.0;
+  // predict, and halves_floor_px. Noise alone gives ratios near 1 or
+  // below (the median length of a 2-D Gaussian vector is 0.83 times its
+  // RMS, and the fitted rotation takes out a little more). Defaults 2.5 and
+  // 0.1 px.
+  double halves_factor = 2.5;
   double halves_floor_px = 0.1;
   // A residual bin (min_bin_count corners or more) is systematic when its
   // mean radial or tangential component is more than residual_se_factor
@@ -39,11 +47,12 @@ struct VerdictOptions {
   // error, hence the floor. Defaults 5 and 0.05 px.
   double residual_se_factor = 5.0;
   double residual_floor_px = 0.05;
-  // Errors grow as the board comes closer when the residual RMS of the
-  // nearest distance bin exceeds closeness_rms_ratio times that of the
-  // farthest. With another model-error finding this points to a
-  // non-central lens; alone it is a model error only when the nearest
-  // bin's RMS is also above closeness_floor_px. Defaults 1.5 and 0.3 px.
+  // The errors depend on closeness when the nearest distance bin's residual
+  // mean is systematic (see residual_se_factor) or its residual RMS
+  // exceeds closeness_rms_ratio times that of the farthest bin. With
+  // another model-error finding this points to a non-central lens; the RMS
+  // ratio alone is a model error only when the nearest bin's RMS is also
+  // above closeness_floor_px. Defaults 1.5 and 0.3 px.
   double closeness_rms_ratio = 1.5;
   double closeness_floor_px = 0.3;
   // A pinhole model whose corners reach beyond this field angle (degrees)
@@ -57,9 +66,9 @@ struct VerdictOptions {
   double max_outlier_fraction = 0.05;
   // A view whose RMS over all of its corners (outliers included, so a view
   // the rejection emptied still shows) exceeds view_rms_factor times the
-  // median of that figure (and view_rms_floor_px) stands out; at most max_bad_view_fraction of
-  // the views standing out is "a few views" (more is the model's or the
-  // data's doing as a whole). Defaults 3, 0.2 px and 0.2.
+  // median of that figure (and view_rms_floor_px) stands out; at most
+  // max_bad_view_fraction of the views standing out is "a few views" (more is
+  // the model's or the data's doing as a whole). Defaults 3, 0.2 px and 0.2.
   double view_rms_factor = 3.0;
   double view_rms_floor_px = 0.2;
   double max_bad_view_fraction = 0.2;

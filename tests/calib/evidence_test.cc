@@ -176,9 +176,9 @@ TEST(CrossValidation, HalvesAgreeOnCleanData) {
     const EvidenceOptions options;
     const SystematicResiduals residuals =
         ComputeSystematicResiduals(data.views, result, options);
-    const CrossValidation cv = CrossValidate(
-        data.views, result, CalibrationOptions(), residuals.max_angle_deg,
-        options);
+    const CrossValidation cv =
+        CrossValidate(data.views, result, CalibrationOptions(),
+                      residuals.max_angle_deg, options);
     ASSERT_TRUE(cv.ok) << cv.error;
     EXPECT_EQ(cv.views_a, 15);
     EXPECT_EQ(cv.views_b, 15);

@@ -29,15 +29,14 @@ Judged Judge(const std::vector<CalibrationView>& views, CameraModelId model,
              int width, int height,
              CalibrationOptions options = CalibrationOptions()) {
   Judged judged;
-  judged.calibrated =
-      Calibrate(views, model, width, height, options, &judged.result,
-                &judged.error);
+  judged.calibrated = Calibrate(views, model, width, height, options,
+                                &judged.result, &judged.error);
   if (!judged.calibrated) return judged;
   const EvidenceOptions evidence_options;
   judged.evidence =
       ComputeEvidence(views, judged.result, options, evidence_options);
-  judged.verdict = MakeVerdict(judged.result, judged.evidence,
-                               evidence_options, VerdictOptions());
+  judged.verdict = MakeVerdict(judged.result, judged.evidence, evidence_options,
+                               VerdictOptions());
   return judged;
 }
 
@@ -90,16 +89,14 @@ TEST(NextModel, NamesTheModelToTry) {
 
 // The right model on clean data of several lenses: good.
 TEST(Verdict, CleanScenesAreGood) {
-  for (const Camera& truth :
-       {testing::TruthRadtan(), testing::TruthRational(),
-        testing::TruthFisheye190()}) {
+  for (const Camera& truth : {testing::TruthRadtan(), testing::TruthRational(),
+                              testing::TruthFisheye190()}) {
     const SyntheticData data = MakeSyntheticData(Scene(truth, 24, 3));
-    const Judged judged = Judge(data.views, truth.model, truth.width,
-                                truth.height);
+    const Judged judged =
+        Judge(data.views, truth.model, truth.width, truth.height);
     ASSERT_TRUE(judged.calibrated) << judged.error;
     EXPECT_EQ(judged.verdict.kind, VerdictKind::kGood)
-        << CameraModelName(truth.model) << ": " << judged.verdict.Line()
-        << "\n"
+        << CameraModelName(truth.model) << ": " << judged.verdict.Line() << "\n"
         << EvidenceText(judged.evidence);
   }
 }
