@@ -78,6 +78,7 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
                  const ModelSelectionOptions& options,
                  ModelSelection* selection, std::string* error) {
   *selection = ModelSelection();
+  selection->min_relative_gain = options.min_relative_gain;
   std::string why;
   if (!options.Check(&why))
     return Fail("model selection options: " + why, error);
@@ -196,8 +197,9 @@ std::string ModelSelection::Table() const {
   }
   if (chosen >= 0) {
     table << "chosen: " << CameraModelName(candidates[chosen].model)
-          << " (lowest held-out RMS; within the tie margin, fewer "
-             "parameters)\n";
+          << " (lowest held-out RMS; candidates within "
+          << static_cast<int>(std::lround(100 * min_relative_gain))
+          << " % of it go to the one with fewer parameters)\n";
   }
   return table.str();
 }

@@ -49,6 +49,7 @@ struct ModelSelection {
   int chosen = -1;  // index into candidates, -1 when none succeeded
   int fit_views = 0;
   int holdout_views = 0;
+  double min_relative_gain = 0;  // the options' tie margin, for Table()
 
   // The comparison table (one line per candidate, the chosen one marked).
   std::string Table() const;
