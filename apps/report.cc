@@ -873,9 +873,9 @@ cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
                      const std::string& title, const std::string& subtitle,
                      const std::string& bar_label,
                      const std::vector<std::string>& notes) {
-  ImageLayout layout = MakeImageLayout(options.image_plot_width, data.width,
-                                       data.height,
-                                       static_cast<int>(notes.size()));
+  ImageLayout layout =
+      MakeImageLayout(options.image_plot_width, data.width, data.height,
+                      static_cast<int>(notes.size()));
   cv::Mat& canvas = layout.canvas;
   const plot::Frame& frame = layout.frame;
   double largest = 0;
@@ -887,8 +887,10 @@ cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
   const int step = std::max(1, map.step_px);
   auto value_at = [&](double x, double y) {
     const double gx = x / step, gy = y / step;
-    const int i0 = std::clamp(static_cast<int>(std::floor(gx)), 0, map.cols - 1);
-    const int j0 = std::clamp(static_cast<int>(std::floor(gy)), 0, map.rows - 1);
+    const int i0 =
+        std::clamp(static_cast<int>(std::floor(gx)), 0, map.cols - 1);
+    const int j0 =
+        std::clamp(static_cast<int>(std::floor(gy)), 0, map.rows - 1);
     const int i1 = std::min(i0 + 1, map.cols - 1);
     const int j1 = std::min(j0 + 1, map.rows - 1);
     const double fx = std::clamp(gx - i0, 0.0, 1.0);
@@ -969,8 +971,8 @@ cv::Mat PlotUncertainty(const ReportData& data, const ReportOptions& options,
   return PlotPixelMap(
       data, options, map, largest,
       "Projection uncertainty (1 sigma) of a far point at each pixel",
-      "sqrt(tr(C) / 2) per axis, C = J Sigma J^T: J = d pixel / d intrinsics "
-      "with the ray held fixed",
+      "sqrt(tr(C) / 2) per axis, C = A Sigma A^T, A = d pixel / d intrinsics "
+      "(ray fixed) less the part a common rotation undoes",
       "1 sigma (px)",
       {Format("Colours scaled to the observed field (up to %.1f deg); "
               "beyond it the value grows and saturates.",
@@ -988,8 +990,8 @@ cv::Mat PlotResidualBins(const ReportData& data, const ReportOptions& options,
   auto panel = [&](const std::vector<ResidualBin>& bins, int x0,
                    const std::string& x_label) {
     plot::Frame frame;
-    frame.area = cv::Rect(x0 + 90, 90, half - 90 - 30,
-                          options.chart_height - 90 - 80);
+    frame.area =
+        cv::Rect(x0 + 90, 90, half - 90 - 30, options.chart_height - 90 - 80);
     double lo = 0, hi = 1, extent = 0.05;
     if (!bins.empty()) {
       lo = bins.front().lo;
@@ -997,9 +999,9 @@ cv::Mat PlotResidualBins(const ReportData& data, const ReportOptions& options,
     }
     for (const ResidualBin& b : bins) {
       if (b.count < 2) continue;
-      extent = std::max({extent,
-                         std::abs(b.mean_radial_px) + 2 * b.se_radial_px,
-                         std::abs(b.mean_tangential_px) + 2 * b.se_tangential_px});
+      extent =
+          std::max({extent, std::abs(b.mean_radial_px) + 2 * b.se_radial_px,
+                    std::abs(b.mean_tangential_px) + 2 * b.se_tangential_px});
     }
     frame.x_min = lo;
     frame.x_max = hi > lo ? hi : lo + 1;
@@ -1017,8 +1019,7 @@ cv::Mat PlotResidualBins(const ReportData& data, const ReportOptions& options,
         const double x = b.lo + width * (c == 0 ? 0.4 : 0.6);
         const cv::Scalar colour = c == 0 ? plot::kBlue : plot::kOrange;
         cv::line(canvas, frame.ToCanvasPixel(x, mean - 2 * se),
-                 frame.ToCanvasPixel(x, mean + 2 * se), colour, 2,
-                 cv::LINE_AA);
+                 frame.ToCanvasPixel(x, mean + 2 * se), colour, 2, cv::LINE_AA);
         cv::circle(canvas, frame.ToCanvasPixel(x, mean), 5, colour, cv::FILLED,
                    cv::LINE_AA);
       }
@@ -1217,9 +1218,9 @@ std::string EvidenceMarkdown(const ReportInput& input) {
   std::ostringstream md;
   md << "## Evidence\n\n";
   if (input.verdict != nullptr) {
-    md << "Verdict **" << VerdictKindName(input.verdict->kind) << "**: "
-       << input.verdict->reason << ". Next step: " << input.verdict->next_step
-       << ".\n\n";
+    md << "Verdict **" << VerdictKindName(input.verdict->kind)
+       << "**: " << input.verdict->reason
+       << ". Next step: " << input.verdict->next_step << ".\n\n";
     if (input.verdict->findings.size() > 1) {
       md << "All findings:\n\n";
       for (const std::string& f : input.verdict->findings) {
@@ -1256,13 +1257,20 @@ std::string EvidenceMarkdown(const ReportInput& input) {
   const ProjectionUncertainty& u = evidence.uncertainty;
   if (u.ok) {
     md << "1-sigma of the projection of a far point, per image axis "
-          "(sqrt(tr(C) / 2) of its 2 x 2 covariance; the ray held fixed, the "
-          "intrinsics' covariance marginal over the poses); the largest "
-          "over 16 directions at each angle:\n\n| where | 1 sigma (px) "
-          "|\n|---|---:|\n";
+          "(sqrt(tr(C) / 2) of its 2 x 2 covariance, from the intrinsics' "
+          "covariance marginal over the poses); the largest over the "
+          "directions at each angle that land in the image. First column: "
+          "after the best-fit common rotation of the camera frame over the "
+          "observed field (a shift of cx, cy that a rotation of all board "
+          "poses undoes is no uncertainty of the lens; the map and the "
+          "verdict use this). Second: the ray held fixed in the camera "
+          "frame.\n\n| where | 1 sigma (px) | in the camera frame (px) "
+          "|\n|---|---:|---:|\n";
     for (const UncertaintyPoint& p : u.points) {
       md << "| " << p.label << " | "
-         << (p.in_image ? Format("%.4f", p.sigma_px) : std::string("not in image"))
+         << (p.in_image
+                 ? Format("%.4f | %.4f", p.sigma_px, p.camera_frame_sigma_px)
+                 : std::string("not in image | not in image"))
          << " |\n";
     }
     md << "\n";
@@ -1289,9 +1297,10 @@ std::string EvidenceMarkdown(const ReportInput& input) {
   };
   table(evidence.residuals.by_angle, "field angle", false);
   table(evidence.residuals.by_distance, "distance from the camera", true);
-  md << Format("Evidence computed in %.2f s (of which the two half "
-               "calibrations %.2f s).\n\n",
-               evidence.seconds, cv.seconds);
+  md << Format(
+      "Evidence computed in %.2f s (of which the two half "
+      "calibrations %.2f s).\n\n",
+      evidence.seconds, cv.seconds);
   return md.str();
 }
 
@@ -1371,8 +1380,7 @@ std::string ReportMarkdown(const ReportInput& input,
   md << "\n\n";
 
   if (!input.model_selection.empty()) {
-    md << "## Model selection\n\n```\n" << input.model_selection
-       << "```\n\n";
+    md << "## Model selection\n\n```\n" << input.model_selection << "```\n\n";
   }
   if (input.evidence != nullptr) md << EvidenceMarkdown(input);
 
@@ -1592,9 +1600,9 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
     if (input.evidence != nullptr && data.camera_valid) {
       const Evidence& evidence = *input.evidence;
       if (evidence.cross_validation.ok &&
-          !write_png("cross_validation.png",
-                     PlotCrossValidation(data, options,
-                                         evidence.cross_validation))) {
+          !write_png(
+              "cross_validation.png",
+              PlotCrossValidation(data, options, evidence.cross_validation))) {
         return false;
       }
       if (evidence.uncertainty.ok &&

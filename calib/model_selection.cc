@@ -1,5 +1,6 @@
 #include "calib/model_selection.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,22 @@ namespace {
 bool Fail(const std::string& message, std::string* why) {
   if (why != nullptr) *why = message;
   return false;
+}
+
+// The widest angle from the optical axis of a used corner under the fitted
+// poses, degrees.
+double WidestFieldDeg(const std::vector<CalibrationView>& views,
+                      const CalibrationResult& result) {
+  double widest = 0;
+  for (size_t v = 0; v < views.size() && v < result.view_used.size(); ++v) {
+    if (!result.view_used[v]) continue;
+    for (const Eigen::Vector3d& board : views[v].board_points) {
+      const Eigen::Vector3d point = result.cam_from_board[v] * board;
+      widest = std::max(
+          widest, std::atan2(point.head<2>().norm(), point.z()) * 180.0 / M_PI);
+    }
+  }
+  return widest;
 }
 
 }  // namespace
@@ -28,6 +45,9 @@ bool ModelSelectionOptions::Check(std::string* why) const {
                       CameraModelNames() + ")",
                   why);
     }
+  }
+  if (!(pinhole_max_field_deg > 0 && pinhole_max_field_deg <= 90)) {
+    return Fail("pinhole_max_field_deg must be in (0, 90]", why);
   }
   if (!(min_relative_gain >= 0)) {
     return Fail("min_relative_gain must be >= 0", why);
@@ -112,6 +132,12 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
                     std::to_string(position) + ")",
                 error);
   }
+  // Fisheye models first: the widest field angle they see tells whether a
+  // pinhole model can hold the views at all.
+  std::stable_partition(models.begin(), models.end(), [](CameraModelId id) {
+    return !CameraModelIsPinhole(id);
+  });
+  double widest_deg = 0;
   for (CameraModelId model : models) {
     const auto start = std::chrono::steady_clock::now();
     ModelCandidate candidate;
@@ -122,11 +148,22 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
     fit_options.compute_covariance = false;
     CalibrationResult result;
     std::string fit_error;
-    if (!Calibrate(fit, model, width, height, fit_options, &result,
-                   &fit_error)) {
+    if (CameraModelIsPinhole(model) &&
+        widest_deg > options.pinhole_max_field_deg) {
+      char text[160];
+      std::snprintf(text, sizeof(text),
+                    "skipped: the corners reach %.1f deg off the axis "
+                    "(limit %.1f deg for a pinhole model)",
+                    widest_deg, options.pinhole_max_field_deg);
+      candidate.error = text;
+    } else if (!Calibrate(fit, model, width, height, fit_options, &result,
+                          &fit_error)) {
       candidate.error = "calibration failed: " + fit_error;
     } else {
       candidate.fit_rms_px = result.rms_px;
+      if (!CameraModelIsPinhole(model)) {
+        widest_deg = std::max(widest_deg, WidestFieldDeg(fit, result));
+      }
       std::string holdout_error;
       if (HoldoutError(holdout, result.camera, calibration,
                        &candidate.holdout_rms_px, &candidate.holdout_corners,
@@ -190,8 +227,8 @@ std::string ModelSelection::Table() const {
       table << line;
     } else {
       std::snprintf(line, sizeof(line),
-                    "  %-27s %6d  failed: ", CameraModelName(c.model),
-                    c.num_params);
+                    "  %-27s %6d  failed (%.1f s): ", CameraModelName(c.model),
+                    c.num_params, c.seconds);
       table << line << c.error << "\n";
     }
   }

@@ -25,6 +25,11 @@ struct ModelSelectionOptions {
   int holdout_offset = 3;
   // Candidate model names; empty (the default) means every model.
   std::vector<std::string> candidates;
+  // Pinhole candidates are skipped when a fisheye candidate's corners reach
+  // beyond this angle from the optical axis (degrees): a pinhole model
+  // cannot project rays at 90 degrees or more, and its fit fails slowly.
+  // Default 85. In (0, 90].
+  double pinhole_max_field_deg = 85.0;
   // A candidate must beat the best held-out error by more than this
   // fraction to be preferred over one with fewer parameters. Default 0.02.
   double min_relative_gain = 0.02;

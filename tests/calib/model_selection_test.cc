@@ -112,6 +112,12 @@ TEST(SelectModel, ChoosesKannalaBrandtForAFisheye) {
   EXPECT_EQ(selection.candidates[selection.chosen].model,
             CameraModelId::kKannalaBrandt)
       << selection.Table();
+  // Corners beyond 90 degrees: the pinhole candidates are not even tried.
+  for (const ModelCandidate& c : selection.candidates) {
+    if (!CameraModelIsPinhole(c.model)) continue;
+    EXPECT_FALSE(c.ok);
+    EXPECT_EQ(c.error.rfind("skipped", 0), 0u) << c.error;
+  }
 }
 
 }  // namespace
