@@ -112,7 +112,24 @@ TEST(SelectModel, ChoosesKannalaBrandtForAFisheye) {
   EXPECT_EQ(selection.candidates[selection.chosen].model,
             CameraModelId::kKannalaBrandt)
       << selection.Table();
-  // Corners beyond 90 degrees: the pinhole candidates are not even tried.
+}
+
+// Boards far off the axis, corners beyond 90 degrees: the pinhole
+// candidates are not even tried.
+TEST(SelectModel, SkipsPinholeModelsBeyondTheirField) {
+  const Camera truth = testing::TruthFisheye190();
+  SyntheticScene scene;
+  scene.camera = truth;
+  scene.num_views = 24;
+  scene.noise_px = 0.2;
+  scene.seed = 10;
+  scene.max_direction_deg = 85;
+  scene.min_visible_fraction = 0.4;
+  const ModelSelection selection = Select(MakeSyntheticData(scene), truth);
+  ASSERT_GE(selection.chosen, 0);
+  EXPECT_EQ(selection.candidates[selection.chosen].model,
+            CameraModelId::kKannalaBrandt)
+      << selection.Table();
   for (const ModelCandidate& c : selection.candidates) {
     if (!CameraModelIsPinhole(c.model)) continue;
     EXPECT_FALSE(c.ok);
