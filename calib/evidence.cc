@@ -568,6 +568,11 @@ Evidence ComputeEvidence(const std::vector<CalibrationView>& views,
                          const EvidenceOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Evidence evidence;
+  std::string why;
+  if (!options.Check(&why)) {
+    evidence.cross_validation.error = "evidence options: " + why;
+    return evidence;
+  }
   evidence.residuals = ComputeSystematicResiduals(views, result, options);
   const double max_angle = evidence.residuals.max_angle_deg;
   evidence.uncertainty =

@@ -199,7 +199,9 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
                               double max_angle_deg,
                               const EvidenceOptions& options);
 
-// All of the above for a successful Calibrate(views, ...) -> result.
+// All of the above for a successful Calibrate(views, ...) -> result. Invalid
+// options leave everything empty, with the reason in
+// cross_validation.error.
 Evidence ComputeEvidence(const std::vector<CalibrationView>& views,
                          const CalibrationResult& result,
                          const CalibrationOptions& calibration,

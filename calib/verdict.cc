@@ -132,6 +132,14 @@ std::string NextModel(CameraModelId model, bool grows_with_closeness,
 Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
                     const EvidenceOptions& evidence_options,
                     const VerdictOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) {
+    Verdict invalid;
+    invalid.kind = VerdictKind::kInsufficientData;
+    invalid.reason = "verdict options: " + why;
+    invalid.next_step = "fix the options";
+    return invalid;
+  }
   std::vector<Finding> findings;
   const int min_count = evidence_options.min_bin_count;
   const Camera& camera = result.camera;

@@ -112,6 +112,7 @@ struct Verdict {
 };
 
 // The verdict for a successful calibration (`result`) and its evidence.
+// Invalid options give insufficient-data with the options' fault as reason.
 Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
                     const EvidenceOptions& evidence_options,
                     const VerdictOptions& options);
