@@ -26,6 +26,9 @@
 #include "apps/subcommand.h"
 #include "calib/calibrate.h"
 #include "calib/camera_yaml.h"
+#include "calib/evidence.h"
+#include "calib/model_selection.h"
+#include "calib/verdict.h"
 
 namespace puzzlecal {
 namespace {
@@ -270,10 +273,11 @@ int RunCalibrate() {
                  "required. Run `puzzlecal calibrate --help`.\n";
     return kExitUsage;
   }
-  CameraModelId model;
-  if (!CameraModelIdFromName(FLAGS_model, &model)) {
+  CameraModelId model = CameraModelId::kPinholeRadtan;
+  const bool auto_model = FLAGS_model == "auto";
+  if (!auto_model && !CameraModelIdFromName(FLAGS_model, &model)) {
     std::cerr << "puzzlecal calibrate: unknown model '" << FLAGS_model
-              << "'; choose one of " << CameraModelNames() << ".\n";
+              << "'; choose one of " << CameraModelNames() << " or auto.\n";
     return kExitUsage;
   }
   std::string error;
@@ -286,7 +290,8 @@ int RunCalibrate() {
   // The format decides the model's free parameters (Kalibr's radtan has no
   // k3), so it is settled before any image is read.
   CalibrationOptions calibration_options;
-  if (!CameraFormatFixedParams(format, model, &calibration_options.fixed_params,
+  if (!auto_model &&
+      !CameraFormatFixedParams(format, model, &calibration_options.fixed_params,
                                &error)) {
     std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
               << error << ".\n";
@@ -357,6 +362,26 @@ int RunCalibrate() {
   }
 
   const auto calib_start = std::chrono::steady_clock::now();
+  // --model auto: the candidate with the lowest held-out error
+  // (calib/model_selection.h).
+  ModelSelection selection;
+  if (auto_model) {
+    if (!SelectModel(views, width, height, calibration_options,
+                     ModelSelectionOptions(), &selection, &error)) {
+      std::cerr << selection.Table() << "puzzlecal calibrate: " << error
+                << "\n";
+      return kExitNoResult;
+    }
+    std::cout << selection.Table();
+    model = selection.candidates[selection.chosen].model;
+    // The chosen model must fit the format (Kalibr's radtan has no k3).
+    if (!CameraFormatFixedParams(format, model,
+                                 &calibration_options.fixed_params, &error)) {
+      std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
+                << error << "; choose --model explicitly.\n";
+      return kExitUsage;
+    }
+  }
   CalibrationResult result;
   std::string calibration_error;
   const std::string mismatch = BoardMismatchMessage(images, board, FLAGS_board);
@@ -369,6 +394,16 @@ int RunCalibrate() {
   }
   if (!calibrated && !mismatch.empty()) calibration_error = mismatch;
   const double seconds_calibrate = SecondsSince(calib_start);
+  // Evidence (halves, uncertainty, binned residuals) and the verdict made
+  // from it (calib/evidence.h, calib/verdict.h).
+  const EvidenceOptions evidence_options;
+  Evidence evidence;
+  Verdict verdict;
+  if (calibrated) {
+    evidence = ComputeEvidence(views, result, calibration_options,
+                               evidence_options);
+    verdict = MakeVerdict(result, evidence, evidence_options, VerdictOptions());
+  }
 
   const std::vector<ReportImage> report_images =
       ReportLines(images, view_of_image, calibrated ? &result : nullptr);
@@ -383,8 +418,9 @@ int RunCalibrate() {
     for (size_t i = 0; i < images.size(); ++i) {
       if (view_of_image[i] >= 0) view_files[view_of_image[i]] = images[i].file;
     }
-    const CameraFileStats stats =
+    CameraFileStats stats =
         CameraFileStatsOfResult(result, view_files, board.Point(board.origin));
+    stats.verdict = verdict.Line();
     if (!WriteCameraFile(FLAGS_out, format, result.camera, stats, &error,
                          names)) {
       std::cerr << "puzzlecal calibrate: " << error << "\n";
@@ -407,6 +443,11 @@ int RunCalibrate() {
     input.seconds_calibrate = seconds_calibrate;
     input.seconds_total = SecondsSince(run_start);
     input.threads = threads;
+    if (calibrated) {
+      input.evidence = &evidence;
+      input.verdict = &verdict;
+    }
+    if (auto_model) input.model_selection = selection.Table();
     if (!WriteReportInPlace(FLAGS_report, input, &error)) {
       std::cerr << "puzzlecal calibrate: report not written: " << error
                 << (calibrated
@@ -432,6 +473,9 @@ int RunCalibrate() {
               << std::setprecision(4) << result.rms_px << " px\n";
   }
   if (verbosity == Verbosity::kVerbose) {
+    std::cout << EvidenceText(evidence) << std::setprecision(3)
+              << "evidence: " << evidence.seconds << " s (halves "
+              << evidence.cross_validation.seconds << " s)\n";
     std::cout << std::setprecision(3) << "time: " << seconds_total
               << " s wall clock on " << threads
               << " threads; summed over images: image decoding " << seconds_load
@@ -439,6 +483,7 @@ int RunCalibrate() {
               << seconds_grid_decode << " s; calibration " << seconds_calibrate
               << " s\n";
   }
+  std::cout << verdict.Line() << "\n";
   std::cout << "wrote " << FLAGS_out
             << (FLAGS_report.empty() ? "" : " and the report " + FLAGS_report)
             << "\n";

@@ -9,8 +9,9 @@ DEFINE_string(out, "",
               "render and undistort: a folder (created if missing). Files go "
               "into an existing, writable folder.");
 DEFINE_string(model, "pinhole-radtan",
-              "Camera model: pinhole-radtan, pinhole-rational or "
-              "kannala-brandt.");
+              "Camera model: pinhole-radtan, pinhole-rational, "
+              "kannala-brandt, or auto (calibrate: chosen by held-out "
+              "error).");
 DEFINE_string(format, "puzzlecal",
               "Camera file format: puzzlecal, opencv, ros or kalibr.");
 DEFINE_string(report, "", "Folder for the calibration report (optional).");

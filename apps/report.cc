@@ -862,6 +862,189 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
   return canvas;
 }
 
+// ---------------------------------------------------------------------------
+// Evidence plots (calib/evidence.h).
+
+// A PixelMap drawn over the image rectangle (bilinear between samples,
+// grey where the map has no value), with a colour bar from 0 to `colour_max`
+// (0: the map's largest value).
+cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
+                     const PixelMap& map, double colour_max,
+                     const std::string& title, const std::string& subtitle,
+                     const std::string& bar_label,
+                     const std::vector<std::string>& notes) {
+  ImageLayout layout =
+      MakeImageLayout(options.image_plot_width, data.width, data.height,
+                      static_cast<int>(notes.size()));
+  cv::Mat& canvas = layout.canvas;
+  const plot::Frame& frame = layout.frame;
+  double largest = 0;
+  for (double value : map.values) {
+    if (std::isfinite(value)) largest = std::max(largest, value);
+  }
+  if (!(colour_max > 0)) colour_max = largest > 0 ? largest : 1.0;
+  const cv::Rect& a = frame.area;
+  const int step = std::max(1, map.step_px);
+  auto value_at = [&](double x, double y) {
+    const double gx = x / step, gy = y / step;
+    const int i0 =
+        std::clamp(static_cast<int>(std::floor(gx)), 0, map.cols - 1);
+    const int j0 =
+        std::clamp(static_cast<int>(std::floor(gy)), 0, map.rows - 1);
+    const int i1 = std::min(i0 + 1, map.cols - 1);
+    const int j1 = std::min(j0 + 1, map.rows - 1);
+    const double fx = std::clamp(gx - i0, 0.0, 1.0);
+    const double fy = std::clamp(gy - j0, 0.0, 1.0);
+    const double v00 = map.At(i0, j0), v10 = map.At(i1, j0);
+    const double v01 = map.At(i0, j1), v11 = map.At(i1, j1);
+    if (std::isfinite(v00) && std::isfinite(v10) && std::isfinite(v01) &&
+        std::isfinite(v11)) {
+      return (1 - fy) * ((1 - fx) * v00 + fx * v10) +
+             fy * ((1 - fx) * v01 + fx * v11);
+    }
+    return map.At(fx < 0.5 ? i0 : i1, fy < 0.5 ? j0 : j1);
+  };
+  cv::Mat lut(256, 1, CV_8UC1);
+  for (int i = 0; i < 256; ++i) lut.at<uint8_t>(i) = static_cast<uint8_t>(i);
+  cv::Mat lut_colour;
+  cv::applyColorMap(lut, lut_colour, cv::COLORMAP_VIRIDIS);
+  if (map.cols > 0 && map.rows > 0) {
+    for (int v = 0; v < a.height; ++v) {
+      for (int u = 0; u < a.width; ++u) {
+        const double x = (u + 0.5) / layout.scale - 0.5;
+        const double y = (v + 0.5) / layout.scale - 0.5;
+        const double value = value_at(x, y);
+        cv::Vec3b colour(170, 170, 170);
+        if (std::isfinite(value)) {
+          colour = lut_colour.at<cv::Vec3b>(static_cast<int>(
+              std::lround(std::clamp(value / colour_max, 0.0, 1.0) * 255)));
+        }
+        canvas.at<cv::Vec3b>(a.y + v, a.x + u) = colour;
+      }
+    }
+  }
+  plot::DrawAxes(&canvas, frame, "x (px)", "y (px)", false);
+  const cv::Rect bar(a.x + a.width + 20, a.y, 22, a.height);
+  plot::DrawColourBar(&canvas, bar, 0, colour_max, cv::COLORMAP_VIRIDIS,
+                      bar_label);
+  plot::DrawTitle(&canvas, title, subtitle);
+  for (size_t k = 0; k < notes.size(); ++k) {
+    DrawNote(&layout, static_cast<int>(k), notes[k]);
+  }
+  return canvas;
+}
+
+cv::Mat PlotCrossValidation(const ReportData& data,
+                            const ReportOptions& options,
+                            const CrossValidation& cv) {
+  double largest_band = 0;
+  for (const AngleBand& band : cv.difference_bands) {
+    if (band.count > 0) largest_band = std::max(largest_band, band.p95);
+  }
+  return PlotPixelMap(
+      data, options, cv.difference_px, largest_band,
+      "Cross-validation: projection difference between two halves of the views",
+      Format("%d + %d views calibrated apart (alternating); far-field "
+             "difference after the best-fit rotation (%.3f deg)",
+             cv.views_a, cv.views_b, cv.rotation_deg),
+      "|A - B| (px)",
+      {"Each pixel's ray under half A, rotated into half B's frame and "
+       "projected by B, against the pixel. Colours up to the largest "
+       "band's 95th percentile.",
+       "Noise alone predicts differences of the size in summary.md "
+       "(\"expected\"); far larger ones are model error.",
+       "Grey: beyond the widest field angle of any used corner (not "
+       "compared) or no ray."});
+}
+
+cv::Mat PlotUncertainty(const ReportData& data, const ReportOptions& options,
+                        const ProjectionUncertainty& uncertainty,
+                        double max_angle_deg) {
+  PixelMap map = uncertainty.sigma_px;
+  double largest = 0;
+  for (size_t k = 0; k < map.values.size(); ++k) {
+    if (std::isfinite(map.values[k]) && std::isfinite(map.angle_deg[k]) &&
+        map.angle_deg[k] <= max_angle_deg) {
+      largest = std::max(largest, map.values[k]);
+    }
+  }
+  return PlotPixelMap(
+      data, options, map, largest,
+      "Projection uncertainty (1 sigma) of a far point at each pixel",
+      "sqrt(tr(C) / 2) per axis, C = A Sigma A^T, A = d pixel / d intrinsics "
+      "(ray fixed) less the part a common rotation undoes",
+      "1 sigma (px)",
+      {Format("Colours scaled to the observed field (up to %.1f deg); "
+              "beyond it the value grows and saturates.",
+              max_angle_deg),
+       "Sigma: the intrinsics' covariance marginal over the board poses, "
+       "scaled by the residual variance."});
+}
+
+cv::Mat PlotResidualBins(const ReportData& data, const ReportOptions& options,
+                         const SystematicResiduals& residuals) {
+  (void)data;
+  cv::Mat canvas(options.chart_height, options.chart_width, CV_8UC3,
+                 plot::kWhite);
+  const int half = options.chart_width / 2;
+  auto panel = [&](const std::vector<ResidualBin>& bins, int x0,
+                   const std::string& x_label) {
+    plot::Frame frame;
+    frame.area =
+        cv::Rect(x0 + 90, 90, half - 90 - 30, options.chart_height - 90 - 80);
+    double lo = 0, hi = 1, extent = 0.05;
+    if (!bins.empty()) {
+      lo = bins.front().lo;
+      hi = bins.back().hi;
+    }
+    for (const ResidualBin& b : bins) {
+      if (b.count < 2) continue;
+      extent =
+          std::max({extent, std::abs(b.mean_radial_px) + 2 * b.se_radial_px,
+                    std::abs(b.mean_tangential_px) + 2 * b.se_tangential_px});
+    }
+    frame.x_min = lo;
+    frame.x_max = hi > lo ? hi : lo + 1;
+    frame.y_min = -1.1 * extent;
+    frame.y_max = 1.1 * extent;
+    plot::DrawAxes(&canvas, frame, x_label, "mean residual (px)", true);
+    plot::DrawDashedLine(&canvas, frame.ToCanvas(frame.x_min, 0),
+                         frame.ToCanvas(frame.x_max, 0), plot::kGrey, 1, 6);
+    for (const ResidualBin& b : bins) {
+      if (b.count < 2) continue;
+      const double width = b.hi - b.lo;
+      for (int c = 0; c < 2; ++c) {
+        const double mean = c == 0 ? b.mean_radial_px : b.mean_tangential_px;
+        const double se = c == 0 ? b.se_radial_px : b.se_tangential_px;
+        const double x = b.lo + width * (c == 0 ? 0.4 : 0.6);
+        const cv::Scalar colour = c == 0 ? plot::kBlue : plot::kOrange;
+        cv::line(canvas, frame.ToCanvasPixel(x, mean - 2 * se),
+                 frame.ToCanvasPixel(x, mean + 2 * se), colour, 2, cv::LINE_AA);
+        cv::circle(canvas, frame.ToCanvasPixel(x, mean), 5, colour, cv::FILLED,
+                   cv::LINE_AA);
+      }
+      plot::DrawText(&canvas, Format("%d", b.count),
+                     frame.ToCanvasPixel(b.lo + 0.5 * width, frame.y_max) +
+                         cv::Point(0, 14),
+                     plot::kTickScale, plot::kGrey, Align::kCenter);
+    }
+    cv::rectangle(canvas, frame.area, plot::kBlack, 1);
+  };
+  panel(residuals.by_angle, 0, "field angle of the corner's ray (deg)");
+  panel(residuals.by_distance, half,
+        "distance of the corner from the camera (m)");
+  plot::DrawTitle(
+      &canvas, "Binned residual means (radial and tangential, +- 2 SE)",
+      "A right model leaves every mean near zero; grey numbers: corners "
+      "per bin");
+  const std::vector<plot::LegendEntry> legend = {
+      {plot::LegendEntry::Marker::kCircle, plot::kBlue,
+       "radial (> 0: projected farther out than seen)"},
+      {plot::LegendEntry::Marker::kCircle, plot::kOrange, "tangential"}};
+  plot::DrawLegend(&canvas, {100, 100}, legend);
+  return canvas;
+}
+
 std::string SafeStem(const std::string& file) {
   std::string stem = std::filesystem::path(file).stem().string();
   for (char& c : stem) {
@@ -1027,6 +1210,102 @@ std::string FormatWithSigma(double value, double sigma,
   return Format("%.8g", value);
 }
 
+namespace {
+
+// The evidence section of summary.md.
+std::string EvidenceMarkdown(const ReportInput& input) {
+  const Evidence& evidence = *input.evidence;
+  std::ostringstream md;
+  md << "## Evidence\n\n";
+  if (input.verdict != nullptr) {
+    md << "Verdict **" << VerdictKindName(input.verdict->kind)
+       << "**: " << input.verdict->reason
+       << ". Next step: " << input.verdict->next_step << ".\n\n";
+    if (input.verdict->findings.size() > 1) {
+      md << "All findings:\n\n";
+      for (const std::string& f : input.verdict->findings) {
+        md << "- " << f << "\n";
+      }
+      md << "\n";
+    }
+  }
+  const CrossValidation& cv = evidence.cross_validation;
+  md << "### Cross-validation (two halves of the views)\n\n";
+  if (cv.ok) {
+    md << Format(
+        "Views alternately into halves of %d and %d, each calibrated alone "
+        "(RMS %.3f and %.3f px). Far-field projection difference after the "
+        "best-fit rotation between the halves' camera frames (%.3f deg), "
+        "against the difference the halves' own covariances predict (RMS "
+        "length):\n\n",
+        cv.views_a, cv.views_b, cv.rms_a_px, cv.rms_b_px, cv.rotation_deg);
+    md << "| field angle | samples | difference median (px) | p95 (px) | "
+          "expected median (px) | p95 (px) |\n|---|---:|---:|---:|---:|---:|\n";
+    for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
+      const AngleBand& d = cv.difference_bands[b];
+      const AngleBand& e = cv.expected_bands[b];
+      if (d.count == 0) continue;
+      md << Format("| %.0f-%.0f deg | %d | %.3f | %.3f | %.3f | %.3f |\n",
+                   d.lo_deg, d.hi_deg, d.count, d.median, d.p95, e.median,
+                   e.p95);
+    }
+    md << "\n";
+  } else {
+    md << "Not available: " << Cell(cv.error) << "\n\n";
+  }
+  md << "### Projection uncertainty\n\n";
+  const ProjectionUncertainty& u = evidence.uncertainty;
+  if (u.ok) {
+    md << "1-sigma of the projection of a far point, per image axis "
+          "(sqrt(tr(C) / 2) of its 2 x 2 covariance, from the intrinsics' "
+          "covariance marginal over the poses); the largest over the "
+          "directions at each angle that land in the image. First column: "
+          "after the best-fit common rotation of the camera frame over the "
+          "observed field (a shift of cx, cy that a rotation of all board "
+          "poses undoes is no uncertainty of the lens; the map and the "
+          "verdict use this). Second: the ray held fixed in the camera "
+          "frame.\n\n| where | 1 sigma (px) | in the camera frame (px) "
+          "|\n|---|---:|---:|\n";
+    for (const UncertaintyPoint& p : u.points) {
+      md << "| " << p.label << " | "
+         << (p.in_image
+                 ? Format("%.4f | %.4f", p.sigma_px, p.camera_frame_sigma_px)
+                 : std::string("not in image | not in image"))
+         << " |\n";
+    }
+    md << "\n";
+  } else {
+    md << "Not available (no covariance).\n\n";
+  }
+  md << "### Systematic residuals\n\n"
+        "Mean residual (projected minus detected) of the inlier corners, "
+        "split into the component away from the principal point (radial) and "
+        "across it (tangential), +- its standard error (corners taken as "
+        "independent).\n\n";
+  auto table = [&](const std::vector<ResidualBin>& bins, const char* what,
+                   bool metres) {
+    md << "| " << what << " | corners | radial (px) | tangential (px) |\n"
+       << "|---|---:|---:|---:|\n";
+    for (const ResidualBin& b : bins) {
+      md << (metres ? Format("| %.3f-%.3f m", b.lo, b.hi)
+                    : Format("| %.0f-%.0f deg", b.lo, b.hi))
+         << Format(" | %d | %+.4f ± %.4f | %+.4f ± %.4f |\n", b.count,
+                   b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
+                   b.se_tangential_px);
+    }
+    md << "\n";
+  };
+  table(evidence.residuals.by_angle, "field angle", false);
+  table(evidence.residuals.by_distance, "distance from the camera", true);
+  md << Format(
+      "Evidence computed in %.2f s (of which the two half "
+      "calibrations %.2f s).\n\n",
+      evidence.seconds, cv.seconds);
+  return md.str();
+}
+
+}  // namespace
+
 std::string ReportMarkdown(const ReportInput& input,
                            const ReportOptions& options,
                            const std::vector<std::string>& png_files) {
@@ -1040,6 +1319,7 @@ std::string ReportMarkdown(const ReportInput& input,
   const Camera& camera = result.camera;
   std::ostringstream md;
   md << "# Calibration report\n\n";
+  if (input.verdict != nullptr) md << "**" << input.verdict->Line() << "**\n\n";
   md << "Model **" << CameraModelName(camera.model) << "**, image "
      << camera.width << " x " << camera.height
      << " px; board: " << BoardTypeName(input.board.type) << ", "
@@ -1098,6 +1378,11 @@ std::string ReportMarkdown(const ReportInput& input,
         "suits the lens.";
   if (!result.covariance_ok) md << " **The covariance could not be computed.**";
   md << "\n\n";
+
+  if (!input.model_selection.empty()) {
+    md << "## Model selection\n\n```\n" << input.model_selection << "```\n\n";
+  }
+  if (input.evidence != nullptr) md << EvidenceMarkdown(input);
 
   // Worst views.
   std::vector<int> used;
@@ -1208,6 +1493,18 @@ std::string ReportMarkdown(const ReportInput& input,
                    "more than 90 deg off the axis")
          << ". White lines mark the angle of the ray from the optical "
             "axis.\n";
+    } else if (file == "cross_validation.png") {
+      md << "how far the two halves of the views, calibrated apart, "
+            "disagree on where a far point projects (after the best-fit "
+            "rotation between their camera frames). Compare with the "
+            "expected figures in the evidence section.\n";
+    } else if (file == "uncertainty.png") {
+      md << "the 1-sigma of the projection of a far point at each pixel, "
+            "from the parameter covariance: how well the views pin the "
+            "model down there (not whether the model suits the lens).\n";
+    } else if (file == "residual_bins.png") {
+      md << "residual means by field angle and by board distance with "
+            "+- 2 standard errors; means away from zero are model error.\n";
     } else {
       md << "\n";
     }
@@ -1299,6 +1596,25 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
     } else {
       summary->warnings.push_back(
           "no distortion map: the result's camera parameters are not valid");
+    }
+    if (input.evidence != nullptr && data.camera_valid) {
+      const Evidence& evidence = *input.evidence;
+      if (evidence.cross_validation.ok &&
+          !write_png(
+              "cross_validation.png",
+              PlotCrossValidation(data, options, evidence.cross_validation))) {
+        return false;
+      }
+      if (evidence.uncertainty.ok &&
+          !write_png("uncertainty.png",
+                     PlotUncertainty(data, options, evidence.uncertainty,
+                                     evidence.residuals.max_angle_deg))) {
+        return false;
+      }
+      if (!write_png("residual_bins.png",
+                     PlotResidualBins(data, options, evidence.residuals))) {
+        return false;
+      }
     }
     std::set<std::string> taken;
     for (const auto& [v, rank] : PickOverlayViews(data, options.num_overlays)) {

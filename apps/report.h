@@ -10,6 +10,8 @@
 #include "apps/image_io.h"
 #include "calib/calibrate.h"
 #include "calib/calibration_view.h"
+#include "calib/evidence.h"
+#include "calib/verdict.h"
 #include "decode/board.h"
 
 namespace puzzlecal {
@@ -84,6 +86,14 @@ struct ReportInput {
   double seconds_calibrate = -1;
   double seconds_total = -1;
   int threads = 0;
+  // Evidence on the calibration and its verdict (calib/evidence.h,
+  // calib/verdict.h); null when not computed. The verdict heads
+  // summary.md; the evidence adds a section and cross_validation.png,
+  // uncertainty.png and residual_bins.png.
+  const Evidence* evidence = nullptr;
+  const Verdict* verdict = nullptr;
+  // The comparison table of `--model auto` ("" when not run).
+  std::string model_selection;
 };
 
 // What WriteReport did.
@@ -93,7 +103,8 @@ struct ReportSummary {
 };
 
 // Writes into `dir` (created if needed): summary.md, residuals.png,
-// residual_histogram.png, view_rms.png, coverage.png, distortion.png and
+// residual_histogram.png, view_rms.png, coverage.png, distortion.png,
+// the evidence plots (when input.evidence is set) and
 // overlay_<image name>.png for options.num_overlays views. Files are
 // written atomically (temporary name, then rename). Returns false with a
 // message naming the path on failure; `summary` (optional) lists the files.

@@ -112,6 +112,9 @@ std::string FormatPuzzlecal(const Camera& camera,
     out << YAML::Key << "views_used" << YAML::Value << stats.num_views_used;
     out << YAML::Key << "corners_used" << YAML::Value << stats.num_corners_used;
     out << YAML::Key << "outliers" << YAML::Value << stats.num_outliers;
+    if (!stats.verdict.empty()) {
+      out << YAML::Key << "verdict" << YAML::Value << stats.verdict;
+    }
     if (!stats.views.empty()) {
       out << YAML::Key << "views" << YAML::Value << YAML::BeginSeq;
       for (const CameraFileView& view : stats.views) EmitView(view, out);

@@ -49,6 +49,8 @@ struct CameraFileStats {
   int num_corners_used = 0;
   int num_outliers = 0;
   std::vector<CameraFileView> views;  // the views used, in input order
+  // The calibration's verdict line (calib/verdict.h); "" writes none.
+  std::string verdict;
 };
 
 // The statistics of `result` with its used views; `view_files[v]` names view

@@ -1,0 +1,244 @@
+#include "calib/model_selection.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+namespace puzzlecal {
+namespace {
+
+bool Fail(const std::string& message, std::string* why) {
+  if (why != nullptr) *why = message;
+  return false;
+}
+
+// The widest angle from the optical axis of a used corner under the fitted
+// poses, degrees.
+double WidestFieldDeg(const std::vector<CalibrationView>& views,
+                      const CalibrationResult& result) {
+  double widest = 0;
+  for (size_t v = 0; v < views.size() && v < result.view_used.size(); ++v) {
+    if (!result.view_used[v]) continue;
+    for (const Eigen::Vector3d& board : views[v].board_points) {
+      const Eigen::Vector3d point = result.cam_from_board[v] * board;
+      widest = std::max(
+          widest, std::atan2(point.head<2>().norm(), point.z()) * 180.0 / M_PI);
+    }
+  }
+  return widest;
+}
+
+}  // namespace
+
+bool ModelSelectionOptions::Check(std::string* why) const {
+  if (holdout_every < 2) return Fail("holdout_every must be >= 2", why);
+  if (holdout_offset < 0 || holdout_offset >= holdout_every) {
+    return Fail("holdout_offset must be in [0, holdout_every)", why);
+  }
+  for (const std::string& name : candidates) {
+    CameraModelId id;
+    if (!CameraModelIdFromName(name, &id)) {
+      return Fail("unknown candidate model '" + name + "' (choose from " +
+                      CameraModelNames() + ")",
+                  why);
+    }
+  }
+  if (!(pinhole_max_field_deg > 0 && pinhole_max_field_deg <= 90)) {
+    return Fail("pinhole_max_field_deg must be in (0, 90]", why);
+  }
+  if (!(min_relative_gain >= 0)) {
+    return Fail("min_relative_gain must be >= 0", why);
+  }
+  return true;
+}
+
+bool HoldoutError(const std::vector<CalibrationView>& views,
+                  const Camera& camera, const CalibrationOptions& calibration,
+                  double* rms_px, int* corners, std::string* error) {
+  // Calibrate with every intrinsic held: only the poses move. The checks
+  // meant for a calibration (views, spread, coverage, RMS) do not apply to
+  // a pose fit; no corner is dropped, so a model that cannot follow the
+  // lens pays for all of its corners.
+  CalibrationOptions options = calibration;
+  options.initial_params = camera.params;
+  options.fix_focal_length = true;
+  options.fix_principal_point = true;
+  options.fix_distortion = true;
+  options.outlier_k = 0;
+  options.min_views = 1;
+  options.min_orientation_spread_deg = 0;
+  options.min_coverage = 0;
+  options.max_rms_px = std::numeric_limits<double>::max();
+  options.compute_covariance = false;
+  CalibrationResult result;
+  if (!Calibrate(views, camera.model, camera.width, camera.height, options,
+                 &result, error)) {
+    return false;
+  }
+  double sum2 = 0;
+  int n = 0;
+  for (size_t v = 0; v < result.residuals.size(); ++v) {
+    if (!result.view_used[v]) continue;
+    for (size_t i = 0; i < result.residuals[v].size(); ++i) {
+      if (!result.inlier[v][i]) continue;
+      sum2 += result.residuals[v][i].squaredNorm();
+      ++n;
+    }
+  }
+  *corners = n;
+  *rms_px = n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
+  return n > 0 || Fail("no held-out corner projects", error);
+}
+
+bool SelectModel(const std::vector<CalibrationView>& views, int width,
+                 int height, const CalibrationOptions& calibration,
+                 const ModelSelectionOptions& options,
+                 ModelSelection* selection, std::string* error) {
+  *selection = ModelSelection();
+  selection->min_relative_gain = options.min_relative_gain;
+  std::string why;
+  if (!options.Check(&why))
+    return Fail("model selection options: " + why, error);
+  std::vector<CameraModelId> models;
+  if (options.candidates.empty()) {
+    models.assign(kAllCameraModels.begin(), kAllCameraModels.end());
+  } else {
+    for (const std::string& name : options.candidates) {
+      CameraModelId id;
+      CameraModelIdFromName(name, &id);
+      models.push_back(id);
+    }
+  }
+  std::vector<CalibrationView> fit, holdout;
+  int position = 0;
+  for (const CalibrationView& view : views) {
+    if (static_cast<int>(view.board_points.size()) <
+        calibration.min_corners_per_view) {
+      continue;
+    }
+    if (position++ % options.holdout_every == options.holdout_offset) {
+      holdout.push_back(view);
+    } else {
+      fit.push_back(view);
+    }
+  }
+  selection->fit_views = static_cast<int>(fit.size());
+  selection->holdout_views = static_cast<int>(holdout.size());
+  if (holdout.empty()) {
+    return Fail("model selection: too few views to hold any out (" +
+                    std::to_string(position) + ")",
+                error);
+  }
+  // Fisheye models first: the widest field angle they see tells whether a
+  // pinhole model can hold the views at all.
+  std::stable_partition(models.begin(), models.end(), [](CameraModelId id) {
+    return !CameraModelIsPinhole(id);
+  });
+  double widest_deg = 0;
+  for (CameraModelId model : models) {
+    const auto start = std::chrono::steady_clock::now();
+    ModelCandidate candidate;
+    candidate.model = model;
+    candidate.num_params = CameraModelNumParams(model);
+    candidate.holdout_views = static_cast<int>(holdout.size());
+    CalibrationOptions fit_options = calibration;
+    fit_options.compute_covariance = false;
+    CalibrationResult result;
+    std::string fit_error;
+    if (CameraModelIsPinhole(model) &&
+        widest_deg > options.pinhole_max_field_deg) {
+      char text[160];
+      std::snprintf(text, sizeof(text),
+                    "skipped: the corners reach %.1f deg off the axis "
+                    "(limit %.1f deg for a pinhole model)",
+                    widest_deg, options.pinhole_max_field_deg);
+      candidate.error = text;
+    } else if (!Calibrate(fit, model, width, height, fit_options, &result,
+                          &fit_error)) {
+      candidate.error = "calibration failed: " + fit_error;
+    } else {
+      candidate.fit_rms_px = result.rms_px;
+      if (!CameraModelIsPinhole(model)) {
+        widest_deg = std::max(widest_deg, WidestFieldDeg(fit, result));
+      }
+      std::string holdout_error;
+      if (HoldoutError(holdout, result.camera, calibration,
+                       &candidate.holdout_rms_px, &candidate.holdout_corners,
+                       &holdout_error)) {
+        candidate.ok = true;
+      } else {
+        candidate.error = "held-out fit failed: " + holdout_error;
+      }
+    }
+    candidate.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count();
+    selection->candidates.push_back(candidate);
+  }
+  // Lowest held-out error; a model with more parameters must beat the best
+  // one with fewer by min_relative_gain.
+  double best = std::numeric_limits<double>::infinity();
+  for (const ModelCandidate& c : selection->candidates) {
+    if (c.ok) best = std::min(best, c.holdout_rms_px);
+  }
+  for (size_t k = 0; k < selection->candidates.size(); ++k) {
+    const ModelCandidate& c = selection->candidates[k];
+    if (!c.ok || c.holdout_rms_px > best * (1 + options.min_relative_gain)) {
+      continue;
+    }
+    if (selection->chosen < 0 ||
+        c.num_params < selection->candidates[selection->chosen].num_params ||
+        (c.num_params == selection->candidates[selection->chosen].num_params &&
+         c.holdout_rms_px <
+             selection->candidates[selection->chosen].holdout_rms_px)) {
+      selection->chosen = static_cast<int>(k);
+    }
+  }
+  if (selection->chosen < 0) {
+    std::string reasons;
+    for (const ModelCandidate& c : selection->candidates) {
+      reasons += std::string("; ") + CameraModelName(c.model) + ": " + c.error;
+    }
+    return Fail(
+        "model selection: no candidate model could be calibrated" + reasons,
+        error);
+  }
+  return true;
+}
+
+std::string ModelSelection::Table() const {
+  std::ostringstream table;
+  table << "model selection: " << fit_views << " views fitted, "
+        << holdout_views << " held out (poses fitted, intrinsics fixed)\n";
+  table << "  model                       params  fit RMS   held-out RMS  "
+           "corners  time\n";
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const ModelCandidate& c = candidates[k];
+    char line[256];
+    if (c.ok) {
+      std::snprintf(line, sizeof(line),
+                    "%s %-27s %6d  %7.4f   %12.4f  %7d  %.1f s\n",
+                    static_cast<int>(k) == chosen ? "*" : " ",
+                    CameraModelName(c.model), c.num_params, c.fit_rms_px,
+                    c.holdout_rms_px, c.holdout_corners, c.seconds);
+      table << line;
+    } else {
+      std::snprintf(line, sizeof(line),
+                    "  %-27s %6d  failed (%.1f s): ", CameraModelName(c.model),
+                    c.num_params, c.seconds);
+      table << line << c.error << "\n";
+    }
+  }
+  if (chosen >= 0) {
+    table << "chosen: " << CameraModelName(candidates[chosen].model)
+          << " (lowest held-out RMS; candidates within "
+          << static_cast<int>(std::lround(100 * min_relative_gain))
+          << " % of it go to the one with fewer parameters)\n";
+  }
+  return table.str();
+}
+
+}  // namespace puzzlecal

@@ -1,0 +1,100 @@
+// The evidence sections of the calibration report: the verdict heads
+// summary.md, the evidence tables follow, and the evidence plots are written.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/report.h"
+#include "calib/calibrate.h"
+#include "calib/evidence.h"
+#include "calib/verdict.h"
+#include "tests/calib/synthetic_views.h"
+
+namespace puzzlecal {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+TEST(ReportEvidence, VerdictHeadsTheSummaryAndPlotsAreWritten) {
+  testing::SyntheticScene scene;
+  scene.camera = testing::TruthFisheye190();
+  scene.num_views = 16;
+  scene.noise_px = 0.2;
+  scene.max_direction_deg = 45;
+  scene.min_visible_fraction = 0.6;
+  const testing::SyntheticData data = testing::MakeSyntheticData(scene);
+  CalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(Calibrate(data.views, scene.camera.model, scene.camera.width,
+                        scene.camera.height, CalibrationOptions(), &result,
+                        &error))
+      << error;
+  const EvidenceOptions evidence_options;
+  const Evidence evidence = ComputeEvidence(
+      data.views, result, CalibrationOptions(), evidence_options);
+  const Verdict verdict =
+      MakeVerdict(result, evidence, evidence_options, VerdictOptions());
+
+  ReportInput input;
+  input.board.cols = scene.board_cols;
+  input.board.rows = scene.board_rows;
+  input.board.tile_size_m = scene.tile;
+  input.result = &result;
+  input.views = &data.views;
+  input.evidence = &evidence;
+  input.verdict = &verdict;
+  for (size_t v = 0; v < data.views.size(); ++v) {
+    ReportImage image;
+    image.file = data.views[v].name + ".png";  // not on disk: no overlays
+    image.outcome = "used";
+    image.view_index = static_cast<int>(v);
+    input.images.push_back(image);
+  }
+  ReportOptions options;
+  options.num_overlays = 0;
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / "puzzlecal_report_evidence_test";
+  fs::remove_all(dir);
+  ReportSummary summary;
+  ASSERT_TRUE(WriteReport(dir.string(), input, options, &error, &summary))
+      << error;
+  for (const char* name :
+       {"cross_validation.png", "uncertainty.png", "residual_bins.png"}) {
+    EXPECT_NE(std::find(summary.files.begin(), summary.files.end(), name),
+              summary.files.end())
+        << name;
+    const cv::Mat image = cv::imread((dir / name).string());
+    EXPECT_FALSE(image.empty()) << name;
+  }
+  const std::string markdown = ReadText(dir / "summary.md");
+  EXPECT_EQ(
+      markdown.rfind("# Calibration report\n\n**" + verdict.Line() + "**", 0),
+      0u)
+      << markdown.substr(0, 300);
+  EXPECT_NE(markdown.find("## Evidence"), std::string::npos);
+  EXPECT_NE(markdown.find("### Cross-validation"), std::string::npos);
+  EXPECT_NE(markdown.find("### Projection uncertainty"), std::string::npos);
+  EXPECT_NE(markdown.find("### Systematic residuals"), std::string::npos);
+  // One table row per residual bin by field angle.
+  const std::string first_bin =
+      "| 0-10 deg | " + std::to_string(evidence.residuals.by_angle[0].count) +
+      " |";
+  EXPECT_NE(markdown.find(first_bin), std::string::npos) << first_bin;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace puzzlecal

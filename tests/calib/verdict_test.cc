@@ -1,0 +1,233 @@
+#include "calib/verdict.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "calib/calibrate.h"
+#include "calib/evidence.h"
+#include "tests/calib/synthetic_views.h"
+
+namespace puzzlecal {
+namespace {
+
+using testing::MakeSyntheticData;
+using testing::SyntheticData;
+using testing::SyntheticScene;
+
+struct Judged {
+  bool calibrated = false;
+  std::string error;
+  CalibrationResult result;
+  Evidence evidence;
+  Verdict verdict;
+};
+
+Judged Judge(const std::vector<CalibrationView>& views, CameraModelId model,
+             int width, int height,
+             CalibrationOptions options = CalibrationOptions()) {
+  Judged judged;
+  judged.calibrated = Calibrate(views, model, width, height, options,
+                                &judged.result, &judged.error);
+  if (!judged.calibrated) return judged;
+  const EvidenceOptions evidence_options;
+  judged.evidence =
+      ComputeEvidence(views, judged.result, options, evidence_options);
+  judged.verdict = MakeVerdict(judged.result, judged.evidence, evidence_options,
+                               VerdictOptions());
+  return judged;
+}
+
+SyntheticScene Scene(const Camera& camera, int num_views, unsigned seed) {
+  SyntheticScene scene;
+  scene.camera = camera;
+  scene.num_views = num_views;
+  scene.noise_px = 0.2;
+  scene.seed = seed;
+  scene.max_direction_deg = 40;
+  scene.min_visible_fraction = 0.6;
+  return scene;
+}
+
+TEST(VerdictOptions, CheckRejectsBadValues) {
+  VerdictOptions options;
+  EXPECT_TRUE(options.Check());
+  options.halves_factor = 0;
+  EXPECT_FALSE(options.Check());
+  options = VerdictOptions();
+  options.max_outlier_fraction = 2;
+  EXPECT_FALSE(options.Check());
+  options = VerdictOptions();
+  options.pinhole_max_field_deg = 95;
+  EXPECT_FALSE(options.Check());
+  options = VerdictOptions();
+  options.min_views = 0;
+  EXPECT_FALSE(options.Check());
+}
+
+TEST(Verdict, LineHasKindReasonAndNextStep) {
+  Verdict verdict;
+  verdict.kind = VerdictKind::kModelError;
+  verdict.reason = "why";
+  verdict.next_step = "what";
+  EXPECT_EQ(verdict.Line(), "verdict: model-error \u2014 why \u2014 what");
+}
+
+TEST(NextModel, NamesTheModelToTry) {
+  const VerdictOptions options;
+  EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandt, true, 80, options),
+            "kannala-brandt-noncentral");
+  EXPECT_EQ(NextModel(CameraModelId::kPinholeRadtan, false, 85, options),
+            "kannala-brandt");
+  EXPECT_EQ(NextModel(CameraModelId::kPinholeRational, false, 85, options),
+            "kannala-brandt");
+  EXPECT_EQ(NextModel(CameraModelId::kPinholeRadtan, false, 45, options),
+            "pinhole-rational");
+}
+
+// The right model on clean data of several lenses: good.
+TEST(Verdict, CleanScenesAreGood) {
+  for (const Camera& truth : {testing::TruthRadtan(), testing::TruthRational(),
+                              testing::TruthFisheye190()}) {
+    const SyntheticData data = MakeSyntheticData(Scene(truth, 24, 3));
+    const Judged judged =
+        Judge(data.views, truth.model, truth.width, truth.height);
+    ASSERT_TRUE(judged.calibrated) << judged.error;
+    EXPECT_EQ(judged.verdict.kind, VerdictKind::kGood)
+        << CameraModelName(truth.model) << ": " << judged.verdict.Line() << "\n"
+        << EvidenceText(judged.evidence);
+  }
+}
+
+// A pinhole model on a strong fisheye (corners up to 80 degrees off the
+// axis): model-error, and the next step is kannala-brandt.
+TEST(Verdict, PinholeOnFisheyeIsModelErrorNamingKannalaBrandt) {
+  const Camera truth = testing::TruthFisheye190();
+  SyntheticScene scene = Scene(truth, 24, 5);
+  scene.max_corner_angle_deg = 80;
+  scene.max_direction_deg = 60;
+  scene.min_visible_fraction = 0.4;
+  const SyntheticData data = MakeSyntheticData(scene);
+  // The RMS limit is raised so the (poor) fit is judged at all.
+  CalibrationOptions options;
+  options.max_rms_px = 1000;
+  const Judged judged = Judge(data.views, CameraModelId::kPinholeRadtan,
+                              truth.width, truth.height, options);
+  ASSERT_TRUE(judged.calibrated) << judged.error;
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kModelError)
+      << judged.verdict.Line();
+  EXPECT_EQ(judged.verdict.suggested_model, "kannala-brandt");
+  EXPECT_NE(judged.verdict.next_step.find("--model kannala-brandt"),
+            std::string::npos);
+}
+
+// Kannala-Brandt projection through an entrance pupil that moves along the
+// axis with the field angle, z0(theta) = e1 theta^2 (a non-central lens):
+// theta is the angle of the ray from (0, 0, z0(theta)) to the point.
+bool ProjectNoncentral(const Camera& camera, double e1,
+                       const Eigen::Vector3d& point, Eigen::Vector2d* pixel) {
+  const double r = point.head<2>().norm();
+  double theta = std::atan2(r, point.z());
+  for (int it = 0; it < 50; ++it) {
+    theta = std::atan2(r, point.z() - e1 * theta * theta);
+  }
+  // The central model's projection of a point along the corrected ray.
+  const Eigen::Vector3d ray(std::sin(theta) * point.x() / r,
+                            std::sin(theta) * point.y() / r, std::cos(theta));
+  return camera.Project(ray, pixel);
+}
+
+// The central model on a non-central lens seen from close up: model-error,
+// and the next step is kannala-brandt-noncentral.
+TEST(Verdict, CentralModelOnNoncentralLensNamesNoncentral) {
+  const Camera truth = testing::TruthFisheye190();
+  SyntheticScene scene = Scene(truth, 40, 19);
+  scene.noise_px = 0.1;
+  scene.max_corner_angle_deg = 85;
+  scene.max_direction_deg = 60;
+  scene.min_distance = 0.4;
+  scene.max_distance = 2.0;
+  scene.min_visible_fraction = 0.4;
+  SyntheticData data = MakeSyntheticData(scene);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal(0.0, scene.noise_px);
+  constexpr double kE1 = 0.004;  // metres per rad^2: 9 mm at 90 degrees
+  for (size_t v = 0; v < data.views.size(); ++v) {
+    CalibrationView& view = data.views[v];
+    for (size_t i = 0; i < view.board_points.size(); ++i) {
+      Eigen::Vector2d pixel;
+      ASSERT_TRUE(ProjectNoncentral(
+          truth, kE1, data.cam_from_board[v] * view.board_points[i], &pixel));
+      view.image_points[i] = pixel + Eigen::Vector2d(normal(rng), normal(rng));
+    }
+  }
+  const Judged judged = Judge(data.views, CameraModelId::kKannalaBrandt,
+                              truth.width, truth.height);
+  ASSERT_TRUE(judged.calibrated) << judged.error;
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kModelError)
+      << judged.verdict.Line() << "\n"
+      << EvidenceText(judged.evidence);
+  EXPECT_EQ(judged.verdict.suggested_model, "kannala-brandt-noncentral");
+  EXPECT_NE(judged.verdict.reason.find("closer"), std::string::npos)
+      << judged.verdict.reason << "\n"
+      << EvidenceText(judged.evidence);
+
+  // The same poses through the central lens: good.
+  SyntheticScene central = scene;
+  const SyntheticData clean = MakeSyntheticData(central);
+  const Judged good = Judge(clean.views, CameraModelId::kKannalaBrandt,
+                            truth.width, truth.height);
+  ASSERT_TRUE(good.calibrated) << good.error;
+  EXPECT_EQ(good.verdict.kind, VerdictKind::kGood) << good.verdict.Line();
+}
+
+// Four views: the halves cannot be calibrated alone and the views are few.
+TEST(Verdict, TooFewViewsIsInsufficientData) {
+  const Camera truth = testing::TruthRadtan();
+  const SyntheticData data = MakeSyntheticData(Scene(truth, 4, 7));
+  const Judged judged =
+      Judge(data.views, truth.model, truth.width, truth.height);
+  ASSERT_TRUE(judged.calibrated) << judged.error;
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kInsufficientData)
+      << judged.verdict.Line();
+  EXPECT_FALSE(judged.evidence.cross_validation.ok);
+}
+
+// Gross outliers on 10 % of the corners: bad-detections.
+TEST(Verdict, ManyOutliersAreBadDetections) {
+  const Camera truth = testing::TruthRadtan();
+  SyntheticScene scene = Scene(truth, 24, 13);
+  scene.outlier_fraction = 0.1;
+  const SyntheticData data = MakeSyntheticData(scene);
+  const Judged judged =
+      Judge(data.views, truth.model, truth.width, truth.height);
+  ASSERT_TRUE(judged.calibrated) << judged.error;
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kBadDetections)
+      << judged.verdict.Line();
+}
+
+// One view whose corners are off by about 1 px each (a blurred or badly
+// detected view): a few views far worse than the rest.
+TEST(Verdict, OneBadViewIsBadDetections) {
+  const Camera truth = testing::TruthRadtan();
+  SyntheticData data = MakeSyntheticData(Scene(truth, 24, 17));
+  for (size_t i = 0; i < data.views[5].image_points.size(); ++i) {
+    // Alternating 1 px shifts: no pose absorbs them.
+    const double sign = i % 2 == 0 ? 1.0 : -1.0;
+    data.views[5].image_points[i] += sign * Eigen::Vector2d(0.8, 0.6);
+  }
+  const Judged judged =
+      Judge(data.views, truth.model, truth.width, truth.height);
+  ASSERT_TRUE(judged.calibrated) << judged.error;
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kBadDetections)
+      << judged.verdict.Line();
+  EXPECT_NE(judged.verdict.reason.find("view 5"), std::string::npos)
+      << judged.verdict.reason << " used " << judged.result.view_used[5] << " "
+      << judged.result.view_reason[5] << " rms " << judged.result.view_rms_px[5]
+      << " outliers " << judged.result.num_outliers;
+}
+
+}  // namespace
+}  // namespace puzzlecal
