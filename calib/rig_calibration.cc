@@ -270,7 +270,8 @@ struct GlobalLayout {
 // Covariance of the global parameters (all intrinsics and extrinsics) with
 // the frame poses marginalised out: the inverse of the Schur complement
 // S = A - sum_f B_f C_f^-1 B_f' of J'J, summed in a fixed order. False when
-// S is singular.
+// S is singular (after scaling its diagonal to 1, its smallest eigenvalue
+// is below min_eigenvalue_ratio times the largest).
 bool JointMarginalCovariance(const JointState& state, SolveOutcome* outcome,
                              double min_eigenvalue_ratio, GlobalLayout* layout,
                              Eigen::MatrixXd* covariance) {
@@ -351,12 +352,21 @@ bool JointMarginalCovariance(const JointState& state, SolveOutcome* outcome,
     }
     a.noalias() -= b[f] * ldlt.solve(b[f].transpose());
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
+  // Jacobi scaling first: the parameters differ in scale by many orders
+  // (focal lengths, distortion coefficients, angles, metres), and the
+  // singularity test should not depend on their units.
+  const Eigen::VectorXd diagonal = a.diagonal();
+  if (!(diagonal.minCoeff() > 0)) return false;
+  const Eigen::VectorXd scale = diagonal.cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd scaled = scale.asDiagonal() * a * scale.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled);
   if (eig.info() != Eigen::Success) return false;
   const Eigen::VectorXd values = eig.eigenvalues();
   if (!(values(0) > min_eigenvalue_ratio * values(n - 1))) return false;
-  *covariance = eig.eigenvectors() * values.cwiseInverse().asDiagonal() *
-                eig.eigenvectors().transpose();
+  *covariance = scale.asDiagonal() *
+                (eig.eigenvectors() * values.cwiseInverse().asDiagonal() *
+                 eig.eigenvectors().transpose()) *
+                scale.asDiagonal();
   return true;
 }
 
