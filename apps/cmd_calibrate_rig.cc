@@ -172,8 +172,8 @@ int RunCalibrateRig() {
     input.name = folders[c].filename().string();
     input.model = models[c];
     input.frames.resize(num_frames);
-    std::vector<ImageResult> images = ProcessImageFiles(
-        listings[c].images, board, pipeline_options, threads);
+    std::vector<ImageResult> images =
+        ProcessImageFiles(listings[c].images, board, pipeline_options, threads);
     std::vector<int> view_of_image;
     std::vector<CalibrationView> views = MakeCalibrationViews(
         board, &images, &view_of_image, &input.width, &input.height);
@@ -185,9 +185,9 @@ int RunCalibrateRig() {
       if (view_of_image[i] < 0) {
         LOG(WARNING) << images[i].file << ": "
                      << ImageOutcomeName(images[i].outcome)
-                     << (images[i].reason.empty() ? ""
-                                                  : " (" + images[i].reason +
-                                                        ")");
+                     << (images[i].reason.empty()
+                             ? ""
+                             : " (" + images[i].reason + ")");
         continue;
       }
       input.frames[frame] = std::move(views[view_of_image[i]]);

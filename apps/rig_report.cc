@@ -80,9 +80,9 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
   fs::create_directories(dir, ec);
   if (ec) return Fail("cannot create '" + dir + "': " + ec.message(), error);
   std::ostringstream summary;
-  summary << (input.calibration_ok ? "calibration: ok\n"
-                                   : "calibration failed: " +
-                                         input.calibration_error + "\n");
+  summary << (input.calibration_ok
+                  ? "calibration: ok\n"
+                  : "calibration failed: " + input.calibration_error + "\n");
   if (input.result != nullptr && !input.result->cameras.empty() &&
       input.calibration_ok) {
     summary << RigCalibrationReport(*input.result);
@@ -121,8 +121,7 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
     return Fail("rectified pair: " + why, error);
   }
   cv::Mat first, second;
-  if (!LoadGreyImage(input.files[0][best], ImageLoadOptions(), &first,
-                     error) ||
+  if (!LoadGreyImage(input.files[0][best], ImageLoadOptions(), &first, error) ||
       !LoadGreyImage(input.files[1][best], ImageLoadOptions(), &second,
                      error)) {
     return false;

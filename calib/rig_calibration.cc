@@ -149,11 +149,9 @@ bool Residual(const JointState& state, size_t c, size_t f, size_t i,
   const CalibrationView& view = (*state.input)[c].frames[f];
   const Eigen::Vector3d point =
       IsometryFromPose(state.cam_from_rig(c)) *
-      (IsometryFromPose(state.rig_from_board[f].data()) *
-       view.board_points[i]);
+      (IsometryFromPose(state.rig_from_board[f].data()) * view.board_points[i]);
   Eigen::Vector2d pixel;
-  if (!ProjectPoint((*state.input)[c].model, state.params(c), point,
-                    &pixel)) {
+  if (!ProjectPoint((*state.input)[c].model, state.params(c), point, &pixel)) {
     return false;
   }
   *residual = pixel - view.image_points[i];
@@ -199,14 +197,12 @@ void SolveJoint(JointState* state, const CalibrationOptions& options,
             problem.AddResidualBlock(
                 ReprojectionError<Model>::Create(view.board_points[i],
                                                  view.image_points[i]),
-                loss->get(), state->params(c),
-                state->rig_from_board[f].data());
+                loss->get(), state->params(c), state->rig_from_board[f].data());
           } else {
             problem.AddResidualBlock(
                 RigReprojectionError<Model>::Create(view.board_points[i],
                                                     view.image_points[i]),
-                loss->get(), state->params(c),
-                state->cam_from_rig(c),
+                loss->get(), state->params(c), state->cam_from_rig(c),
                 state->rig_from_board[f].data());
             extrinsics_in_problem[c] = true;
           }
@@ -285,8 +281,7 @@ bool JointMarginalCovariance(const JointState& state, SolveOutcome* outcome,
     const int free = static_cast<int>(
         std::count(state.fixed[c].begin(), state.fixed[c].end(), false));
     if (free > 0) {
-      evaluate.parameter_blocks.push_back(
-          const_cast<double*>(state.params(c)));
+      evaluate.parameter_blocks.push_back(const_cast<double*>(state.params(c)));
       layout->params_begin[c] = layout->size;
       layout->size += free;
     }
@@ -341,7 +336,8 @@ bool JointMarginalCovariance(const JointState& state, SolveOutcome* outcome,
       for (int q : touched) a(p, q) += j_global(p) * j_global(q);
     }
     if (frame >= 0) {
-      for (int p : touched) b[frame].row(p) += j_global(p) * j_frame.transpose();
+      for (int p : touched)
+        b[frame].row(p) += j_global(p) * j_frame.transpose();
       c[frame].noalias() += j_frame * j_frame.transpose();
     }
   }
@@ -437,7 +433,8 @@ Eigen::Isometry3d RobustAverage(const std::vector<Eigen::Isometry3d>& samples,
     Eigen::Quaterniond q(sample.linear());
     if (q.dot(centre) < 0) q.coeffs() = -q.coeffs();
     quaternion_sum += q.coeffs();
-    for (int k = 0; k < 3; ++k) translation[k].push_back(sample.translation()(k));
+    for (int k = 0; k < 3; ++k)
+      translation[k].push_back(sample.translation()(k));
   }
   Eigen::Quaterniond mean;
   mean.coeffs() = quaternion_sum.normalized();
@@ -480,7 +477,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
                   RigCalibrationResult* result, std::string* error) {
   *result = RigCalibrationResult();
   std::string why;
-  if (!options.Check(&why)) return Fail("rig calibration options: " + why, error);
+  if (!options.Check(&why))
+    return Fail("rig calibration options: " + why, error);
   const size_t num_cameras = cameras.size();
   if (num_cameras < 2) {
     return Fail("a rig needs at least two cameras (got " +
@@ -525,9 +523,9 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
     for (int t = 0; t < threads; ++t) {
       workers.emplace_back([&, t]() {
         for (size_t c = t; c < num_cameras; c += threads) {
-          single_ok[c] = Calibrate(cameras[c].frames, cameras[c].model,
-                                   cameras[c].width, cameras[c].height, copt,
-                                   &single[c], &single_error[c]);
+          single_ok[c] =
+              Calibrate(cameras[c].frames, cameras[c].model, cameras[c].width,
+                        cameras[c].height, copt, &single[c], &single_error[c]);
         }
       });
     }
@@ -547,7 +545,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
 
   // 2. Starting cam_from_rig: frames two cameras share, chained along the
   // maximum spanning tree of shared frames from the reference camera.
-  Eigen::MatrixXi posed_shared = Eigen::MatrixXi::Zero(num_cameras, num_cameras);
+  Eigen::MatrixXi posed_shared =
+      Eigen::MatrixXi::Zero(num_cameras, num_cameras);
   for (size_t a = 0; a < num_cameras; ++a) {
     for (size_t b = 0; b < num_cameras; ++b) {
       for (size_t f = 0; f < num_frames; ++f) {
@@ -645,8 +644,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
       }
     }
     if (best < 0) continue;
-    state.rig_from_board[f] = PoseFromIsometry(
-        cam_from_rig[best].inverse() * single[best].cam_from_board[f]);
+    state.rig_from_board[f] = PoseFromIsometry(cam_from_rig[best].inverse() *
+                                               single[best].cam_from_board[f]);
     state.frame_posed[f] = true;
   }
 
@@ -766,9 +765,9 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
     out.inlier.resize(num_frames);
     double sum2 = 0;
     for (size_t f = 0; f < num_frames; ++f) {
-      out.inlier[f] = state.used[c][f] ? state.inlier[c][f]
-                                       : std::vector<bool>(
-                                             state.inlier[c][f].size(), false);
+      out.inlier[f] = state.used[c][f]
+                          ? state.inlier[c][f]
+                          : std::vector<bool>(state.inlier[c][f].size(), false);
       if (!state.used[c][f]) continue;
       ++out.num_frames_used;
       result->frame_used[f] = true;
@@ -801,7 +800,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
   for (size_t f = 0; f < num_frames; ++f) {
     if (!result->frame_used[f]) continue;
     ++result->num_frames_used;
-    result->rig_from_board[f] = IsometryFromPose(state.rig_from_board[f].data());
+    result->rig_from_board[f] =
+        IsometryFromPose(state.rig_from_board[f].data());
   }
   result->num_corners_used = corners_all;
   result->num_outliers = outliers_all;
@@ -859,14 +859,14 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
   result->seconds_joint = SecondsSince(joint_start);
 
   if (!outcome.summary.IsSolutionUsable()) {
-    return Fail("the joint bundle adjustment failed: " +
-                    outcome.summary.message,
-                error);
+    return Fail(
+        "the joint bundle adjustment failed: " + outcome.summary.message,
+        error);
   }
   if (outcome.summary.termination_type == ceres::NO_CONVERGENCE) {
     return Fail("the joint bundle adjustment did not converge within " +
-                    std::to_string(copt.max_iterations) +
-                    " iterations (RMS " + Format("%.3f", result->rms_px) +
+                    std::to_string(copt.max_iterations) + " iterations (RMS " +
+                    Format("%.3f", result->rms_px) +
                     " px): raise the iteration limit or check the "
                     "correspondences",
                 error);
@@ -874,9 +874,11 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
   for (size_t c = 0; c < num_cameras; ++c) {
     const RigCameraResult& out = result->cameras[c];
     if (!(out.rms_px <= copt.max_rms_px)) {
-      return Fail("camera '" + out.name + "': the reprojection RMS of the "
-                      "joint solve is " + Format("%.2f", out.rms_px) +
-                      " px (limit " + Format("%.2f", copt.max_rms_px) +
+      return Fail("camera '" + out.name +
+                      "': the reprojection RMS of the "
+                      "joint solve is " +
+                      Format("%.2f", out.rms_px) + " px (limit " +
+                      Format("%.2f", copt.max_rms_px) +
                       " px): the frames of the folders may not be the same "
                       "instants, or the rig moved between photos",
                   error);
@@ -925,8 +927,8 @@ std::string RigCalibrationReport(const RigCalibrationResult& result) {
     if (c > 0) {
       const Eigen::AngleAxisd rotation(cam.cam_from_rig.linear());
       const Eigen::Vector3d t = cam.cam_from_rig.translation();
-      out << "  cam_from_rig: rotation " << Format("%.5f", rotation.angle() / kDegree)
-          << " deg";
+      out << "  cam_from_rig: rotation "
+          << Format("%.5f", rotation.angle() / kDegree) << " deg";
       if (result.covariance_ok) {
         out << " +- " << Format("%.2g", cam.rotation_stddev_deg);
       }

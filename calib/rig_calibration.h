@@ -121,7 +121,7 @@ struct RigCalibrationResult {
   int outlier_rounds = 0;
   int iterations = 0;  // Levenberg-Marquardt iterations of the joint solves
   bool covariance_ok = false;
-  std::string termination;  // Ceres' message of the last joint solve
+  std::string termination;    // Ceres' message of the last joint solve
   double seconds_single = 0;  // the cameras' own calibrations
   double seconds_joint = 0;   // start, joint solves and covariance
 };

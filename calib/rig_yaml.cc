@@ -175,7 +175,8 @@ bool FormatOpenCv(const RigCalibrationResult& result, std::string* text,
     const Camera& first = result.cameras[0].camera;
     const Camera& second = result.cameras[1].camera;
     const Eigen::Isometry3d second_from_first =
-        result.cameras[1].cam_from_rig * result.cameras[0].cam_from_rig.inverse();
+        result.cameras[1].cam_from_rig *
+        result.cameras[0].cam_from_rig.inverse();
     StereoRectification rect;
     if (!StereoRectify(first, second, second_from_first, &rect, error)) {
       return false;
@@ -274,9 +275,9 @@ bool FormatRos(const RigCalibrationResult& result, const std::string& out_path,
   }
   for (size_t c = 0; c < result.cameras.size(); ++c) {
     RigFileText file;
-    file.path = (out.parent_path() /
-                 (stem + "_" + result.cameras[c].name + extension))
-                    .string();
+    file.path =
+        (out.parent_path() / (stem + "_" + result.cameras[c].name + extension))
+            .string();
     file.text = FormatRosCamera(result.cameras[c], rect[c], proj[c]);
     files->push_back(file);
   }
@@ -300,9 +301,9 @@ bool FormatKalibr(const RigCalibrationResult& result, std::string* text,
     out << YAML::Key << "cam" + std::to_string(c) << YAML::Value
         << YAML::BeginMap;
     if (c > 0) {
-      const Eigen::Matrix4d t = (cam.cam_from_rig *
-                                 result.cameras[c - 1].cam_from_rig.inverse())
-                                    .matrix();
+      const Eigen::Matrix4d t =
+          (cam.cam_from_rig * result.cameras[c - 1].cam_from_rig.inverse())
+              .matrix();
       out << YAML::Key << "T_cn_cnm1" << YAML::Value << YAML::BeginSeq;
       for (int r = 0; r < 4; ++r) Flow(out, RowMajor(t.row(r)));
       out << YAML::EndSeq;
@@ -361,21 +362,21 @@ bool StereoRectify(const Camera& first, const Camera& second,
   try {
     if (fisheye1 && fisheye2) {
       cv::Mat d1(Distortion(first)), d2(Distortion(second));
-      cv::fisheye::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1,
-                                 r2, p1, p2, q, cv::CALIB_ZERO_DISPARITY,
-                                 size, 0.0, 1.0);
+      cv::fisheye::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1, r2,
+                                 p1, p2, q, cv::CALIB_ZERO_DISPARITY, size, 0.0,
+                                 1.0);
     } else {
       // A fisheye's coefficients mean nothing to cv::stereoRectify: leave
       // the distortion out (the rotations do not depend on it).
-      cv::Mat d1 = fisheye1 || fisheye2 ? cv::Mat() : cv::Mat(Distortion(first));
+      cv::Mat d1 =
+          fisheye1 || fisheye2 ? cv::Mat() : cv::Mat(Distortion(first));
       cv::Mat d2 =
           fisheye1 || fisheye2 ? cv::Mat() : cv::Mat(Distortion(second));
       cv::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1, r2, p1, p2,
                         q, cv::CALIB_ZERO_DISPARITY, 0.0);
     }
   } catch (const cv::Exception& e) {
-    return Fail(std::string("stereo rectification failed: ") + e.what(),
-                error);
+    return Fail(std::string("stereo rectification failed: ") + e.what(), error);
   }
   cv::cv2eigen(r1, rect->r1);
   cv::cv2eigen(r2, rect->r2);
@@ -389,8 +390,8 @@ bool StereoRectify(const Camera& first, const Camera& second,
   return true;
 }
 
-bool FormatRigFiles(const RigCalibrationResult& result,
-                    CameraFileFormat format, const std::string& out_path,
+bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
+                    const std::string& out_path,
                     std::vector<RigFileText>* files, std::string* error) {
   files->clear();
   if (!CheckCameras(result, error)) return false;
@@ -460,8 +461,8 @@ bool ParseRigFile(const std::string& text, const std::string& source,
       // The camera part is a single-camera file: its reader checks it.
       YAML::Emitter single;
       single << node;
-      if (!ParseCameraFile(single.c_str(), source + " " + field,
-                           &camera.camera, nullptr, error)) {
+      if (!ParseCameraFile(single.c_str(), source + " " + field, &camera.camera,
+                           nullptr, error)) {
         return false;
       }
       const YAML::Node pose = node["cam_from_rig"];

@@ -37,8 +37,8 @@ struct RigFileText {
 // The files of `result` in `format` for the output path `out_path` (one
 // file, except ros: one per camera next to it, named after the camera).
 // False with a reason when the format cannot hold the rig without loss.
-bool FormatRigFiles(const RigCalibrationResult& result,
-                    CameraFileFormat format, const std::string& out_path,
+bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
+                    const std::string& out_path,
                     std::vector<RigFileText>* files, std::string* error);
 
 // Formats, then writes every file atomically; `written` (optional) returns

@@ -49,8 +49,9 @@ RenderOptions RigRender() {
   return render;
 }
 
-std::vector<TruthCorner> VisibleCorners(const RigSceneSpec& scene, size_t c,
-                                        const Eigen::Isometry3d& rig_from_board) {
+std::vector<TruthCorner> VisibleCorners(
+    const RigSceneSpec& scene, size_t c,
+    const Eigen::Isometry3d& rig_from_board) {
   const RigSceneCamera& cam = scene.cameras[c];
   RenderOptions options = scene.render;
   options.field_of_view_deg = cam.field_of_view_deg;
@@ -92,8 +93,9 @@ bool RigSceneSpec::Check(std::string* why) const {
     }
   }
   if (!cameras[0].cam_from_rig.isApprox(Eigen::Isometry3d::Identity())) {
-    return fail("cameras[0].cam_from_rig: the first camera is the rig frame "
-                "(identity)");
+    return fail(
+        "cameras[0].cam_from_rig: the first camera is the rig frame "
+        "(identity)");
   }
   const RigRandomFrames& r = random_frames;
   if (r.count < 0) return fail("random_frames.count: must be >= 0");
@@ -149,8 +151,7 @@ std::vector<Eigen::Isometry3d> RigFramePoses(const RigSceneSpec& scene) {
 }
 
 std::vector<RigCameraInput> RigCorrespondences(const RigSceneSpec& scene,
-                                               double noise_px,
-                                               uint64_t seed) {
+                                               double noise_px, uint64_t seed) {
   const std::vector<Eigen::Isometry3d> frames = RigFramePoses(scene);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -221,8 +222,8 @@ bool RenderRigScene(const RigSceneSpec& scene, const std::string& dir,
       options.field_of_view_deg = cam.field_of_view_deg;
       options.seed = scene.render.seed + 1000 * c + f;
       const Eigen::Isometry3d cam_from_board = cam.cam_from_rig * frames[f];
-      const std::vector<TruthCorner> corners = ProjectBoardCorners(
-          scene.board, cam.camera, cam_from_board, options);
+      const std::vector<TruthCorner> corners =
+          ProjectBoardCorners(scene.board, cam.camera, cam_from_board, options);
       const int visible = static_cast<int>(
           std::count_if(corners.begin(), corners.end(),
                         [](const TruthCorner& t) { return t.visible; }));
@@ -263,8 +264,8 @@ RigSceneSpec StereoPinholeRig(int width, int height) {
   right.name = "cam1";
   right.camera = WidePinholeCamera(width, height, 66.0, -0.08);
   right.camera.params[2] -= 0.02 * width;  // a different principal point
-  right.cam_from_rig = CamFromRig(Eigen::Vector3d(0.12, 0.004, -0.002), -4.0,
-                                  0.7);
+  right.cam_from_rig =
+      CamFromRig(Eigen::Vector3d(0.12, 0.004, -0.002), -4.0, 0.7);
   scene.cameras = {left, right};
   scene.render = RigRender();
   RigRandomFrames& r = scene.random_frames;

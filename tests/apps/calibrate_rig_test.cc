@@ -8,7 +8,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -48,8 +47,8 @@ struct RunResult {
 
 RunResult RunProgram(const std::string& arguments) {
   const fs::path log = fs::temp_directory_path() / "puzzlecal_rig_run.log";
-  const std::string command = ProgramPath().string() + " " + arguments +
-                              " > " + log.string() + " 2>&1";
+  const std::string command =
+      ProgramPath().string() + " " + arguments + " > " + log.string() + " 2>&1";
   const int status = std::system(command.c_str());
   RunResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -149,8 +148,8 @@ TEST(CalibrateRigTest, StereoPinholeRendersInOpenCvFormat) {
   const fs::path out = rig.root / "stereo.yaml";
   const RunResult run =
       RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
-          rig.board + " --model pinhole-radtan --format opencv --out " +
-          out.string() + " --threads 2");
+                 rig.board + " --model pinhole-radtan --format opencv --out " +
+                 out.string() + " --threads 2");
   ASSERT_EQ(run.exit_code, kExitOk) << run.output;
   cv::FileStorage storage(out.string(), cv::FileStorage::READ);
   ASSERT_TRUE(storage.isOpened());
@@ -190,7 +189,7 @@ TEST(CalibrateRigTest, CameraThatNeverSharesAFrameIsNamedAndNothingWritten) {
   const fs::path out = rig.root / "rig.yaml";
   const RunResult run =
       RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
-          rig.board + " --model pinhole-radtan --out " + out.string());
+                 rig.board + " --model pinhole-radtan --out " + out.string());
   EXPECT_EQ(run.exit_code, kExitNoResult) << run.output;
   EXPECT_NE(run.output.find("'cam1' shares no frame"), std::string::npos)
       << run.output;
@@ -204,17 +203,16 @@ TEST(CalibrateRigTest, WrongNumberOfModelsIsAUsageError) {
   fs::create_directories(root / "c");
   const RigSceneSpec scene = StereoPinholeRig();
   const std::string board = WriteBoardFile(scene.board, root);
-  const RunResult run = RunProgram("calibrate-rig --images " + root.string() +
-                            " --board " + board +
-                            " --model pinhole-radtan,kannala-brandt --out " +
-                            (root / "rig.yaml").string());
+  const RunResult run =
+      RunProgram("calibrate-rig --images " + root.string() + " --board " +
+                 board + " --model pinhole-radtan,kannala-brandt --out " +
+                 (root / "rig.yaml").string());
   EXPECT_EQ(run.exit_code, kExitUsage) << run.output;
   EXPECT_NE(run.output.find("2 models for 3 cameras"), std::string::npos)
       << run.output;
-  const RunResult one =
-      RunProgram("calibrate-rig --images " + (root / "a").string() + " --board " +
-          board + " --model pinhole-radtan --out " +
-          (root / "rig.yaml").string());
+  const RunResult one = RunProgram(
+      "calibrate-rig --images " + (root / "a").string() + " --board " + board +
+      " --model pinhole-radtan --out " + (root / "rig.yaml").string());
   EXPECT_EQ(one.exit_code, kExitBadInput) << one.output;
   EXPECT_NE(one.output.find("at least two"), std::string::npos) << one.output;
 }

@@ -61,8 +61,8 @@ void ExpectMatchesTruth(const RigSceneSpec& scene,
     EXPECT_LT(translation_error, kMaxTranslationErrorOfBaseline * baseline)
         << translation_error * 1000 << " mm of a " << baseline * 1000
         << " mm baseline";
-    EXPECT_NEAR(cam.baseline_m, baseline, kMaxTranslationErrorOfBaseline *
-                                              baseline);
+    EXPECT_NEAR(cam.baseline_m, baseline,
+                kMaxTranslationErrorOfBaseline * baseline);
     // The standard deviations describe the errors: the truth lies within
     // 5 sigma (and the sigma are not absurdly large).
     ASSERT_TRUE(result.covariance_ok);
@@ -76,9 +76,9 @@ void ExpectMatchesTruth(const RigSceneSpec& scene,
   }
 }
 
-RigCalibrationResult CalibrateOrDie(const std::vector<RigCameraInput>& inputs,
-                                    const RigCalibrationOptions& options =
-                                        RigCalibrationOptions()) {
+RigCalibrationResult CalibrateOrDie(
+    const std::vector<RigCameraInput>& inputs,
+    const RigCalibrationOptions& options = RigCalibrationOptions()) {
   RigCalibrationResult result;
   std::string error;
   EXPECT_TRUE(CalibrateRig(inputs, options, &result, &error)) << error;
@@ -162,9 +162,8 @@ TEST(RigCalibrationTest, CamerasSeeingDifferentCornersMeetTheFigures) {
           .toRotationMatrix();
   scene.random_frames.count = 36;
   std::vector<RigCameraInput> inputs = RigCorrespondences(scene, kNoisePx, 10);
-  const double split_x =
-      (scene.board.origin.x() + 0.5 * scene.board.cols) *
-      scene.board.tile_size_m;
+  const double split_x = (scene.board.origin.x() + 0.5 * scene.board.cols) *
+                         scene.board.tile_size_m;
   for (size_t c = 0; c < 2; ++c) {
     for (CalibrationView& view : inputs[c].frames) {
       CalibrationView kept;
@@ -211,8 +210,8 @@ TEST(RigCalibrationTest, CamerasSeeingDifferentCornersMeetTheFigures) {
   cv::Matx33d k1 = cv::Matx33d::eye(), k2 = cv::Matx33d::eye();
   cv::Vec4d d1, d2;
   cv::Mat r, t;
-  EXPECT_THROW(cv::fisheye::stereoCalibrate(object, left, right, k1, d1, k2,
-                                            d2, cv::Size(640, 480), r, t),
+  EXPECT_THROW(cv::fisheye::stereoCalibrate(object, left, right, k1, d1, k2, d2,
+                                            cv::Size(640, 480), r, t),
                cv::Exception);
 
   const RigCalibrationResult result = CalibrateOrDie(inputs);

@@ -35,9 +35,9 @@ RigCalibrationResult ResultFromScene(const RigSceneSpec& scene) {
     cam.param_stddev.assign(cam.camera.params.size(), 0.01);
     cam.param_fixed.assign(cam.camera.params.size(), false);
     cam.rotation_stddev_deg = 0.002;
-    cam.baseline_m = (cam.cam_from_rig.linear().transpose() *
-                      cam.cam_from_rig.translation())
-                         .norm();
+    cam.baseline_m =
+        (cam.cam_from_rig.linear().transpose() * cam.cam_from_rig.translation())
+            .norm();
     result.cameras.push_back(cam);
   }
   result.covariance_ok = true;
@@ -64,8 +64,8 @@ TEST(RigYamlTest, PuzzlecalFormatReadsBack) {
   const RigCalibrationResult result = ResultFromScene(FourCameraRig());
   const std::string path = TempPath("rig.yaml");
   std::string error;
-  ASSERT_TRUE(
-      WriteRigFiles(path, CameraFileFormat::kPuzzlecal, result, nullptr, &error))
+  ASSERT_TRUE(WriteRigFiles(path, CameraFileFormat::kPuzzlecal, result, nullptr,
+                            &error))
       << error;
   std::vector<RigFileCamera> cameras;
   ASSERT_TRUE(ReadRigFile(path, &cameras, &error)) << error;
@@ -96,8 +96,7 @@ TEST(RigYamlTest, PuzzlecalReaderNamesTheBadField) {
   YAML::Node root = YAML::Load(files[0].text);
   root["cameras"][1]["cam_from_rig"]["R"][0][0] = 3.0;
   std::vector<RigFileCamera> cameras;
-  EXPECT_FALSE(
-      ParseRigFile(YAML::Dump(root), "bad.yaml", &cameras, &error));
+  EXPECT_FALSE(ParseRigFile(YAML::Dump(root), "bad.yaml", &cameras, &error));
   EXPECT_NE(error.find("bad.yaml"), std::string::npos) << error;
   EXPECT_NE(error.find("cameras[1]/cam_from_rig"), std::string::npos) << error;
   root = YAML::Load(files[0].text);
@@ -200,7 +199,8 @@ TEST(RigYamlTest, RosFormatWritesOneCameraInfoPerCamera) {
         root["projection_matrix"]["data"].as<std::vector<double>>();
     const Eigen::Matrix3d& expected_r = c == 0 ? rect.r1 : rect.r2;
     const Eigen::Matrix<double, 3, 4>& expected_p = c == 0 ? rect.p1 : rect.p2;
-    for (int i = 0; i < 9; ++i) EXPECT_DOUBLE_EQ(r[i], expected_r(i / 3, i % 3));
+    for (int i = 0; i < 9; ++i)
+      EXPECT_DOUBLE_EQ(r[i], expected_r(i / 3, i % 3));
     for (int i = 0; i < 12; ++i) {
       EXPECT_DOUBLE_EQ(p[i], expected_p(i / 4, i % 4));
     }
@@ -229,7 +229,8 @@ TEST(RigYamlTest, KalibrFormatChainsNeighbours) {
   for (int c = 1; c < 4; ++c) {
     const std::string key = "cam" + std::to_string(c);
     const Eigen::Matrix4d expected =
-        (scene.cameras[c].cam_from_rig * scene.cameras[c - 1].cam_from_rig.inverse())
+        (scene.cameras[c].cam_from_rig *
+         scene.cameras[c - 1].cam_from_rig.inverse())
             .matrix();
     for (int i = 0; i < 4; ++i) {
       for (int j = 0; j < 4; ++j) {

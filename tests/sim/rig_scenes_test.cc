@@ -31,9 +31,9 @@ int Seen(const std::vector<RigCameraInput>& inputs, size_t c) {
 
 // cv::projectPoints / cv::fisheye::projectPoints of the board points of a
 // view through cam_from_rig * rig_from_board.
-std::vector<cv::Point2d> OpenCvProjection(const RigSceneCamera& cam,
-                                          const Eigen::Isometry3d& rig_from_board,
-                                          const CalibrationView& view) {
+std::vector<cv::Point2d> OpenCvProjection(
+    const RigSceneCamera& cam, const Eigen::Isometry3d& rig_from_board,
+    const CalibrationView& view) {
   const Eigen::Isometry3d pose = cam.cam_from_rig * rig_from_board;
   cv::Mat rotation, rvec, tvec;
   cv::eigen2cv(Eigen::Matrix3d(pose.linear()), rotation);
@@ -120,9 +120,10 @@ TEST(RigScenesTest, StandardRigsHaveTheirStructure) {
   // The fisheye + pinhole rig: the pinhole is turned 50 degrees away and
   // some frames only the fisheye sees.
   const RigSceneSpec mixed = FisheyePinholeRig();
-  EXPECT_NEAR(Eigen::AngleAxisd(mixed.cameras[1].cam_from_rig.linear()).angle() *
-                  180 / M_PI,
-              50.0, 1e-9);
+  EXPECT_NEAR(
+      Eigen::AngleAxisd(mixed.cameras[1].cam_from_rig.linear()).angle() * 180 /
+          M_PI,
+      50.0, 1e-9);
   const std::vector<RigCameraInput> inputs = RigCorrespondences(mixed, 0.0);
   int only_one = 0, both = 0;
   for (size_t f = 0; f < inputs[0].frames.size(); ++f) {
