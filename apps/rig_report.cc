@@ -1,5 +1,6 @@
 #include "apps/rig_report.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -47,6 +48,40 @@ cv::Mat RectifyImage(const cv::Mat& image, const Camera& camera,
   cv::remap(image, rectified, map_x, map_y, cv::INTER_LINEAR,
             cv::BORDER_CONSTANT, cv::Scalar(0));
   return rectified;
+}
+
+StereoRectification ViewingRectification(
+    const Camera& first, const Camera& second,
+    const Eigen::Isometry3d& second_from_first) {
+  const Eigen::Matrix3d r = second_from_first.linear();
+  const Eigen::Vector3d centre =
+      -(r.transpose() * second_from_first.translation());
+  const Eigen::Vector3d x = centre.normalized();
+  const Eigen::Vector3d axes =
+      (Eigen::Vector3d::UnitZ() + r.transpose() * Eigen::Vector3d::UnitZ())
+          .normalized();
+  const Eigen::Vector3d z = (axes - x * x.dot(axes)).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  StereoRectification rect;
+  rect.r1.row(0) = x.transpose();
+  rect.r1.row(1) = y.transpose();
+  rect.r1.row(2) = z.transpose();
+  rect.r2 = rect.r1 * r.transpose();
+  const double f = std::min(first.params[0], second.params[0]);
+  Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
+  k(0, 0) = k(1, 1) = f;
+  k(0, 2) = 0.5 * (first.width - 1);
+  k(1, 2) = 0.5 * (first.height - 1);
+  rect.p1.setZero();
+  rect.p1.leftCols<3>() = k;
+  rect.p2 = rect.p1;
+  rect.p2(0, 3) = -f * centre.norm();
+  rect.width = first.width;
+  rect.height = first.height;
+  rect.q.setZero();
+  rect.essential.setZero();
+  rect.fundamental.setZero();
+  return rect;
 }
 
 cv::Mat RectifiedPairImage(const cv::Mat& first, const cv::Mat& second,
@@ -113,13 +148,10 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
     }
   }
   if (best < 0) return true;
-  StereoRectification rect;
-  if (!StereoRectify(result.cameras[0].camera, result.cameras[1].camera,
-                     result.cameras[1].cam_from_rig *
-                         result.cameras[0].cam_from_rig.inverse(),
-                     &rect, &why)) {
-    return Fail("rectified pair: " + why, error);
-  }
+  const StereoRectification rect =
+      ViewingRectification(result.cameras[0].camera, result.cameras[1].camera,
+                           result.cameras[1].cam_from_rig *
+                               result.cameras[0].cam_from_rig.inverse());
   cv::Mat first, second;
   if (!LoadGreyImage(input.files[0][best], ImageLoadOptions(), &first, error) ||
       !LoadGreyImage(input.files[1][best], ImageLoadOptions(), &second,

@@ -43,6 +43,18 @@ cv::Mat RectifyImage(const cv::Mat& image, const Camera& camera,
                      const Eigen::Matrix3d& rectified_from_camera,
                      const Eigen::Matrix3d& projection, int width, int height);
 
+// A rectification for viewing a pair whose optical axes may diverge (a
+// fisheye next to a pinhole turned 50 degrees): the common rectified z axis
+// is the bisector of the two optical axes made orthogonal to the baseline,
+// x runs along the baseline, and both views share the intrinsics
+// (the smaller focal length, principal point at the first image's centre).
+// cv::stereoRectify (the opencv file's R1 R2 P1 P2) keeps each view close
+// to its own camera instead, which for diverging cameras leaves little of
+// the overlap in the image.
+StereoRectification ViewingRectification(
+    const Camera& first, const Camera& second,
+    const Eigen::Isometry3d& second_from_first);
+
 // The two rectified images side by side (grey in, colour out) with
 // horizontal lines every options.line_spacing_px rows.
 cv::Mat RectifiedPairImage(const cv::Mat& first, const cv::Mat& second,

@@ -871,6 +871,31 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
                     "correspondences",
                 error);
   }
+  // Outlier rejection may have taken a camera out of every frame it shared:
+  // every camera must still reach the reference through shared frames.
+  std::vector<bool> reached(num_cameras, false);
+  reached[0] = true;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (size_t a = 0; a < num_cameras; ++a) {
+      for (size_t b = 0; b < num_cameras; ++b) {
+        if (reached[a] && !reached[b] && result->shared_frames(a, b) > 0) {
+          reached[b] = true;
+          grew = true;
+        }
+      }
+    }
+  }
+  for (size_t c = 0; c < num_cameras; ++c) {
+    if (!reached[c]) {
+      return Fail("camera '" + cameras[c].name +
+                      "' shares no frame with the reference camera's group "
+                      "after outlier rejection, so its place in the rig is "
+                      "undetermined: take photos in which it and a "
+                      "neighbouring camera see the board together",
+                  error);
+    }
+  }
   for (size_t c = 0; c < num_cameras; ++c) {
     const RigCameraResult& out = result->cameras[c];
     if (!(out.rms_px <= copt.max_rms_px)) {
