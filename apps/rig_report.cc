@@ -1,6 +1,7 @@
 #include "apps/rig_report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -33,11 +34,24 @@ cv::Mat RectifyImage(const cv::Mat& image, const Camera& camera,
   cv::Mat map_x(height, width, CV_32FC1), map_y(height, width, CV_32FC1);
   const Eigen::Matrix3d camera_from_pixel =
       rectified_from_camera.transpose() * projection.inverse();
+  // Beyond the fold of a pinhole's distortion polynomial (where the image
+  // radius stops growing with the ray's angle) a ray lands on a pixel that
+  // is not its own: black.
+  const bool pinhole = CameraModelIsPinhole(camera.model);
+  const Eigen::Vector2d centre(camera.params[2], camera.params[3]);
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       const Eigen::Vector3d ray = camera_from_pixel * Eigen::Vector3d(u, v, 1);
       Eigen::Vector2d pixel;
-      if (!camera.Project(ray, &pixel) || !pixel.allFinite()) {
+      bool valid = camera.Project(ray, &pixel) && pixel.allFinite();
+      if (valid && pinhole) {
+        Eigen::Vector3d outward = ray;
+        outward.head<2>() *= 1.0 + 1e-4;
+        Eigen::Vector2d further;
+        valid = camera.Project(outward, &further) &&
+                (further - centre).norm() > (pixel - centre).norm();
+      }
+      if (!valid) {
         pixel.setConstant(-1e6);
       }
       map_x.at<float>(v, u) = static_cast<float>(pixel.x());

@@ -57,12 +57,21 @@ void ExpectSameResampling(const Camera& camera, const Eigen::Matrix3d& r,
     cv::initUndistortRectifyMap(cv_k, d, cv_r, cv_p, size, CV_32FC1, map_x,
                                 map_y);
   }
-  int compared = 0;
+  const cv::Mat valid =
+      RectifyImage(cv::Mat(camera.height, camera.width, CV_32FC1, 1.0f), camera,
+                   r, k, camera.width, camera.height);
+  int compared = 0, folded = 0;
   for (int y = 0; y < camera.height; y += 7) {
     for (int x = 0; x < camera.width; x += 7) {
       const float mx = map_x.at<float>(y, x), my = map_y.at<float>(y, x);
       if (!(mx > 1 && my > 1 && mx < camera.width - 2 &&
             my < camera.height - 2)) {
+        continue;
+      }
+      // Beyond the fold of the pinhole's distortion RectifyImage draws
+      // black where OpenCV's map still points into the image.
+      if (valid.at<float>(y, x) < 1) {
+        ++folded;
         continue;
       }
       EXPECT_NEAR(ours_x.at<float>(y, x), mx, 0.04) << "at " << x << ", " << y;
@@ -71,6 +80,7 @@ void ExpectSameResampling(const Camera& camera, const Eigen::Matrix3d& r,
     }
   }
   EXPECT_GT(compared, 1000);
+  EXPECT_LT(folded, compared / 50);
 }
 
 TEST(RigReportTest, RectifyImageResamplesLikeOpenCv) {
