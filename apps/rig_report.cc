@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "apps/image_io.h"
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {

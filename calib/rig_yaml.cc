@@ -10,7 +10,7 @@
 #include <opencv2/core/eigen.hpp>
 #include <sstream>
 
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {
