@@ -1,0 +1,989 @@
+#include "calib/rig_calibration.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "calib/reprojection_error.h"
+
+namespace puzzlecal {
+namespace {
+
+using Pose = std::array<double, kPoseBlockSize>;
+constexpr double kDegree = M_PI / 180.0;
+
+bool Fail(const std::string& message, std::string* error) {
+  if (error != nullptr) *error = message;
+  return false;
+}
+
+std::string Format(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
+Pose PoseFromIsometry(const Eigen::Isometry3d& transform) {
+  Pose pose;
+  const Eigen::Matrix3d rotation = transform.linear();
+  ceres::RotationMatrixToAngleAxis(
+      ceres::ColumnMajorAdapter3x3(rotation.data()), pose.data());
+  for (int k = 0; k < 3; ++k) pose[3 + k] = transform.translation()(k);
+  return pose;
+}
+
+Eigen::Isometry3d IsometryFromPose(const double* pose) {
+  Eigen::Matrix3d rotation;
+  ceres::AngleAxisToRotationMatrix(
+      pose, ceres::ColumnMajorAdapter3x3(rotation.data()));
+  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
+  result.linear() = rotation;
+  result.translation() = Eigen::Vector3d(pose[3], pose[4], pose[5]);
+  return result;
+}
+
+// The pixel error of one board corner seen by a camera that is not the
+// reference: intrinsics, cam_from_rig and the frame's rig_from_board (both
+// angle-axis + translation).
+template <typename Model>
+class RigReprojectionError {
+ public:
+  RigReprojectionError(const Eigen::Vector3d& board_point,
+                       const Eigen::Vector2d& observed_pixel)
+      : board_point_(board_point), observed_pixel_(observed_pixel) {}
+
+  template <typename T>
+  bool operator()(const T* intrinsics, const T* cam_from_rig,
+                  const T* rig_from_board, T* residuals) const {
+    const T point_board[3] = {T(board_point_.x()), T(board_point_.y()),
+                              T(board_point_.z())};
+    T point_rig[3];
+    ceres::AngleAxisRotatePoint(rig_from_board, point_board, point_rig);
+    for (int k = 0; k < 3; ++k) point_rig[k] += rig_from_board[3 + k];
+    T point_cam[3];
+    ceres::AngleAxisRotatePoint(cam_from_rig, point_rig, point_cam);
+    for (int k = 0; k < 3; ++k) point_cam[k] += cam_from_rig[3 + k];
+    T pixel[2];
+    if (!Model::Project(intrinsics, point_cam, pixel)) return false;
+    residuals[0] = pixel[0] - T(observed_pixel_.x());
+    residuals[1] = pixel[1] - T(observed_pixel_.y());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& board_point,
+                                     const Eigen::Vector2d& observed_pixel) {
+    return new ceres::AutoDiffCostFunction<RigReprojectionError, 2,
+                                           Model::kNumParams, kPoseBlockSize,
+                                           kPoseBlockSize>(
+        new RigReprojectionError(board_point, observed_pixel));
+  }
+
+ private:
+  Eigen::Vector3d board_point_;
+  Eigen::Vector2d observed_pixel_;
+};
+
+// The state the joint solves share. Indices: [camera][frame][corner].
+//
+// The intrinsics and extrinsics of all cameras live in one buffer, in
+// camera order: Ceres orders the blocks of an elimination group by address,
+// so one buffer makes that order (and the sums of the reduced system) the
+// same on every run.
+struct JointState {
+  const std::vector<RigCameraInput>* input = nullptr;
+  std::vector<double> global;
+  std::vector<size_t> params_offset;      // per camera, into `global`
+  std::vector<size_t> extrinsics_offset;  // per camera, into `global`
+  std::vector<int> num_params;            // per camera
+  double* params(size_t c) { return global.data() + params_offset[c]; }
+  const double* params(size_t c) const {
+    return global.data() + params_offset[c];
+  }
+  double* cam_from_rig(size_t c) {
+    return global.data() + extrinsics_offset[c];
+  }
+  const double* cam_from_rig(size_t c) const {
+    return global.data() + extrinsics_offset[c];
+  }
+  std::vector<double> Params(size_t c) const {
+    return std::vector<double>(params(c), params(c) + num_params[c]);
+  }
+  Pose CamFromRig(size_t c) const {
+    Pose pose;
+    std::copy(cam_from_rig(c), cam_from_rig(c) + kPoseBlockSize, pose.data());
+    return pose;
+  }
+  std::vector<Pose> rig_from_board;
+  std::vector<bool> frame_posed;  // rig_from_board has a value
+  std::vector<std::vector<bool>> used;
+  std::vector<std::vector<std::vector<bool>>> valid;
+  std::vector<std::vector<std::vector<bool>>> inlier;
+  std::vector<std::vector<bool>> fixed;
+};
+
+bool Residual(const JointState& state, size_t c, size_t f, size_t i,
+              Eigen::Vector2d* residual) {
+  const CalibrationView& view = (*state.input)[c].frames[f];
+  const Eigen::Vector3d point =
+      IsometryFromPose(state.cam_from_rig(c)) *
+      (IsometryFromPose(state.rig_from_board[f].data()) * view.board_points[i]);
+  Eigen::Vector2d pixel;
+  if (!ProjectPoint((*state.input)[c].model, state.params(c), point, &pixel)) {
+    return false;
+  }
+  *residual = pixel - view.image_points[i];
+  return residual->allFinite();
+}
+
+struct SolveOutcome {
+  ceres::Solver::Summary summary;
+  std::unique_ptr<ceres::Problem> problem;
+  std::vector<bool> params_in_problem;  // per camera
+  std::vector<bool> frame_in_problem;
+};
+
+void SolveJoint(JointState* state, const CalibrationOptions& options,
+                std::unique_ptr<ceres::LossFunction>* loss,
+                SolveOutcome* outcome) {
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  outcome->problem = std::make_unique<ceres::Problem>(problem_options);
+  ceres::Problem& problem = *outcome->problem;
+  loss->reset();
+  if (options.loss == RobustLoss::kHuber) {
+    loss->reset(new ceres::HuberLoss(options.loss_scale_px));
+  } else if (options.loss == RobustLoss::kCauchy) {
+    loss->reset(new ceres::CauchyLoss(options.loss_scale_px));
+  }
+  const size_t num_cameras = state->input->size();
+  const size_t num_frames = state->rig_from_board.size();
+  outcome->params_in_problem.assign(num_cameras, false);
+  outcome->frame_in_problem.assign(num_frames, false);
+  std::vector<bool> extrinsics_in_problem(num_cameras, false);
+  int num_residuals = 0;
+  for (size_t c = 0; c < num_cameras; ++c) {
+    const RigCameraInput& camera = (*state->input)[c];
+    DispatchCameraModel(camera.model, [&](auto model_struct) {
+      using Model = decltype(model_struct);
+      for (size_t f = 0; f < num_frames; ++f) {
+        if (!state->used[c][f]) continue;
+        const CalibrationView& view = camera.frames[f];
+        for (size_t i = 0; i < view.board_points.size(); ++i) {
+          if (!state->inlier[c][f][i]) continue;
+          if (c == 0) {
+            problem.AddResidualBlock(
+                ReprojectionError<Model>::Create(view.board_points[i],
+                                                 view.image_points[i]),
+                loss->get(), state->params(c), state->rig_from_board[f].data());
+          } else {
+            problem.AddResidualBlock(
+                RigReprojectionError<Model>::Create(view.board_points[i],
+                                                    view.image_points[i]),
+                loss->get(), state->params(c), state->cam_from_rig(c),
+                state->rig_from_board[f].data());
+            extrinsics_in_problem[c] = true;
+          }
+          outcome->params_in_problem[c] = true;
+          outcome->frame_in_problem[f] = true;
+          ++num_residuals;
+        }
+      }
+    });
+  }
+  if (num_residuals == 0) {
+    outcome->summary = ceres::Solver::Summary();
+    outcome->summary.message = "no corners left to fit";
+    return;
+  }
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (size_t f = 0; f < num_frames; ++f) {
+    if (outcome->frame_in_problem[f]) {
+      ordering->AddElementToGroup(state->rig_from_board[f].data(), 0);
+    }
+  }
+  for (size_t c = 0; c < num_cameras; ++c) {
+    if (extrinsics_in_problem[c]) {
+      ordering->AddElementToGroup(state->cam_from_rig(c), 1);
+    }
+    if (!outcome->params_in_problem[c]) continue;
+    ordering->AddElementToGroup(state->params(c), 1);
+    const int n = state->num_params[c];
+    std::vector<int> fixed_indices;
+    for (int k = 0; k < n; ++k) {
+      if (state->fixed[c][k]) fixed_indices.push_back(k);
+    }
+    if (static_cast<int>(fixed_indices.size()) == n) {
+      problem.SetParameterBlockConstant(state->params(c));
+    } else if (!fixed_indices.empty()) {
+      problem.SetManifold(state->params(c),
+                          new ceres::SubsetManifold(n, fixed_indices));
+    }
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solver_options.linear_solver_ordering = ordering;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.gradient_tolerance = options.gradient_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
+  solver_options.num_threads = options.deterministic ? 1 : options.num_threads;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solve(solver_options, &problem, &outcome->summary);
+}
+
+// Where each camera's free parameters sit in the global (non-frame) part of
+// the Jacobian: intrinsics (free ones only) and cam_from_rig (6, not for
+// the reference camera).
+struct GlobalLayout {
+  std::vector<int> params_begin;      // -1 when not in the covariance
+  std::vector<int> extrinsics_begin;  // -1 when not in the covariance
+  int size = 0;
+};
+
+// Covariance of the global parameters (all intrinsics and extrinsics) with
+// the frame poses marginalised out: the inverse of the Schur complement
+// S = A - sum_f B_f C_f^-1 B_f' of J'J, summed in a fixed order. False when
+// S is singular (after scaling its diagonal to 1, its smallest eigenvalue
+// is below min_eigenvalue_ratio times the largest).
+bool JointMarginalCovariance(const JointState& state, SolveOutcome* outcome,
+                             double min_eigenvalue_ratio, GlobalLayout* layout,
+                             Eigen::MatrixXd* covariance) {
+  const size_t num_cameras = state.num_params.size();
+  ceres::Problem::EvaluateOptions evaluate;
+  layout->params_begin.assign(num_cameras, -1);
+  layout->extrinsics_begin.assign(num_cameras, -1);
+  layout->size = 0;
+  for (size_t c = 0; c < num_cameras; ++c) {
+    if (!outcome->params_in_problem[c]) continue;
+    const int free = static_cast<int>(
+        std::count(state.fixed[c].begin(), state.fixed[c].end(), false));
+    if (free > 0) {
+      evaluate.parameter_blocks.push_back(const_cast<double*>(state.params(c)));
+      layout->params_begin[c] = layout->size;
+      layout->size += free;
+    }
+    if (c > 0) {
+      evaluate.parameter_blocks.push_back(
+          const_cast<double*>(state.cam_from_rig(c)));
+      layout->extrinsics_begin[c] = layout->size;
+      layout->size += kPoseBlockSize;
+    }
+  }
+  int num_frames = 0;
+  for (size_t f = 0; f < state.rig_from_board.size(); ++f) {
+    if (!outcome->frame_in_problem[f]) continue;
+    evaluate.parameter_blocks.push_back(
+        const_cast<double*>(state.rig_from_board[f].data()));
+    ++num_frames;
+  }
+  evaluate.num_threads = 1;
+  ceres::CRSMatrix jacobian;
+  if (!outcome->problem->Evaluate(evaluate, nullptr, nullptr, nullptr,
+                                  &jacobian)) {
+    return false;
+  }
+  const int n = layout->size;
+  if (n == 0 || jacobian.num_cols != n + kPoseBlockSize * num_frames) {
+    return false;
+  }
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  std::vector<Eigen::MatrixXd> b(num_frames, Eigen::MatrixXd::Zero(n, 6));
+  std::vector<Eigen::Matrix<double, 6, 6>> c(
+      num_frames, Eigen::Matrix<double, 6, 6>::Zero());
+  Eigen::VectorXd j_global(n);
+  Eigen::Matrix<double, 6, 1> j_frame;
+  std::vector<int> touched;
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    j_global.setZero();
+    j_frame.setZero();
+    touched.clear();
+    int frame = -1;
+    for (int e = jacobian.rows[row]; e < jacobian.rows[row + 1]; ++e) {
+      const int col = jacobian.cols[e];
+      if (col < n) {
+        j_global(col) = jacobian.values[e];
+        touched.push_back(col);
+      } else {
+        frame = (col - n) / kPoseBlockSize;
+        j_frame((col - n) % kPoseBlockSize) = jacobian.values[e];
+      }
+    }
+    // Only the touched columns are non-zero: update those entries.
+    for (int p : touched) {
+      for (int q : touched) a(p, q) += j_global(p) * j_global(q);
+    }
+    if (frame >= 0) {
+      for (int p : touched)
+        b[frame].row(p) += j_global(p) * j_frame.transpose();
+      c[frame].noalias() += j_frame * j_frame.transpose();
+    }
+  }
+  for (int f = 0; f < num_frames; ++f) {
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(c[f]);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
+      return false;
+    }
+    a.noalias() -= b[f] * ldlt.solve(b[f].transpose());
+  }
+  // Jacobi scaling first: the parameters differ in scale by many orders
+  // (focal lengths, distortion coefficients, angles, metres), and the
+  // singularity test should not depend on their units.
+  const Eigen::VectorXd diagonal = a.diagonal();
+  if (!(diagonal.minCoeff() > 0)) return false;
+  const Eigen::VectorXd scale = diagonal.cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd scaled = scale.asDiagonal() * a * scale.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled);
+  if (eig.info() != Eigen::Success) return false;
+  const Eigen::VectorXd values = eig.eigenvalues();
+  if (!(values(0) > min_eigenvalue_ratio * values(n - 1))) return false;
+  *covariance = scale.asDiagonal() *
+                (eig.eigenvectors() * values.cwiseInverse().asDiagonal() *
+                 eig.eigenvectors().transpose()) *
+                scale.asDiagonal();
+  return true;
+}
+
+// The small rotation (rig frame of the camera, angle-axis) that takes
+// R(pose) to R(pose + delta), to first order: its 3x6 Jacobian in delta.
+Eigen::Matrix<double, 3, 6> RotationJacobian(const Pose& pose) {
+  Eigen::Matrix<double, 3, 6> jacobian = Eigen::Matrix<double, 3, 6>::Zero();
+  const Eigen::Matrix3d r0 = IsometryFromPose(pose.data()).linear();
+  constexpr double kStep = 1e-7;
+  for (int k = 0; k < 3; ++k) {
+    Pose plus = pose, minus = pose;
+    plus[k] += kStep;
+    minus[k] -= kStep;
+    const Eigen::AngleAxisd dp(IsometryFromPose(plus.data()).linear() *
+                               r0.transpose());
+    const Eigen::AngleAxisd dm(IsometryFromPose(minus.data()).linear() *
+                               r0.transpose());
+    jacobian.col(k) =
+        (dp.angle() * dp.axis() - dm.angle() * dm.axis()) / (2 * kStep);
+  }
+  return jacobian;
+}
+
+// Distance of the camera centre (-R' t) from the rig origin, and its 1x6
+// Jacobian.
+double Baseline(const Pose& pose, Eigen::Matrix<double, 1, 6>* jacobian) {
+  auto centre_norm = [](const Pose& p) {
+    const Eigen::Isometry3d t = IsometryFromPose(p.data());
+    return (t.linear().transpose() * t.translation()).norm();
+  };
+  const double value = centre_norm(pose);
+  constexpr double kStep = 1e-7;
+  for (int k = 0; k < 6; ++k) {
+    Pose plus = pose, minus = pose;
+    plus[k] += kStep;
+    minus[k] -= kStep;
+    (*jacobian)(k) = (centre_norm(plus) - centre_norm(minus)) / (2 * kStep);
+  }
+  return value;
+}
+
+// Robust relative pose from per-frame estimates: the rotation closest to
+// all others (least summed angle), the quaternion mean of the estimates
+// within `max_deviation_deg` of it and the per-axis median of their
+// translations.
+Eigen::Isometry3d RobustAverage(const std::vector<Eigen::Isometry3d>& samples,
+                                double max_deviation_deg) {
+  size_t best = 0;
+  double best_sum = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < samples.size(); ++i) {
+    double sum = 0;
+    for (size_t j = 0; j < samples.size(); ++j) {
+      sum += RotationDifferenceDeg(samples[i].linear(), samples[j].linear());
+    }
+    if (sum < best_sum) {
+      best_sum = sum;
+      best = i;
+    }
+  }
+  const Eigen::Quaterniond centre(samples[best].linear());
+  Eigen::Vector4d quaternion_sum = Eigen::Vector4d::Zero();
+  std::array<std::vector<double>, 3> translation;
+  for (const Eigen::Isometry3d& sample : samples) {
+    if (RotationDifferenceDeg(sample.linear(), samples[best].linear()) >
+        max_deviation_deg) {
+      continue;
+    }
+    Eigen::Quaterniond q(sample.linear());
+    if (q.dot(centre) < 0) q.coeffs() = -q.coeffs();
+    quaternion_sum += q.coeffs();
+    for (int k = 0; k < 3; ++k)
+      translation[k].push_back(sample.translation()(k));
+  }
+  Eigen::Quaterniond mean;
+  mean.coeffs() = quaternion_sum.normalized();
+  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
+  result.linear() = mean.toRotationMatrix();
+  for (int k = 0; k < 3; ++k) result.translation()(k) = Median(translation[k]);
+  return result;
+}
+
+std::string CameraList(const std::vector<RigCameraInput>& cameras,
+                       const std::vector<bool>& member) {
+  std::string list;
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    if (!member[c]) continue;
+    if (!list.empty()) list += ", ";
+    list += "'" + cameras[c].name + "'";
+  }
+  return list;
+}
+
+}  // namespace
+
+double RotationDifferenceDeg(const Eigen::Matrix3d& a,
+                             const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a * b.transpose()).angle() / kDegree;
+}
+
+bool RigCalibrationOptions::Check(std::string* why) const {
+  if (min_shared_frames < 1) {
+    return Fail("min_shared_frames must be >= 1", why);
+  }
+  if (!(max_start_rotation_deviation_deg > 0)) {
+    return Fail("max_start_rotation_deviation_deg must be > 0", why);
+  }
+  return camera.Check(why);
+}
+
+bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
+                  const RigCalibrationOptions& options,
+                  RigCalibrationResult* result, std::string* error) {
+  *result = RigCalibrationResult();
+  std::string why;
+  if (!options.Check(&why))
+    return Fail("rig calibration options: " + why, error);
+  const size_t num_cameras = cameras.size();
+  if (num_cameras < 2) {
+    return Fail("a rig needs at least two cameras (got " +
+                    std::to_string(num_cameras) + ")",
+                error);
+  }
+  const size_t num_frames = cameras[0].frames.size();
+  for (const RigCameraInput& camera : cameras) {
+    if (camera.frames.size() != num_frames) {
+      return Fail("camera '" + camera.name + "' has " +
+                      std::to_string(camera.frames.size()) +
+                      " frames, camera '" + cameras[0].name + "' has " +
+                      std::to_string(num_frames) +
+                      " (give every camera one view per frame, empty where "
+                      "it did not see the board)",
+                  error);
+    }
+  }
+  const CalibrationOptions& copt = options.camera;
+  result->cameras.resize(num_cameras);
+  result->frame_used.assign(num_frames, false);
+  result->rig_from_board.assign(num_frames, Eigen::Isometry3d::Identity());
+  result->start_parent.assign(num_cameras, -1);
+  result->shared_frames = Eigen::MatrixXi::Zero(num_cameras, num_cameras);
+  for (size_t c = 0; c < num_cameras; ++c) {
+    result->cameras[c].name = cameras[c].name;
+    result->cameras[c].camera.model = cameras[c].model;
+    result->cameras[c].camera.width = cameras[c].width;
+    result->cameras[c].camera.height = cameras[c].height;
+  }
+
+  // 1. Each camera alone, in parallel over cameras (each solve is
+  // sequential, so the result does not depend on the thread count).
+  const auto single_start = std::chrono::steady_clock::now();
+  std::vector<CalibrationResult> single(num_cameras);
+  std::vector<std::string> single_error(num_cameras);
+  std::vector<char> single_ok(num_cameras, 0);
+  {
+    const int threads = std::max(
+        1, std::min<int>(copt.num_threads, static_cast<int>(num_cameras)));
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t) {
+      workers.emplace_back([&, t]() {
+        for (size_t c = t; c < num_cameras; c += threads) {
+          single_ok[c] =
+              Calibrate(cameras[c].frames, cameras[c].model, cameras[c].width,
+                        cameras[c].height, copt, &single[c], &single_error[c]);
+        }
+      });
+    }
+    for (std::thread& worker : workers) worker.join();
+  }
+  result->seconds_single = SecondsSince(single_start);
+  for (size_t c = 0; c < num_cameras; ++c) {
+    result->cameras[c].single_rms_px = single[c].rms_px;
+    result->cameras[c].single_views_used = single[c].num_views_used;
+    if (!single_ok[c]) {
+      return Fail("camera '" + cameras[c].name +
+                      "' cannot be calibrated alone: " + single_error[c],
+                  error);
+    }
+  }
+  const auto joint_start = std::chrono::steady_clock::now();
+
+  // 2. Starting cam_from_rig: frames two cameras share, chained along the
+  // maximum spanning tree of shared frames from the reference camera.
+  Eigen::MatrixXi posed_shared =
+      Eigen::MatrixXi::Zero(num_cameras, num_cameras);
+  for (size_t a = 0; a < num_cameras; ++a) {
+    for (size_t b = 0; b < num_cameras; ++b) {
+      for (size_t f = 0; f < num_frames; ++f) {
+        posed_shared(a, b) += single[a].view_used[f] && single[b].view_used[f];
+      }
+    }
+  }
+  std::vector<bool> in_tree(num_cameras, false);
+  std::vector<Eigen::Isometry3d> cam_from_rig(num_cameras,
+                                              Eigen::Isometry3d::Identity());
+  in_tree[0] = true;
+  for (;;) {
+    int best_a = -1, best_b = -1, best_count = 0;
+    for (size_t a = 0; a < num_cameras; ++a) {
+      if (!in_tree[a]) continue;
+      for (size_t b = 0; b < num_cameras; ++b) {
+        if (in_tree[b]) continue;
+        const int count = posed_shared(a, b);
+        if (count >= options.min_shared_frames && count > best_count) {
+          best_count = count;
+          best_a = static_cast<int>(a);
+          best_b = static_cast<int>(b);
+        }
+      }
+    }
+    if (best_b < 0) break;
+    std::vector<Eigen::Isometry3d> samples;  // cam_b_from_cam_a per frame
+    for (size_t f = 0; f < num_frames; ++f) {
+      if (single[best_a].view_used[f] && single[best_b].view_used[f]) {
+        samples.push_back(single[best_b].cam_from_board[f] *
+                          single[best_a].cam_from_board[f].inverse());
+      }
+    }
+    cam_from_rig[best_b] =
+        RobustAverage(samples, options.max_start_rotation_deviation_deg) *
+        cam_from_rig[best_a];
+    result->start_parent[best_b] = best_a;
+    in_tree[best_b] = true;
+  }
+  for (size_t c = 0; c < num_cameras; ++c) {
+    if (in_tree[c]) continue;
+    const bool shares_any = [&]() {
+      for (size_t o = 0; o < num_cameras; ++o) {
+        if (o != c && posed_shared(c, o) >= options.min_shared_frames) {
+          return true;
+        }
+      }
+      return false;
+    }();
+    if (!shares_any) {
+      return Fail("camera '" + cameras[c].name +
+                      "' shares no frame with any other camera (no instant "
+                      "at which it and another camera both see the board), "
+                      "so its place in the rig is undetermined: take photos "
+                      "in which it and a neighbouring camera see the board "
+                      "together",
+                  error);
+    }
+    std::vector<bool> outside(num_cameras);
+    for (size_t o = 0; o < num_cameras; ++o) outside[o] = !in_tree[o];
+    return Fail("cameras " + CameraList(cameras, outside) +
+                    " share no frame with the reference camera's group (" +
+                    CameraList(cameras, in_tree) +
+                    "), so their place in the rig is undetermined: take "
+                    "photos in which a camera of each group sees the board",
+                error);
+  }
+
+  // 3. Starting rig_from_board: from the camera that saw the most corners
+  // in the frame.
+  JointState state;
+  state.input = &cameras;
+  state.fixed.resize(num_cameras);
+  for (size_t c = 0; c < num_cameras; ++c) {
+    state.num_params.push_back(
+        static_cast<int>(single[c].camera.params.size()));
+    state.params_offset.push_back(state.global.size());
+    state.global.insert(state.global.end(), single[c].camera.params.begin(),
+                        single[c].camera.params.end());
+    state.extrinsics_offset.push_back(state.global.size());
+    const Pose pose = PoseFromIsometry(cam_from_rig[c]);
+    state.global.insert(state.global.end(), pose.begin(), pose.end());
+    state.fixed[c] = single[c].param_fixed;
+  }
+  state.rig_from_board.assign(num_frames, Pose{});
+  state.frame_posed.assign(num_frames, false);
+  for (size_t f = 0; f < num_frames; ++f) {
+    int best = -1;
+    size_t best_corners = 0;
+    for (size_t c = 0; c < num_cameras; ++c) {
+      if (single[c].view_used[f] &&
+          cameras[c].frames[f].board_points.size() > best_corners) {
+        best = static_cast<int>(c);
+        best_corners = cameras[c].frames[f].board_points.size();
+      }
+    }
+    if (best < 0) continue;
+    state.rig_from_board[f] = PoseFromIsometry(cam_from_rig[best].inverse() *
+                                               single[best].cam_from_board[f]);
+    state.frame_posed[f] = true;
+  }
+
+  // Which (camera, frame) pairs and corners take part: finite corners that
+  // project with the starting state, at least min_corners_per_view of them.
+  state.used.assign(num_cameras, std::vector<bool>(num_frames, false));
+  state.valid.resize(num_cameras);
+  for (size_t c = 0; c < num_cameras; ++c) {
+    state.valid[c].resize(num_frames);
+    for (size_t f = 0; f < num_frames; ++f) {
+      const CalibrationView& view = cameras[c].frames[f];
+      const size_t n = view.board_points.size();
+      state.valid[c][f].assign(n, false);
+      if (!state.frame_posed[f] || view.image_points.size() != n) continue;
+      int good = 0;
+      for (size_t i = 0; i < n; ++i) {
+        Eigen::Vector2d r;
+        const bool ok = view.board_points[i].allFinite() &&
+                        view.image_points[i].allFinite() &&
+                        Residual(state, c, f, i, &r);
+        state.valid[c][f][i] = ok;
+        good += ok ? 1 : 0;
+      }
+      state.used[c][f] = good >= copt.min_corners_per_view;
+    }
+  }
+  state.inlier = state.valid;
+
+  // 4. Joint solves with k-sigma outlier rejection per camera.
+  std::unique_ptr<ceres::LossFunction> loss;
+  SolveOutcome outcome;
+  int iterations = 0;
+  SolveJoint(&state, copt, &loss, &outcome);
+  iterations += static_cast<int>(outcome.summary.iterations.size());
+  std::vector<std::vector<std::vector<Eigen::Vector2d>>> residuals(num_cameras);
+  std::vector<std::vector<std::vector<bool>>> projects(num_cameras);
+  auto compute_residuals = [&]() {
+    for (size_t c = 0; c < num_cameras; ++c) {
+      residuals[c].assign(num_frames, {});
+      projects[c].assign(num_frames, {});
+      for (size_t f = 0; f < num_frames; ++f) {
+        if (!state.used[c][f]) continue;
+        const size_t n = cameras[c].frames[f].board_points.size();
+        residuals[c][f].assign(n, Eigen::Vector2d::Zero());
+        projects[c][f].assign(n, false);
+        for (size_t i = 0; i < n; ++i) {
+          if (!state.valid[c][f][i]) continue;
+          Eigen::Vector2d r;
+          if (Residual(state, c, f, i, &r)) {
+            residuals[c][f][i] = r;
+            projects[c][f][i] = true;
+          } else {
+            residuals[c][f][i].setConstant(
+                std::numeric_limits<double>::quiet_NaN());
+          }
+        }
+      }
+    }
+  };
+  compute_residuals();
+  int rounds = 0;
+  while (copt.outlier_k > 0 && rounds < copt.outlier_iterations &&
+         outcome.summary.IsSolutionUsable()) {
+    bool changed = false;
+    for (size_t c = 0; c < num_cameras; ++c) {
+      std::vector<double> magnitudes;
+      for (size_t f = 0; f < num_frames; ++f) {
+        for (size_t i = 0; i < residuals[c][f].size(); ++i) {
+          if (!projects[c][f][i]) continue;
+          magnitudes.push_back(std::abs(residuals[c][f][i].x()));
+          magnitudes.push_back(std::abs(residuals[c][f][i].y()));
+        }
+      }
+      const double threshold =
+          std::max(copt.outlier_k * 1.4826 * Median(magnitudes),
+                   copt.min_outlier_threshold_px);
+      for (size_t f = 0; f < num_frames; ++f) {
+        if (!state.used[c][f]) continue;
+        int kept = 0;
+        for (size_t i = 0; i < residuals[c][f].size(); ++i) {
+          const bool keep =
+              projects[c][f][i] && residuals[c][f][i].norm() <= threshold;
+          changed |= keep != state.inlier[c][f][i];
+          state.inlier[c][f][i] = keep;
+          kept += keep ? 1 : 0;
+        }
+        if (kept < copt.min_corners_per_view) {
+          state.used[c][f] = false;
+          std::fill(state.inlier[c][f].begin(), state.inlier[c][f].end(),
+                    false);
+          changed = true;
+        }
+      }
+    }
+    if (!changed) break;
+    ++rounds;
+    SolveJoint(&state, copt, &loss, &outcome);
+    iterations += static_cast<int>(outcome.summary.iterations.size());
+    compute_residuals();
+  }
+
+  // 5. The result.
+  result->outlier_rounds = rounds;
+  result->iterations = iterations;
+  result->termination = outcome.summary.message;
+  double sum2_all = 0;
+  int corners_all = 0, outliers_all = 0;
+  for (size_t c = 0; c < num_cameras; ++c) {
+    RigCameraResult& out = result->cameras[c];
+    out.camera.params = state.Params(c);
+    out.param_fixed = state.fixed[c];
+    out.param_stddev.assign(state.num_params[c], 0.0);
+    out.cam_from_rig = IsometryFromPose(state.cam_from_rig(c));
+    if (c == 0) out.cam_from_rig = Eigen::Isometry3d::Identity();
+    out.frame_used = state.used[c];
+    out.residuals = residuals[c];
+    out.inlier.resize(num_frames);
+    double sum2 = 0;
+    for (size_t f = 0; f < num_frames; ++f) {
+      out.inlier[f] = state.used[c][f]
+                          ? state.inlier[c][f]
+                          : std::vector<bool>(state.inlier[c][f].size(), false);
+      if (!state.used[c][f]) continue;
+      ++out.num_frames_used;
+      result->frame_used[f] = true;
+      for (size_t i = 0; i < residuals[c][f].size(); ++i) {
+        if (state.inlier[c][f][i]) {
+          sum2 += residuals[c][f][i].squaredNorm();
+          ++out.num_corners_used;
+        } else if (state.valid[c][f][i]) {
+          ++out.num_outliers;
+        }
+      }
+    }
+    out.rms_px = out.num_corners_used > 0
+                     ? std::sqrt(sum2 / (2.0 * out.num_corners_used))
+                     : 0.0;
+    Eigen::Matrix<double, 1, 6> g;
+    out.baseline_m = Baseline(state.CamFromRig(c), &g);
+    if (c == 0) out.baseline_m = 0;
+    sum2_all += sum2;
+    corners_all += out.num_corners_used;
+    outliers_all += out.num_outliers;
+  }
+  for (size_t a = 0; a < num_cameras; ++a) {
+    for (size_t b = 0; b < num_cameras; ++b) {
+      for (size_t f = 0; f < num_frames; ++f) {
+        result->shared_frames(a, b) += state.used[a][f] && state.used[b][f];
+      }
+    }
+  }
+  for (size_t f = 0; f < num_frames; ++f) {
+    if (!result->frame_used[f]) continue;
+    ++result->num_frames_used;
+    result->rig_from_board[f] =
+        IsometryFromPose(state.rig_from_board[f].data());
+  }
+  result->num_corners_used = corners_all;
+  result->num_outliers = outliers_all;
+  result->rms_px =
+      corners_all > 0 ? std::sqrt(sum2_all / (2.0 * corners_all)) : 0.0;
+
+  // Covariance, scaled by the residual variance.
+  if (copt.compute_covariance && outcome.problem &&
+      outcome.summary.IsSolutionUsable()) {
+    GlobalLayout layout;
+    Eigen::MatrixXd covariance;
+    if (JointMarginalCovariance(state, &outcome,
+                                copt.covariance_min_eigenvalue_ratio, &layout,
+                                &covariance)) {
+      const int free_params =
+          layout.size + kPoseBlockSize * result->num_frames_used;
+      if (2 * corners_all > free_params) {
+        const double variance = sum2_all / (2.0 * corners_all - free_params);
+        covariance *= variance;
+        result->covariance_ok = true;
+        for (size_t c = 0; c < num_cameras; ++c) {
+          RigCameraResult& out = result->cameras[c];
+          if (layout.params_begin[c] >= 0) {
+            int index = layout.params_begin[c];
+            for (int k = 0; k < state.num_params[c]; ++k) {
+              if (state.fixed[c][k]) continue;
+              out.param_stddev[k] =
+                  std::sqrt(std::max(0.0, covariance(index, index)));
+              ++index;
+            }
+          }
+          if (layout.extrinsics_begin[c] >= 0) {
+            const int e = layout.extrinsics_begin[c];
+            out.extrinsics_covariance = covariance.block<6, 6>(e, e);
+            const Eigen::Matrix<double, 3, 6> jr =
+                RotationJacobian(state.CamFromRig(c));
+            out.rotation_stddev_deg =
+                std::sqrt(std::max(
+                    0.0, (jr * out.extrinsics_covariance * jr.transpose())
+                             .trace())) /
+                kDegree;
+            for (int k = 0; k < 3; ++k) {
+              out.translation_stddev_m(k) = std::sqrt(
+                  std::max(0.0, out.extrinsics_covariance(3 + k, 3 + k)));
+            }
+            Eigen::Matrix<double, 1, 6> g;
+            Baseline(state.CamFromRig(c), &g);
+            out.baseline_stddev_m = std::sqrt(std::max(
+                0.0, (g * out.extrinsics_covariance * g.transpose())(0, 0)));
+          }
+        }
+      }
+    }
+  }
+  result->seconds_joint = SecondsSince(joint_start);
+
+  if (!outcome.summary.IsSolutionUsable()) {
+    return Fail(
+        "the joint bundle adjustment failed: " + outcome.summary.message,
+        error);
+  }
+  if (outcome.summary.termination_type == ceres::NO_CONVERGENCE) {
+    return Fail("the joint bundle adjustment did not converge within " +
+                    std::to_string(copt.max_iterations) + " iterations (RMS " +
+                    Format("%.3f", result->rms_px) +
+                    " px): raise the iteration limit or check the "
+                    "correspondences",
+                error);
+  }
+  // Outlier rejection may have taken a camera out of every frame it shared:
+  // every camera must still reach the reference through shared frames.
+  std::vector<bool> reached(num_cameras, false);
+  reached[0] = true;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (size_t a = 0; a < num_cameras; ++a) {
+      for (size_t b = 0; b < num_cameras; ++b) {
+        if (reached[a] && !reached[b] && result->shared_frames(a, b) > 0) {
+          reached[b] = true;
+          grew = true;
+        }
+      }
+    }
+  }
+  for (size_t c = 0; c < num_cameras; ++c) {
+    if (!reached[c]) {
+      return Fail("camera '" + cameras[c].name +
+                      "' shares no frame with the reference camera's group "
+                      "after outlier rejection, so its place in the rig is "
+                      "undetermined: take photos in which it and a "
+                      "neighbouring camera see the board together",
+                  error);
+    }
+  }
+  for (size_t c = 0; c < num_cameras; ++c) {
+    const RigCameraResult& out = result->cameras[c];
+    if (!(out.rms_px <= copt.max_rms_px)) {
+      return Fail("camera '" + out.name +
+                      "': the reprojection RMS of the "
+                      "joint solve is " +
+                      Format("%.2f", out.rms_px) + " px (limit " +
+                      Format("%.2f", copt.max_rms_px) +
+                      " px): the frames of the folders may not be the same "
+                      "instants, or the rig moved between photos",
+                  error);
+    }
+    for (int k = 0; k < 2; ++k) {
+      if (result->covariance_ok && !out.param_fixed[k] &&
+          !(out.param_stddev[k] <=
+            copt.max_focal_relative_stddev * std::abs(out.camera.params[k]))) {
+        return Fail("camera '" + out.name +
+                        "': the frames do not determine the focal length (" +
+                        Format("%.1f", out.camera.params[k]) + " +- " +
+                        Format("%.3g", out.param_stddev[k]) +
+                        " px): add photos with the board tilted",
+                    error);
+      }
+    }
+  }
+  return true;
+}
+
+std::string RigCalibrationReport(const RigCalibrationResult& result) {
+  std::ostringstream out;
+  out << "rig: " << result.cameras.size() << " cameras, "
+      << result.num_frames_used << " of " << result.frame_used.size()
+      << " frames used, " << result.num_corners_used << " corners, "
+      << result.num_outliers << " outliers (" << result.outlier_rounds
+      << " rejection rounds), RMS " << Format("%.4f", result.rms_px)
+      << " px per coordinate\n";
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    const RigCameraResult& cam = result.cameras[c];
+    const std::vector<std::string> names =
+        CameraModelParamNames(cam.camera.model);
+    out << "camera " << c << " '" << cam.name << "' ("
+        << CameraModelName(cam.camera.model) << ", " << cam.camera.width << "x"
+        << cam.camera.height << ")" << (c == 0 ? ", the rig frame" : "")
+        << "\n";
+    for (size_t k = 0; k < names.size() && k < cam.camera.params.size(); ++k) {
+      out << "  " << names[k] << " = " << Format("%.10g", cam.camera.params[k]);
+      if (cam.param_fixed[k]) {
+        out << " (fixed)";
+      } else if (result.covariance_ok) {
+        out << " +- " << Format("%.3g", cam.param_stddev[k]);
+      }
+      out << "\n";
+    }
+    if (c > 0) {
+      const Eigen::AngleAxisd rotation(cam.cam_from_rig.linear());
+      const Eigen::Vector3d t = cam.cam_from_rig.translation();
+      out << "  cam_from_rig: rotation "
+          << Format("%.5f", rotation.angle() / kDegree) << " deg";
+      if (result.covariance_ok) {
+        out << " +- " << Format("%.2g", cam.rotation_stddev_deg);
+      }
+      out << ", t = (" << Format("%.6f", t.x()) << ", " << Format("%.6f", t.y())
+          << ", " << Format("%.6f", t.z()) << ") m, baseline "
+          << Format("%.3f", 1000 * cam.baseline_m) << " mm";
+      if (result.covariance_ok) {
+        out << " +- " << Format("%.3g", 1000 * cam.baseline_stddev_m) << " mm";
+      }
+      out << " (started from camera " << result.start_parent[c] << ")\n";
+    }
+    out << "  joint: " << cam.num_frames_used << " frames, "
+        << cam.num_corners_used << " corners, " << cam.num_outliers
+        << " outliers, RMS " << Format("%.4f", cam.rms_px)
+        << " px; alone: " << cam.single_views_used << " views, RMS "
+        << Format("%.4f", cam.single_rms_px) << " px\n";
+  }
+  if (!result.covariance_ok) {
+    out << "covariance: not available (the problem is rank deficient)\n";
+  }
+  out << "shared frames:";
+  for (int a = 0; a < result.shared_frames.rows(); ++a) {
+    for (int b = a + 1; b < result.shared_frames.cols(); ++b) {
+      out << " " << a << "-" << b << ": " << result.shared_frames(a, b);
+    }
+  }
+  out << "\nsolver: " << result.iterations << " iterations, "
+      << result.termination << "; " << Format("%.3f", result.seconds_single)
+      << " s alone, " << Format("%.3f", result.seconds_joint) << " s joint\n";
+  return out.str();
+}
+
+}  // namespace puzzlecal

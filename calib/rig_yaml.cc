@@ -1,0 +1,520 @@
+#include "calib/rig_yaml.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <sstream>
+
+#include "util/atomic_file.h"
+
+namespace puzzlecal {
+namespace {
+
+constexpr const char* kRigFormatTag = "puzzlecal-rig";
+
+bool Fail(const std::string& message, std::string* error) {
+  if (error != nullptr) *error = message;
+  return false;
+}
+
+YAML::Emitter& Flow(YAML::Emitter& out, const std::vector<double>& values) {
+  out << YAML::Flow << YAML::BeginSeq;
+  for (double v : values) out << v;
+  out << YAML::EndSeq;
+  return out;
+}
+
+template <typename Derived>
+std::vector<double> RowMajor(const Eigen::MatrixBase<Derived>& m) {
+  std::vector<double> values;
+  for (int r = 0; r < m.rows(); ++r) {
+    for (int c = 0; c < m.cols(); ++c) values.push_back(m(r, c));
+  }
+  return values;
+}
+
+Eigen::Matrix3d CameraMatrix(const Camera& camera) {
+  Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
+  k(0, 0) = camera.params[0];
+  k(1, 1) = camera.params[1];
+  k(0, 2) = camera.params[2];
+  k(1, 2) = camera.params[3];
+  return k;
+}
+
+std::vector<double> Distortion(const Camera& camera) {
+  return std::vector<double>(camera.params.begin() + kDistortionBegin,
+                             camera.params.end());
+}
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d s;
+  s << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return s;
+}
+
+// Every camera must be one a camera file can hold.
+bool CheckCameras(const RigCalibrationResult& result, std::string* error) {
+  if (result.cameras.size() < 2) {
+    return Fail("a rig file needs at least two cameras", error);
+  }
+  for (const RigCameraResult& cam : result.cameras) {
+    std::string text, why;
+    if (!FormatCameraFile(cam.camera, CameraFileStats(),
+                          CameraFileFormat::kPuzzlecal, &text, &why)) {
+      return Fail("camera '" + cam.name + "': " + why, error);
+    }
+  }
+  return true;
+}
+
+std::string FormatPuzzlecal(const RigCalibrationResult& result) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "format" << YAML::Value << kRigFormatTag;
+  out << YAML::Key << "rig_frame" << YAML::Value << result.cameras[0].name;
+  out << YAML::Key << "rms_px" << YAML::Value << result.rms_px;
+  out << YAML::Key << "frames_used" << YAML::Value << result.num_frames_used;
+  out << YAML::Key << "corners_used" << YAML::Value << result.num_corners_used;
+  out << YAML::Key << "outliers" << YAML::Value << result.num_outliers;
+  out << YAML::Key << "cameras" << YAML::Value << YAML::BeginSeq;
+  for (const RigCameraResult& cam : result.cameras) {
+    const std::vector<std::string> names =
+        CameraModelParamNames(cam.camera.model);
+    out << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << cam.name;
+    out << YAML::Key << "model" << YAML::Value
+        << CameraModelName(cam.camera.model);
+    out << YAML::Key << "image_width" << YAML::Value << cam.camera.width;
+    out << YAML::Key << "image_height" << YAML::Value << cam.camera.height;
+    out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
+    for (size_t k = 0; k < names.size(); ++k) {
+      out << YAML::Key << names[k] << YAML::Value << cam.camera.params[k];
+    }
+    out << YAML::EndMap;
+    if (result.covariance_ok && cam.param_stddev.size() == names.size()) {
+      out << YAML::Key << "parameter_stddev" << YAML::Value << YAML::BeginMap;
+      for (size_t k = 0; k < names.size(); ++k) {
+        out << YAML::Key << names[k] << YAML::Value << cam.param_stddev[k];
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::Key << "cam_from_rig" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "R" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (int r = 0; r < 3; ++r) {
+      Flow(out, RowMajor(cam.cam_from_rig.linear().row(r)));
+    }
+    out << YAML::EndSeq;
+    out << YAML::Key << "t" << YAML::Value;
+    Flow(out, RowMajor(cam.cam_from_rig.translation().transpose()));
+    out << YAML::EndMap;
+    if (result.covariance_ok) {
+      out << YAML::Key << "cam_from_rig_stddev" << YAML::Value
+          << YAML::BeginMap;
+      out << YAML::Key << "rotation_deg" << YAML::Value
+          << cam.rotation_stddev_deg;
+      out << YAML::Key << "t" << YAML::Value;
+      Flow(out, RowMajor(cam.translation_stddev_m.transpose()));
+      out << YAML::EndMap;
+    }
+    out << YAML::Key << "baseline_mm" << YAML::Value << 1000 * cam.baseline_m;
+    if (result.covariance_ok) {
+      out << YAML::Key << "baseline_stddev_mm" << YAML::Value
+          << 1000 * cam.baseline_stddev_m;
+    }
+    out << YAML::Key << "rms_px" << YAML::Value << cam.rms_px;
+    out << YAML::Key << "frames_used" << YAML::Value << cam.num_frames_used;
+    out << YAML::Key << "corners_used" << YAML::Value << cam.num_corners_used;
+    out << YAML::Key << "outliers" << YAML::Value << cam.num_outliers;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  return std::string("# puzzlecal rig calibration\n") + out.c_str() + "\n";
+}
+
+// cv::FileStorage's matrix form.
+void OpenCvMatrix(YAML::Emitter& out, const std::string& key, int rows,
+                  int cols, const std::vector<double>& data) {
+  out << YAML::Key << key << YAML::Value << YAML::SecondaryTag("opencv-matrix")
+      << YAML::BeginMap;
+  out << YAML::Key << "rows" << YAML::Value << rows;
+  out << YAML::Key << "cols" << YAML::Value << cols;
+  out << YAML::Key << "dt" << YAML::Value << "d";
+  out << YAML::Key << "data" << YAML::Value;
+  Flow(out, data);
+  out << YAML::EndMap;
+}
+
+bool FormatOpenCv(const RigCalibrationResult& result, std::string* text,
+                  std::string* error) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "num_cameras" << YAML::Value
+      << static_cast<int>(result.cameras.size());
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    const RigCameraResult& cam = result.cameras[c];
+    const std::string n = std::to_string(c + 1);
+    out << YAML::Key << "name" + n << YAML::Value << cam.name;
+    out << YAML::Key << "model" + n << YAML::Value
+        << CameraModelName(cam.camera.model);
+    out << YAML::Key << "image_width" + n << YAML::Value << cam.camera.width;
+    out << YAML::Key << "image_height" + n << YAML::Value << cam.camera.height;
+    OpenCvMatrix(out, "K" + n, 3, 3, RowMajor(CameraMatrix(cam.camera)));
+    const std::vector<double> d = Distortion(cam.camera);
+    OpenCvMatrix(out, "D" + n, 1, static_cast<int>(d.size()), d);
+  }
+  if (result.cameras.size() == 2) {
+    const Camera& first = result.cameras[0].camera;
+    const Camera& second = result.cameras[1].camera;
+    const Eigen::Isometry3d second_from_first =
+        result.cameras[1].cam_from_rig *
+        result.cameras[0].cam_from_rig.inverse();
+    StereoRectification rect;
+    if (!StereoRectify(first, second, second_from_first, &rect, error)) {
+      return false;
+    }
+    OpenCvMatrix(out, "R", 3, 3, RowMajor(second_from_first.linear()));
+    OpenCvMatrix(out, "T", 3, 1, RowMajor(second_from_first.translation()));
+    OpenCvMatrix(out, "E", 3, 3, RowMajor(rect.essential));
+    OpenCvMatrix(out, "F", 3, 3, RowMajor(rect.fundamental));
+    OpenCvMatrix(out, "R1", 3, 3, RowMajor(rect.r1));
+    OpenCvMatrix(out, "R2", 3, 3, RowMajor(rect.r2));
+    OpenCvMatrix(out, "P1", 3, 4, RowMajor(rect.p1));
+    OpenCvMatrix(out, "P2", 3, 4, RowMajor(rect.p2));
+    OpenCvMatrix(out, "Q", 4, 4, RowMajor(rect.q));
+  } else {
+    for (size_t c = 1; c < result.cameras.size(); ++c) {
+      const Eigen::Isometry3d from_first =
+          result.cameras[c].cam_from_rig *
+          result.cameras[0].cam_from_rig.inverse();
+      const std::string n = std::to_string(c + 1);
+      OpenCvMatrix(out, "R" + n, 3, 3, RowMajor(from_first.linear()));
+      OpenCvMatrix(out, "T" + n, 3, 1, RowMajor(from_first.translation()));
+    }
+  }
+  out << YAML::EndMap;
+  *text = std::string("%YAML:1.0\n---\n") + out.c_str() + "\n";
+  return true;
+}
+
+const char* RosDistortionModel(CameraModelId id) {
+  switch (id) {
+    case CameraModelId::kPinholeRadtan:
+      return "plumb_bob";
+    case CameraModelId::kPinholeRational:
+      return "rational_polynomial";
+    case CameraModelId::kKannalaBrandt:
+      return "equidistant";
+  }
+  return "plumb_bob";
+}
+
+std::string FormatRosCamera(const RigCameraResult& cam,
+                            const Eigen::Matrix3d& rectification,
+                            const Eigen::Matrix<double, 3, 4>& projection) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  auto matrix = [&](const char* key, int rows, int cols,
+                    const std::vector<double>& data) {
+    out << YAML::Key << key << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "rows" << YAML::Value << rows;
+    out << YAML::Key << "cols" << YAML::Value << cols;
+    out << YAML::Key << "data" << YAML::Value;
+    Flow(out, data);
+    out << YAML::EndMap;
+  };
+  out << YAML::BeginMap;
+  out << YAML::Key << "image_width" << YAML::Value << cam.camera.width;
+  out << YAML::Key << "image_height" << YAML::Value << cam.camera.height;
+  out << YAML::Key << "camera_name" << YAML::Value << cam.name;
+  matrix("camera_matrix", 3, 3, RowMajor(CameraMatrix(cam.camera)));
+  out << YAML::Key << "distortion_model" << YAML::Value
+      << RosDistortionModel(cam.camera.model);
+  const std::vector<double> d = Distortion(cam.camera);
+  matrix("distortion_coefficients", 1, static_cast<int>(d.size()), d);
+  matrix("rectification_matrix", 3, 3, RowMajor(rectification));
+  matrix("projection_matrix", 3, 4, RowMajor(projection));
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+bool FormatRos(const RigCalibrationResult& result, const std::string& out_path,
+               std::vector<RigFileText>* files, std::string* error) {
+  namespace fs = std::filesystem;
+  const fs::path out(out_path);
+  const std::string stem = out.stem().string();
+  const std::string extension =
+      out.has_extension() ? out.extension().string() : ".yaml";
+  std::vector<Eigen::Matrix3d> rect(result.cameras.size(),
+                                    Eigen::Matrix3d::Identity());
+  std::vector<Eigen::Matrix<double, 3, 4>> proj(result.cameras.size());
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    proj[c].setZero();
+    proj[c].leftCols<3>() = CameraMatrix(result.cameras[c].camera);
+  }
+  if (result.cameras.size() == 2) {
+    StereoRectification r;
+    if (!StereoRectify(result.cameras[0].camera, result.cameras[1].camera,
+                       result.cameras[1].cam_from_rig *
+                           result.cameras[0].cam_from_rig.inverse(),
+                       &r, error)) {
+      return false;
+    }
+    rect[0] = r.r1;
+    rect[1] = r.r2;
+    proj[0] = r.p1;
+    proj[1] = r.p2;
+  }
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    RigFileText file;
+    file.path =
+        (out.parent_path() / (stem + "_" + result.cameras[c].name + extension))
+            .string();
+    file.text = FormatRosCamera(result.cameras[c], rect[c], proj[c]);
+    files->push_back(file);
+  }
+  return true;
+}
+
+bool FormatKalibr(const RigCalibrationResult& result, std::string* text,
+                  std::string* error) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    const RigCameraResult& cam = result.cameras[c];
+    // The single-camera writer knows what Kalibr's models can hold.
+    std::string single, why;
+    if (!FormatCameraFile(cam.camera, CameraFileStats(),
+                          CameraFileFormat::kKalibr, &single, &why)) {
+      return Fail("camera '" + cam.name + "': " + why, error);
+    }
+    const auto& p = cam.camera.params;
+    out << YAML::Key << "cam" + std::to_string(c) << YAML::Value
+        << YAML::BeginMap;
+    if (c > 0) {
+      const Eigen::Matrix4d t =
+          (cam.cam_from_rig * result.cameras[c - 1].cam_from_rig.inverse())
+              .matrix();
+      out << YAML::Key << "T_cn_cnm1" << YAML::Value << YAML::BeginSeq;
+      for (int r = 0; r < 4; ++r) Flow(out, RowMajor(t.row(r)));
+      out << YAML::EndSeq;
+    }
+    out << YAML::Key << "cam_overlaps" << YAML::Value << YAML::Flow
+        << YAML::BeginSeq;
+    for (size_t o = 0; o < result.cameras.size(); ++o) {
+      if (o != c && result.shared_frames(c, o) > 0) out << static_cast<int>(o);
+    }
+    out << YAML::EndSeq;
+    out << YAML::Key << "camera_model" << YAML::Value << "pinhole";
+    out << YAML::Key << "intrinsics" << YAML::Value;
+    Flow(out, {p[0], p[1], p[2], p[3]});
+    out << YAML::Key << "distortion_model" << YAML::Value
+        << (cam.camera.model == CameraModelId::kKannalaBrandt ? "equidistant"
+                                                              : "radtan");
+    out << YAML::Key << "distortion_coeffs" << YAML::Value;
+    Flow(out, {p[4], p[5], p[6], p[7]});
+    out << YAML::Key << "resolution" << YAML::Value << YAML::Flow
+        << YAML::BeginSeq << cam.camera.width << cam.camera.height
+        << YAML::EndSeq;
+    out << YAML::Key << "rostopic" << YAML::Value
+        << "/" + cam.name + "/image_raw";
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  *text = std::string(out.c_str()) + "\n";
+  return true;
+}
+
+}  // namespace
+
+bool StereoRectify(const Camera& first, const Camera& second,
+                   const Eigen::Isometry3d& second_from_first,
+                   StereoRectification* rect, std::string* error) {
+  const Eigen::Matrix3d k1 = CameraMatrix(first), k2 = CameraMatrix(second);
+  const Eigen::Matrix3d r = second_from_first.linear();
+  const Eigen::Vector3d t = second_from_first.translation();
+  if (!(t.norm() > 0)) {
+    return Fail("the two cameras share one centre: no stereo rectification",
+                error);
+  }
+  rect->essential = Skew(t) * r;
+  rect->fundamental = k2.inverse().transpose() * rect->essential * k1.inverse();
+  rect->width = first.width;
+  rect->height = first.height;
+  cv::Mat cv_k1, cv_k2, cv_r, cv_t;
+  cv::eigen2cv(k1, cv_k1);
+  cv::eigen2cv(k2, cv_k2);
+  cv::eigen2cv(r, cv_r);
+  cv::eigen2cv(t, cv_t);
+  const cv::Size size(first.width, first.height);
+  cv::Mat r1, r2, p1, p2, q;
+  const bool fisheye1 = first.model == CameraModelId::kKannalaBrandt;
+  const bool fisheye2 = second.model == CameraModelId::kKannalaBrandt;
+  try {
+    if (fisheye1 && fisheye2) {
+      cv::Mat d1(Distortion(first)), d2(Distortion(second));
+      cv::fisheye::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1, r2,
+                                 p1, p2, q, cv::CALIB_ZERO_DISPARITY, size, 0.0,
+                                 1.0);
+    } else {
+      // A fisheye's coefficients mean nothing to cv::stereoRectify: leave
+      // the distortion out (the rotations do not depend on it).
+      cv::Mat d1 =
+          fisheye1 || fisheye2 ? cv::Mat() : cv::Mat(Distortion(first));
+      cv::Mat d2 =
+          fisheye1 || fisheye2 ? cv::Mat() : cv::Mat(Distortion(second));
+      cv::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1, r2, p1, p2,
+                        q, cv::CALIB_ZERO_DISPARITY, 0.0);
+    }
+  } catch (const cv::Exception& e) {
+    return Fail(std::string("stereo rectification failed: ") + e.what(), error);
+  }
+  cv::cv2eigen(r1, rect->r1);
+  cv::cv2eigen(r2, rect->r2);
+  cv::cv2eigen(p1, rect->p1);
+  cv::cv2eigen(p2, rect->p2);
+  cv::cv2eigen(q, rect->q);
+  const bool finite = rect->r1.allFinite() && rect->r2.allFinite() &&
+                      rect->p1.allFinite() && rect->p2.allFinite() &&
+                      rect->q.allFinite();
+  if (!finite) return Fail("stereo rectification is not finite", error);
+  return true;
+}
+
+bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
+                    const std::string& out_path,
+                    std::vector<RigFileText>* files, std::string* error) {
+  files->clear();
+  if (!CheckCameras(result, error)) return false;
+  RigFileText file;
+  file.path = out_path;
+  switch (format) {
+    case CameraFileFormat::kPuzzlecal:
+      file.text = FormatPuzzlecal(result);
+      break;
+    case CameraFileFormat::kOpenCv:
+      if (!FormatOpenCv(result, &file.text, error)) return false;
+      break;
+    case CameraFileFormat::kRos:
+      return FormatRos(result, out_path, files, error);
+    case CameraFileFormat::kKalibr:
+      if (!FormatKalibr(result, &file.text, error)) return false;
+      break;
+  }
+  files->push_back(file);
+  return true;
+}
+
+bool WriteRigFiles(const std::string& out_path, CameraFileFormat format,
+                   const RigCalibrationResult& result,
+                   std::vector<std::string>* written, std::string* error) {
+  std::vector<RigFileText> files;
+  std::string why;
+  if (!FormatRigFiles(result, format, out_path, &files, &why)) {
+    return Fail("cannot write '" + out_path + "' (" +
+                    CameraFileFormatName(format) + " format): " + why,
+                error);
+  }
+  for (const RigFileText& file : files) {
+    if (!WriteFileAtomically(file.path, file.text, error)) return false;
+    if (written != nullptr) written->push_back(file.path);
+  }
+  return true;
+}
+
+bool ParseRigFile(const std::string& text, const std::string& source,
+                  std::vector<RigFileCamera>* cameras, std::string* error) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    return Fail(source + ": not valid YAML: " + e.what(), error);
+  }
+  if (!root.IsMap() || !root["cameras"]) {
+    return Fail(source + ": not a puzzlecal rig file (no 'cameras' list)",
+                error);
+  }
+  const YAML::Node list = root["cameras"];
+  if (!list.IsSequence() || list.size() < 2) {
+    return Fail(source + ": field 'cameras': expected a list of two or more",
+                error);
+  }
+  std::vector<RigFileCamera> parsed;
+  try {
+    for (size_t c = 0; c < list.size(); ++c) {
+      const std::string field = "cameras[" + std::to_string(c) + "]";
+      const YAML::Node node = list[c];
+      RigFileCamera camera;
+      if (!node.IsMap() || !node["name"] || !node["name"].IsScalar()) {
+        return Fail(source + ": field '" + field + "/name': missing", error);
+      }
+      camera.name = node["name"].as<std::string>();
+      // The camera part is a single-camera file: its reader checks it.
+      YAML::Emitter single;
+      single << node;
+      if (!ParseCameraFile(single.c_str(), source + " " + field, &camera.camera,
+                           nullptr, error)) {
+        return false;
+      }
+      const YAML::Node pose = node["cam_from_rig"];
+      if (!pose || !pose.IsMap() || !pose["R"] || !pose["t"]) {
+        return Fail(source + ": field '" + field +
+                        "/cam_from_rig': missing (needs R and t)",
+                    error);
+      }
+      const YAML::Node r = pose["R"], t = pose["t"];
+      if (!r.IsSequence() || r.size() != 3 || !t.IsSequence() ||
+          t.size() != 3) {
+        return Fail(source + ": field '" + field +
+                        "/cam_from_rig': R must be 3 rows of 3, t 3 numbers",
+                    error);
+      }
+      Eigen::Matrix3d rotation;
+      for (int i = 0; i < 3; ++i) {
+        if (!r[i].IsSequence() || r[i].size() != 3) {
+          return Fail(source + ": field '" + field + "/cam_from_rig/R[" +
+                          std::to_string(i) + "]': expected 3 numbers",
+                      error);
+        }
+        for (int j = 0; j < 3; ++j) rotation(i, j) = r[i][j].as<double>();
+        camera.cam_from_rig.translation()(i) = t[i].as<double>();
+      }
+      if (!rotation.allFinite() ||
+          !(rotation * rotation.transpose())
+               .isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
+          !(rotation.determinant() > 0) ||
+          !camera.cam_from_rig.translation().allFinite()) {
+        return Fail(source + ": field '" + field +
+                        "/cam_from_rig': R is not a rotation or t not finite",
+                    error);
+      }
+      camera.cam_from_rig.linear() = rotation;
+      parsed.push_back(camera);
+    }
+  } catch (const YAML::Exception& e) {
+    return Fail(source + ": " + e.what(), error);
+  }
+  *cameras = parsed;
+  return true;
+}
+
+bool ReadRigFile(const std::string& path, std::vector<RigFileCamera>* cameras,
+                 std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Fail("cannot open '" + path + "'", error);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return Fail("cannot read '" + path + "'", error);
+  return ParseRigFile(text.str(), path, cameras, error);
+}
+
+}  // namespace puzzlecal

@@ -1,0 +1,221 @@
+// `puzzlecal calibrate-rig` end to end on rig renders (sim/rig_scenes.h):
+// detection, decoding and the rig calibration against the exact truth, the
+// output formats, the report, and the refusals. The program is the one
+// built beside this test (<build>/apps/puzzlecal).
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <opencv2/core.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "apps/subcommand.h"
+#include "calib/rig_calibration.h"
+#include "calib/rig_yaml.h"
+#include "sim/rig_scenes.h"
+
+namespace puzzlecal {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kMaxRotationErrorDeg = 0.005;
+constexpr double kMaxTranslationErrorOfBaseline = 0.001;
+constexpr double kMaxFocalRelativeError = 0.0005;
+
+fs::path ProgramPath() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  return self.parent_path().parent_path() / "apps" / "puzzlecal";
+}
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+RunResult RunProgram(const std::string& arguments) {
+  const fs::path log = fs::temp_directory_path() / "puzzlecal_rig_run.log";
+  const std::string command =
+      ProgramPath().string() + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  RunResult result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(log);
+  result.output.assign(std::istreambuf_iterator<char>(in),
+                       std::istreambuf_iterator<char>());
+  return result;
+}
+
+std::string WriteBoardFile(const Board& board, const fs::path& dir) {
+  const fs::path path = dir / "board.yaml";
+  std::ofstream out(path);
+  out << "type: puzzleboard\ncols: " << board.cols << "\nrows: " << board.rows
+      << "\norigin: [" << board.origin.x() << ", " << board.origin.y()
+      << "]\ntile_size_m: " << board.tile_size_m << "\n";
+  return path.string();
+}
+
+// A rendered rig in a fresh temporary folder: images/<camera>/frame_NNN.png
+// and board.yaml.
+struct RenderedRig {
+  RigSceneSpec scene;
+  fs::path root;
+  fs::path images;
+  std::string board;
+  RigRenderSummary summary;
+};
+
+RenderedRig Render(const RigSceneSpec& scene, const std::string& name) {
+  RenderedRig rig;
+  rig.scene = scene;
+  rig.root = fs::temp_directory_path() / ("puzzlecal_rig_test_" + name);
+  fs::remove_all(rig.root);
+  rig.images = rig.root / "images";
+  std::string why;
+  EXPECT_TRUE(RenderRigScene(scene, rig.images.string(), &rig.summary, &why))
+      << why;
+  rig.board = WriteBoardFile(scene.board, rig.root);
+  return rig;
+}
+
+void ExpectMatchesTruth(const RigSceneSpec& scene,
+                        const std::vector<RigFileCamera>& cameras) {
+  ASSERT_EQ(cameras.size(), scene.cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    SCOPED_TRACE("camera " + scene.cameras[c].name);
+    EXPECT_EQ(cameras[c].name, scene.cameras[c].name);
+    const Camera& truth = scene.cameras[c].camera;
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_LT(std::abs(cameras[c].camera.params[k] - truth.params[k]),
+                kMaxFocalRelativeError * truth.params[k])
+          << cameras[c].camera.params[k] << " vs " << truth.params[k];
+    }
+    const Eigen::Isometry3d& expected = scene.cameras[c].cam_from_rig;
+    const double rotation_error = RotationDifferenceDeg(
+        cameras[c].cam_from_rig.linear(), expected.linear());
+    const double baseline =
+        (expected.linear().transpose() * expected.translation()).norm();
+    const double translation_error =
+        (cameras[c].cam_from_rig.translation() - expected.translation()).norm();
+    std::cout << scene.cameras[c].name << ": rotation error " << rotation_error
+              << " deg, translation error " << translation_error * 1000
+              << " mm of " << baseline * 1000 << " mm, fx error "
+              << cameras[c].camera.params[0] - truth.params[0] << " px\n";
+    EXPECT_LT(rotation_error, kMaxRotationErrorDeg);
+    EXPECT_LE(translation_error, kMaxTranslationErrorOfBaseline * baseline);
+  }
+}
+
+TEST(CalibrateRigTest, FisheyeAndPinholeRendersMeetTheFigures) {
+  // 1280 x 960: at 640 x 480 the fisheye's focal length is 137 px (1 px =
+  // 0.4 degrees) and its rotation sigma alone is 0.009 degrees.
+  const RenderedRig rig =
+      Render(FisheyePinholeRig(1280, 960), "fisheye_pinhole");
+  ASSERT_EQ(rig.summary.images_per_camera.size(), 2u);
+  EXPECT_GT(rig.summary.frames_seen_by_one_camera, 0);
+  const fs::path out = rig.root / "rig.yaml";
+  const fs::path report = rig.root / "report";
+  const RunResult run = RunProgram(
+      "calibrate-rig --images " + rig.images.string() + " --board " +
+      rig.board + " --model kannala-brandt,pinhole-radtan --out " +
+      out.string() + " --report " + report.string() + " --threads 2");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  std::vector<RigFileCamera> cameras;
+  std::string error;
+  ASSERT_TRUE(ReadRigFile(out.string(), &cameras, &error)) << error;
+  ExpectMatchesTruth(rig.scene, cameras);
+  EXPECT_TRUE(fs::exists(report / "summary.txt"));
+  const cv::Mat pair = cv::imread((report / "rectified_pair.png").string());
+  EXPECT_EQ(pair.cols, 2 * 1280);
+  EXPECT_EQ(pair.rows, 960);
+  std::cout << run.output;
+}
+
+TEST(CalibrateRigTest, StereoPinholeRendersInOpenCvFormat) {
+  const RenderedRig rig = Render(StereoPinholeRig(), "stereo");
+  const fs::path out = rig.root / "stereo.yaml";
+  const RunResult run =
+      RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
+                 rig.board + " --model pinhole-radtan --format opencv --out " +
+                 out.string() + " --threads 2");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  cv::FileStorage storage(out.string(), cv::FileStorage::READ);
+  ASSERT_TRUE(storage.isOpened());
+  cv::Mat r, t, k2;
+  storage["R"] >> r;
+  storage["T"] >> t;
+  storage["K2"] >> k2;
+  RigFileCamera second;
+  second.name = "cam1";
+  second.camera = rig.scene.cameras[1].camera;
+  second.camera.params[0] = k2.at<double>(0, 0);
+  second.camera.params[1] = k2.at<double>(1, 1);
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  cv::cv2eigen(r, rotation);
+  cv::cv2eigen(t, translation);
+  second.cam_from_rig.linear() = rotation;
+  second.cam_from_rig.translation() = translation;
+  RigFileCamera first;
+  first.name = "cam0";
+  first.camera = rig.scene.cameras[0].camera;
+  ExpectMatchesTruth(rig.scene, {first, second});
+  for (const char* key : {"E", "F", "R1", "R2", "P1", "P2", "Q"}) {
+    cv::Mat m;
+    storage[key] >> m;
+    EXPECT_FALSE(m.empty()) << key;
+  }
+}
+
+TEST(CalibrateRigTest, CameraThatNeverSharesAFrameIsNamedAndNothingWritten) {
+  const RenderedRig rig = Render(StereoPinholeRig(), "no_shared");
+  // Odd frames only for cam0, even ones only for cam1.
+  for (int f = 0; f < rig.summary.num_frames; ++f) {
+    fs::remove(rig.images / (f % 2 == 0 ? "cam0" : "cam1") /
+               RigFrameFileName(f));
+  }
+  const fs::path out = rig.root / "rig.yaml";
+  const RunResult run =
+      RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
+                 rig.board + " --model pinhole-radtan --out " + out.string());
+  EXPECT_EQ(run.exit_code, kExitNoResult) << run.output;
+  EXPECT_NE(run.output.find("'cam1' shares no frame"), std::string::npos)
+      << run.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CalibrateRigTest, WrongNumberOfModelsIsAUsageError) {
+  const fs::path root = fs::temp_directory_path() / "puzzlecal_rig_models";
+  fs::create_directories(root / "a");
+  fs::create_directories(root / "b");
+  fs::create_directories(root / "c");
+  const RigSceneSpec scene = StereoPinholeRig();
+  const std::string board = WriteBoardFile(scene.board, root);
+  const RunResult run =
+      RunProgram("calibrate-rig --images " + root.string() + " --board " +
+                 board + " --model pinhole-radtan,kannala-brandt --out " +
+                 (root / "rig.yaml").string());
+  EXPECT_EQ(run.exit_code, kExitUsage) << run.output;
+  EXPECT_NE(run.output.find("2 models for 3 cameras"), std::string::npos)
+      << run.output;
+  const RunResult one = RunProgram(
+      "calibrate-rig --images " + (root / "a").string() + " --board " + board +
+      " --model pinhole-radtan --out " + (root / "rig.yaml").string());
+  EXPECT_EQ(one.exit_code, kExitBadInput) << one.output;
+  EXPECT_NE(one.output.find("at least two"), std::string::npos) << one.output;
+}
+
+}  // namespace
+}  // namespace puzzlecal

@@ -1,0 +1,351 @@
+// CalibrateRig against the exact truth of sim/ rigs, against
+// cv::stereoCalibrate on the same correspondences, and on inputs OpenCV's
+// stereo calibration cannot take (cameras that see different corners).
+
+#include "calib/rig_calibration.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "sim/rig_scenes.h"
+#include "sim/scenes.h"
+
+namespace puzzlecal {
+namespace {
+
+// The figures a rig calibration must reach on exact correspondences with
+// 0.03 px of corner noise (what the detector reaches on the rig renders,
+// see tests/apps/calibrate_rig_test.cc).
+constexpr double kMaxRotationErrorDeg = 0.005;
+constexpr double kMaxTranslationErrorOfBaseline = 0.001;
+constexpr double kMaxFocalRelativeError = 0.0005;
+constexpr double kNoisePx = 0.03;
+
+double BaselineOf(const Eigen::Isometry3d& cam_from_rig) {
+  return (cam_from_rig.linear().transpose() * cam_from_rig.translation())
+      .norm();
+}
+
+// Checks every camera of `result` against the truth of `scene`; with
+// `sigma_within_limits` also that the standard deviations are below the
+// limits (the frames determine the rig well enough to promise them).
+void ExpectMatchesTruth(const RigSceneSpec& scene,
+                        const RigCalibrationResult& result,
+                        bool sigma_within_limits = true) {
+  ASSERT_EQ(result.cameras.size(), scene.cameras.size());
+  for (size_t c = 0; c < scene.cameras.size(); ++c) {
+    SCOPED_TRACE("camera " + scene.cameras[c].name);
+    const RigCameraResult& cam = result.cameras[c];
+    const Camera& truth = scene.cameras[c].camera;
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_LT(std::abs(cam.camera.params[k] - truth.params[k]),
+                kMaxFocalRelativeError * truth.params[k])
+          << "parameter " << k << ": " << cam.camera.params[k] << " vs "
+          << truth.params[k];
+    }
+    if (c == 0) {
+      EXPECT_TRUE(cam.cam_from_rig.isApprox(Eigen::Isometry3d::Identity()));
+      continue;
+    }
+    const Eigen::Isometry3d& expected = scene.cameras[c].cam_from_rig;
+    const double rotation_error =
+        RotationDifferenceDeg(cam.cam_from_rig.linear(), expected.linear());
+    const double baseline = BaselineOf(expected);
+    const double translation_error =
+        (cam.cam_from_rig.translation() - expected.translation()).norm();
+    EXPECT_LT(rotation_error, kMaxRotationErrorDeg);
+    EXPECT_LT(translation_error, kMaxTranslationErrorOfBaseline * baseline)
+        << translation_error * 1000 << " mm of a " << baseline * 1000
+        << " mm baseline";
+    EXPECT_NEAR(cam.baseline_m, baseline,
+                kMaxTranslationErrorOfBaseline * baseline);
+    // The standard deviations describe the errors: the truth lies within
+    // 5 sigma (and the sigma are not absurdly large).
+    ASSERT_TRUE(result.covariance_ok);
+    EXPECT_GT(cam.rotation_stddev_deg, 0);
+    EXPECT_LT(rotation_error, 5 * cam.rotation_stddev_deg + 1e-9);
+    EXPECT_LT(std::abs(cam.baseline_m - baseline),
+              5 * cam.baseline_stddev_m + 1e-12);
+    if (!sigma_within_limits) continue;
+    EXPECT_LT(cam.rotation_stddev_deg, kMaxRotationErrorDeg);
+    EXPECT_LT(cam.baseline_stddev_m, kMaxTranslationErrorOfBaseline * baseline);
+  }
+}
+
+RigCalibrationResult CalibrateOrDie(
+    const std::vector<RigCameraInput>& inputs,
+    const RigCalibrationOptions& options = RigCalibrationOptions()) {
+  RigCalibrationResult result;
+  std::string error;
+  EXPECT_TRUE(CalibrateRig(inputs, options, &result, &error)) << error;
+  return result;
+}
+
+TEST(RigCalibrationTest, StereoPinholeMeetsTheFigures) {
+  const RigSceneSpec scene = StereoPinholeRig();
+  const std::vector<RigCameraInput> inputs =
+      RigCorrespondences(scene, kNoisePx, 7);
+  const RigCalibrationResult result = CalibrateOrDie(inputs);
+  ExpectMatchesTruth(scene, result);
+  EXPECT_NEAR(result.rms_px, kNoisePx, 0.02);
+  EXPECT_FALSE(RigCalibrationReport(result).empty());
+}
+
+TEST(RigCalibrationTest, FisheyeAndPinholeTurned50DegreesMeetTheFigures) {
+  const RigSceneSpec scene = FisheyePinholeRig();
+  const std::vector<RigCameraInput> inputs =
+      RigCorrespondences(scene, kNoisePx, 8);
+  // The scene has frames only one of the cameras sees.
+  int fisheye_only = 0, pinhole_only = 0, both = 0;
+  for (size_t f = 0; f < inputs[0].frames.size(); ++f) {
+    const bool a = !inputs[0].frames[f].board_points.empty();
+    const bool b = !inputs[1].frames[f].board_points.empty();
+    fisheye_only += a && !b;
+    pinhole_only += b && !a;
+    both += a && b;
+  }
+  EXPECT_GT(fisheye_only, 0);
+  EXPECT_GT(both, 3);
+  const RigCalibrationResult result = CalibrateOrDie(inputs);
+  ExpectMatchesTruth(scene, result);
+  EXPECT_EQ(result.shared_frames(0, 1), both);
+  std::cout << "fisheye-only " << fisheye_only << " pinhole-only "
+            << pinhole_only << " both " << both << "\n"
+            << RigCalibrationReport(result);
+}
+
+TEST(RigCalibrationTest, FourCamerasOfThreeModelsMeetTheFigures) {
+  const RigSceneSpec scene = FourCameraRig();
+  const std::vector<RigCameraInput> inputs =
+      RigCorrespondences(scene, kNoisePx, 9);
+  const RigCalibrationResult result = CalibrateOrDie(inputs);
+  ExpectMatchesTruth(scene, result);
+  std::cout << RigCalibrationReport(result);
+}
+
+// The +100 degree camera never shares a frame with the reference: its
+// starting pose is chained through the +50 degree camera.
+TEST(RigCalibrationTest, ChainsThroughAnotherCamera) {
+  const RigSceneSpec scene = FourCameraRig();
+  std::vector<RigCameraInput> inputs = RigCorrespondences(scene, kNoisePx, 15);
+  int removed = 0;
+  for (size_t f = 0; f < inputs[0].frames.size(); ++f) {
+    if (!inputs[3].frames[f].board_points.empty() &&
+        !inputs[0].frames[f].board_points.empty()) {
+      inputs[0].frames[f] = CalibrationView{};
+      ++removed;
+    }
+  }
+  ASSERT_GT(removed, 0);
+  const RigCalibrationResult result = CalibrateOrDie(inputs);
+  EXPECT_EQ(result.shared_frames(0, 3), 0);
+  EXPECT_EQ(result.start_parent[3], 1);
+  // Fewer frames for the reference: sigma of up to 0.0055 degrees, but
+  // the errors still meet the figures.
+  ExpectMatchesTruth(scene, result, /*sigma_within_limits=*/false);
+}
+
+// Two fisheyes 60 degrees apart; in every frame the first keeps only the
+// board's left columns and the second only its right ones (overlapping in
+// two columns), so no frame has the same corners in both cameras.
+TEST(RigCalibrationTest, CamerasSeeingDifferentCornersMeetTheFigures) {
+  RigSceneSpec scene = FisheyePinholeRig();
+  scene.name = "two_fisheyes";
+  scene.cameras[1].camera = FisheyeLensCamera(640, 480, 180.0);
+  scene.cameras[1].field_of_view_deg = 180.0;
+  scene.cameras[1].cam_from_rig.linear() =
+      Eigen::AngleAxisd(-60.0 * M_PI / 180, Eigen::Vector3d::UnitY())
+          .toRotationMatrix();
+  scene.random_frames.count = 36;
+  std::vector<RigCameraInput> inputs = RigCorrespondences(scene, kNoisePx, 10);
+  const double split_x = (scene.board.origin.x() + 0.5 * scene.board.cols) *
+                         scene.board.tile_size_m;
+  for (size_t c = 0; c < 2; ++c) {
+    for (CalibrationView& view : inputs[c].frames) {
+      CalibrationView kept;
+      kept.name = view.name;
+      for (size_t i = 0; i < view.board_points.size(); ++i) {
+        const double x = view.board_points[i].x() - split_x;
+        const double tile = scene.board.tile_size_m;
+        if ((c == 0 && x < tile) || (c == 1 && x > -tile)) {
+          kept.board_points.push_back(view.board_points[i]);
+          kept.image_points.push_back(view.image_points[i]);
+        }
+      }
+      if (kept.board_points.size() < 12) {
+        kept.board_points.clear();
+        kept.image_points.clear();
+      }
+      view = kept;
+    }
+  }
+  // cv::fisheye::stereoCalibrate needs the same board points in both
+  // cameras; with these frames it refuses.
+  std::vector<std::vector<cv::Point3d>> object;
+  std::vector<std::vector<cv::Point2d>> left, right;
+  int shared = 0;
+  for (size_t f = 0; f < inputs[0].frames.size(); ++f) {
+    const CalibrationView& a = inputs[0].frames[f];
+    const CalibrationView& b = inputs[1].frames[f];
+    if (a.board_points.empty() || b.board_points.empty()) continue;
+    ++shared;
+    EXPECT_NE(a.board_points, b.board_points);
+    object.emplace_back();
+    left.emplace_back();
+    right.emplace_back();
+    for (size_t i = 0; i < a.board_points.size(); ++i) {
+      object.back().emplace_back(a.board_points[i].x(), a.board_points[i].y(),
+                                 0.0);
+      left.back().emplace_back(a.image_points[i].x(), a.image_points[i].y());
+    }
+    for (const Eigen::Vector2d& p : b.image_points) {
+      right.back().emplace_back(p.x(), p.y());
+    }
+  }
+  ASSERT_GT(shared, 3);
+  cv::Matx33d k1 = cv::Matx33d::eye(), k2 = cv::Matx33d::eye();
+  cv::Vec4d d1, d2;
+  cv::Mat r, t;
+  EXPECT_THROW(cv::fisheye::stereoCalibrate(object, left, right, k1, d1, k2, d2,
+                                            cv::Size(640, 480), r, t),
+               cv::Exception);
+
+  const RigCalibrationResult result = CalibrateOrDie(inputs);
+  ExpectMatchesTruth(scene, result);
+}
+
+TEST(RigCalibrationTest, SameRAndTAsOpenCvStereoCalibrate) {
+  // Both cameras see the whole board in every frame: far, nearly head on.
+  RigSceneSpec scene = StereoPinholeRig();
+  scene.random_frames.count = 30;
+  scene.random_frames.min_distance_m = 1.1;
+  scene.random_frames.max_distance_m = 1.4;
+  scene.random_frames.max_off_axis_deg = 8;
+  scene.random_frames.max_roll_deg = 20;
+  scene.min_visible_corners = scene.board.NumCorners();
+  std::vector<RigCameraInput> all = RigCorrespondences(scene, kNoisePx, 11);
+  std::vector<RigCameraInput> inputs = all;
+  for (RigCameraInput& input : inputs) input.frames.clear();
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> image[2];
+  for (size_t f = 0; f < all[0].frames.size(); ++f) {
+    if (all[0].frames[f].board_points.empty() ||
+        all[1].frames[f].board_points.empty()) {
+      continue;
+    }
+    ASSERT_EQ(all[0].frames[f].board_points, all[1].frames[f].board_points);
+    object.emplace_back();
+    for (const Eigen::Vector3d& p : all[0].frames[f].board_points) {
+      object.back().emplace_back(p.x(), p.y(), p.z());
+    }
+    for (int c = 0; c < 2; ++c) {
+      inputs[c].frames.push_back(all[c].frames[f]);
+      image[c].emplace_back();
+      for (const Eigen::Vector2d& p : all[c].frames[f].image_points) {
+        image[c].back().emplace_back(p.x(), p.y());
+      }
+    }
+  }
+  ASSERT_GE(object.size(), 10u);
+
+  // puzzlecal with OpenCV's objective: plain least squares on every corner.
+  RigCalibrationOptions options;
+  options.camera.loss = RobustLoss::kNone;
+  options.camera.outlier_k = 0;
+  const RigCalibrationResult result = CalibrateOrDie(inputs, options);
+  ASSERT_TRUE(result.covariance_ok);
+
+  const cv::Size size(scene.cameras[0].camera.width,
+                      scene.cameras[0].camera.height);
+  const cv::TermCriteria criteria(
+      cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-14);
+  cv::Mat k[2], d[2];
+  for (int c = 0; c < 2; ++c) {
+    std::vector<cv::Mat> rvecs, tvecs;
+    cv::calibrateCamera(object, image[c], size, k[c], d[c], rvecs, tvecs, 0,
+                        criteria);
+  }
+  cv::Mat r, t, e, fundamental;
+  cv::stereoCalibrate(object, image[0], image[1], k[0], d[0], k[1], d[1], size,
+                      r, t, e, fundamental, cv::CALIB_USE_INTRINSIC_GUESS,
+                      criteria);
+  Eigen::Matrix3d r_cv;
+  Eigen::Vector3d t_cv;
+  cv::cv2eigen(r, r_cv);
+  cv::cv2eigen(t, t_cv);
+
+  const RigCameraResult& second = result.cameras[1];
+  const double rotation_difference =
+      RotationDifferenceDeg(second.cam_from_rig.linear(), r_cv);
+  EXPECT_LT(rotation_difference, second.rotation_stddev_deg)
+      << "sigma " << second.rotation_stddev_deg << " deg";
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_LT(std::abs(second.cam_from_rig.translation()(a) - t_cv(a)),
+              second.translation_stddev_m(a))
+        << "axis " << a << ": " << second.cam_from_rig.translation()(a)
+        << " vs " << t_cv(a);
+  }
+  std::cout << "rotation difference to OpenCV " << rotation_difference
+            << " deg (sigma " << second.rotation_stddev_deg
+            << "), translation difference "
+            << (second.cam_from_rig.translation() - t_cv).norm() * 1000
+            << " mm (sigma of the baseline " << second.baseline_stddev_m * 1000
+            << " mm)\n";
+}
+
+TEST(RigCalibrationTest, CameraThatNeverSharesAFrameIsNamed) {
+  const RigSceneSpec scene = StereoPinholeRig();
+  std::vector<RigCameraInput> inputs = RigCorrespondences(scene, kNoisePx, 12);
+  inputs[1].name = "right_camera";
+  // Odd frames only for the first camera, even ones only for the second.
+  for (size_t f = 0; f < inputs[0].frames.size(); ++f) {
+    inputs[f % 2].frames[f] = CalibrationView{};
+  }
+  RigCalibrationResult result;
+  std::string error;
+  EXPECT_FALSE(CalibrateRig(inputs, RigCalibrationOptions(), &result, &error));
+  EXPECT_NE(error.find("'right_camera'"), std::string::npos) << error;
+  EXPECT_NE(error.find("shares no frame"), std::string::npos) << error;
+}
+
+TEST(RigCalibrationTest, MismatchedFrameCountsAreRefused) {
+  std::vector<RigCameraInput> inputs =
+      RigCorrespondences(StereoPinholeRig(), kNoisePx, 13);
+  inputs[1].frames.pop_back();
+  RigCalibrationResult result;
+  std::string error;
+  EXPECT_FALSE(CalibrateRig(inputs, RigCalibrationOptions(), &result, &error));
+  EXPECT_NE(error.find("'cam1'"), std::string::npos) << error;
+}
+
+TEST(RigCalibrationTest, SameResultWhateverTheThreadCount) {
+  const std::vector<RigCameraInput> inputs =
+      RigCorrespondences(FisheyePinholeRig(), kNoisePx, 14);
+  RigCalibrationOptions one, two;
+  one.camera.num_threads = 1;
+  two.camera.num_threads = 2;
+  const RigCalibrationResult a = CalibrateOrDie(inputs, one);
+  const RigCalibrationResult b = CalibrateOrDie(inputs, two);
+  for (size_t c = 0; c < a.cameras.size(); ++c) {
+    EXPECT_EQ(a.cameras[c].camera.params, b.cameras[c].camera.params);
+    EXPECT_EQ(a.cameras[c].param_stddev, b.cameras[c].param_stddev);
+    EXPECT_TRUE(a.cameras[c].cam_from_rig.matrix() ==
+                b.cameras[c].cam_from_rig.matrix());
+  }
+}
+
+TEST(RigCalibrationTest, OptionsCheckNamesTheField) {
+  RigCalibrationOptions options;
+  std::string why;
+  EXPECT_TRUE(options.Check(&why));
+  options.min_shared_frames = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("min_shared_frames"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace puzzlecal
