@@ -223,9 +223,14 @@ int RunCalibrate() {
               << calibration_error << "\n";
     return kExitNoResult;
   }
-  if (!WriteCameraFile(FLAGS_out, format, result, &error)) {
+  std::string format_note;
+  if (!WriteCameraFile(FLAGS_out, format, result, &error,
+                       MeasureCalibrationRange(views, result), &format_note)) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitOutputError;
+  }
+  if (!format_note.empty()) {
+    std::cout << "note: " << FLAGS_out << ": " << format_note << "\n";
   }
 
   const double seconds_total = SecondsSince(run_start);

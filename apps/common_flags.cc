@@ -4,8 +4,8 @@ DEFINE_string(images, "", "Folder of images, or one image file.");
 DEFINE_string(board, "", "Board definition YAML (see configs/boards/).");
 DEFINE_string(out, "", "Output file or folder.");
 DEFINE_string(model, "pinhole-radtan",
-              "Camera model: pinhole-radtan, pinhole-rational or "
-              "kannala-brandt.");
+              "Camera model: pinhole-radtan, pinhole-rational, "
+              "kannala-brandt or kannala-brandt-noncentral.");
 DEFINE_string(format, "puzzlecal",
               "Camera file format: puzzlecal, opencv, ros or kalibr.");
 DEFINE_string(report, "", "Folder for the calibration report (optional).");

@@ -567,12 +567,13 @@ double FarFieldErrorPx(const Camera& camera, double distance_m,
     if (!camera.Project(point, &seen) || !far.Project(point, &seen)) return;
     worst = std::max(worst, (seen - pixel).norm());
   };
-  constexpr int kStep = 4;
+  constexpr int kStep = 8;
   for (int y = 0; y < camera.height; y += kStep) {
     for (int x = 0; x < camera.width; x += kStep) visit(x, y);
     visit(camera.width - 1, y);
   }
   for (int x = 0; x < camera.width; x += kStep) visit(x, camera.height - 1);
+  visit(camera.width - 1, camera.height - 1);
   return worst;
 }
 
@@ -611,6 +612,11 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
                   "; for points %.3g m away it is off by up to %.2f px",
                   omission.distance_m, omission.max_error_px);
     note += buffer;
+    if (omission.distance_m < 1.0) {
+      std::snprintf(buffer, sizeof(buffer), ", %.2f px at 1 m",
+                    FarFieldErrorPx(camera, 1.0, omission.max_field_angle_deg));
+      note += buffer;
+    }
     if (omission.max_field_angle_deg > 0) {
       std::snprintf(buffer, sizeof(buffer), " (field angles up to %.0f deg)",
                     omission.max_field_angle_deg);

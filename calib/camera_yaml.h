@@ -78,7 +78,7 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
                                               const CameraFileStats& stats);
 // The largest pixel distance between `camera` and FarFieldCamera(camera) for
 // points at `distance_m` (> 0) along the rays of the image pixels (sampled
-// every 4 pixels and along the border) up to `max_field_angle_deg` (0: no
+// every 8 pixels and along the border) up to `max_field_angle_deg` (0: no
 // limit). 0 for central cameras.
 double FarFieldErrorPx(const Camera& camera, double distance_m,
                        double max_field_angle_deg);

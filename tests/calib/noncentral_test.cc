@@ -59,7 +59,7 @@ double BisectTheta(const double* params, double r, double z) {
   return 0.5 * (lo + hi);
 }
 
-TEST(NoncentralTest, FixedNewtonCountConvergesFromThreeCentimetresTo110Degrees) {
+TEST(NoncentralTest, FixedNewtonCountConvergesCloseUpTo110Degrees) {
   // Twice the measured pupil shift, so the count has margin.
   std::vector<double> params = kParams;
   params[8] *= 2;
@@ -79,6 +79,18 @@ TEST(NoncentralTest, FixedNewtonCountConvergesFromThreeCentimetresTo110Degrees) 
     }
   }
   EXPECT_LT(worst, 1e-13);
+  // The measured shift from 2 cm (the deltille photos' closest corners are
+  // 2.4 cm away).
+  for (double deg = 1; deg <= 110; deg += 1) {
+    const double r = 0.02 * std::sin(deg * kDegree);
+    const double z = 0.02 * std::cos(deg * kDegree);
+    double residual, slope;
+    const double theta =
+        Model::SolveTheta(kParams.data(), r, z, &residual, &slope);
+    ASSERT_GT(slope, 0) << deg << " deg";
+    EXPECT_LT(residual, 1e-13) << deg << " deg";
+    EXPECT_LT(std::abs(theta - BisectTheta(kParams.data(), r, z)), 1e-13);
+  }
 }
 
 // Project then UnprojectRay: the point lies on the returned ray (its
