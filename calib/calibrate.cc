@@ -702,10 +702,12 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
 // A non-central model without initial_params starts from the central
 // calibration of its far-field model (kannala-brandt for
 // kannala-brandt-noncentral) with the pupil shift at 0: `options` gets
-// initial_params from it. Unchanged for central models.
+// initial_params from it, and `method` says so. Unchanged (and `method`
+// empty) for central models and given initial_params.
 bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
                             CameraModelId model, int width, int height,
-                            CalibrationOptions* options, std::string* error) {
+                            CalibrationOptions* options, std::string* method,
+                            std::string* error) {
   if (CameraModelIsCentral(model) || !options->initial_params.empty()) {
     return true;
   }
@@ -733,6 +735,9 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
   }
   options->initial_params = result.camera.params;
   options->initial_params.resize(CameraModelNumParams(model), 0.0);
+  *method = std::string("the central ") + CameraModelName(far.model) +
+            " calibration (RMS " + Format("%.3f", result.rms_px) +
+            " px), pupil shift 0";
   return true;
 }
 
@@ -842,13 +847,25 @@ bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
                 error);
   }
   CalibrationOptions start = options;
-  if (!StartFromFarFieldModel(views, model, width, height, &start, error)) {
+  std::string start_method;
+  if (!StartFromFarFieldModel(views, model, width, height, &start,
+                              &start_method, error)) {
     return false;
   }
-  return DispatchCameraModel(model, [&](auto model_struct) {
+  const bool ok = DispatchCameraModel(model, [&](auto model_struct) {
     return CalibrateModel<decltype(model_struct)>(views, width, height, start,
                                                   result, error);
   });
+  if (!start_method.empty()) {
+    const std::string line = "initialisation: " + result->initialization_method;
+    const size_t at = result->report.find(line);
+    if (at != std::string::npos) {
+      result->report.replace(at, line.size(),
+                             "initialisation: " + start_method);
+    }
+    result->initialization_method = start_method;
+  }
+  return ok;
 }
 
 }  // namespace puzzlecal

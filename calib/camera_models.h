@@ -295,8 +295,8 @@ struct KannalaBrandtNoncentralModel {
   template <typename T>
   static T PupilZSlope(const T* params, const T& theta) {
     const T t2 = theta * theta;
-    return theta * (T(2) * params[kPupilBegin] +
-                    T(4) * params[kPupilBegin + 1] * t2);
+    return theta *
+           (T(2) * params[kPupilBegin] + T(4) * params[kPupilBegin + 1] * t2);
   }
 
   // The angle theta of the ray that passes through a point at distance r > 0
@@ -358,9 +358,8 @@ struct KannalaBrandtNoncentralModel {
                                    double* direction) {
     return KannalaBrandtModel::Unproject(params, pixel, direction);
   }
-  static UnprojectStatus UnprojectRay(const double* params,
-                                      const double* pixel, double* origin,
-                                      double* direction) {
+  static UnprojectStatus UnprojectRay(const double* params, const double* pixel,
+                                      double* origin, double* direction) {
     const UnprojectStatus status = Unproject(params, pixel, direction);
     const double theta =
         std::atan2(std::hypot(direction[0], direction[1]), direction[2]);

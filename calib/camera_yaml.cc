@@ -415,12 +415,12 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
     if (!r.Model(root["model"], "model", &id)) return false;
     if (CameraModelIsFisheye(id) !=
         (distortion_key == std::string(kOpenCvFisheyeKey))) {
-      return r.Fail(distortion_key,
-                    std::string("model ") + CameraModelName(id) +
-                        (CameraModelIsFisheye(id)
-                             ? " keeps its coefficients under "
-                             : " cannot use ") +
-                        kOpenCvFisheyeKey);
+      return r.Fail(
+          distortion_key,
+          std::string("model ") + CameraModelName(id) +
+              (CameraModelIsFisheye(id) ? " keeps its coefficients under "
+                                        : " cannot use ") +
+              kOpenCvFisheyeKey);
     }
   } else if (distortion_key == std::string(kOpenCvFisheyeKey)) {
     id = CameraModelId::kKannalaBrandt;
@@ -560,7 +560,8 @@ double FarFieldErrorPx(const Camera& camera, double distance_m,
     if (!(std::atan2(d.head<2>().norm(), d.z()) <= max_angle)) return;
     // The point on the ray at distance_m from the camera origin.
     const double b = ray.origin.dot(d);
-    const double disc = b * b - ray.origin.squaredNorm() + distance_m * distance_m;
+    const double disc =
+        b * b - ray.origin.squaredNorm() + distance_m * distance_m;
     if (!(disc >= 0)) return;
     const Eigen::Vector3d point = ray.origin + (-b + std::sqrt(disc)) * d;
     Eigen::Vector2d seen;
@@ -603,8 +604,7 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
                      " format has no " + CameraModelName(camera.model) +
                      " model: it holds the far-field part (" +
                      CameraModelName(far.model) +
-                     ") without the entrance pupil shift " +
-                     omission.left_out;
+                     ") without the entrance pupil shift " + omission.left_out;
   if (omission.distance_m > 0) {
     omission.max_error_px = FarFieldErrorPx(camera, omission.distance_m,
                                             omission.max_field_angle_deg);
@@ -645,7 +645,8 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
     const size_t line_end = body.find('\n');
     if (format == CameraFileFormat::kOpenCv && body.rfind("%YAML", 0) == 0 &&
         line_end != std::string::npos) {
-      *text = body.substr(0, line_end + 1) + comment + body.substr(line_end + 1);
+      *text =
+          body.substr(0, line_end + 1) + comment + body.substr(line_end + 1);
     } else {
       *text = comment + body;
     }
@@ -684,7 +685,8 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
 }
 
 CalibrationRange MeasureCalibrationRange(
-    const std::vector<CalibrationView>& views, const CalibrationResult& result) {
+    const std::vector<CalibrationView>& views,
+    const CalibrationResult& result) {
   CalibrationRange range;
   double closest = std::numeric_limits<double>::infinity();
   double widest = 0;
@@ -695,7 +697,8 @@ CalibrationRange MeasureCalibrationRange(
           !result.inlier[v][i]) {
         continue;
       }
-      const Eigen::Vector3d p = result.cam_from_board[v] * views[v].board_points[i];
+      const Eigen::Vector3d p =
+          result.cam_from_board[v] * views[v].board_points[i];
       if (!p.allFinite()) continue;
       closest = std::min(closest, p.norm());
       widest = std::max(widest, std::atan2(p.head<2>().norm(), p.z()));

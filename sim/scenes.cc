@@ -565,8 +565,8 @@ SceneSpec SampleScene(int width, int height) {
 }
 
 std::vector<std::string> StandardSceneNames() {
-  return {"wide_pinhole", "strong_fisheye",       "tilt_series",
-          "small_tiles",  "fisheye_checkerboard", "dark_fisheye",
+  return {"wide_pinhole",      "strong_fisheye",       "tilt_series",
+          "small_tiles",       "fisheye_checkerboard", "dark_fisheye",
           "noncentral_fisheye"};
 }
 

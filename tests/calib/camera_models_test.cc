@@ -20,9 +20,8 @@ const std::vector<double> kRational = {760.0, 761.2, 637.8, 482.6,
 const std::vector<double> kFisheye = {495.0, 494.2, 801.7,  598.4,
                                       0.02,  -0.005, 0.001, -0.0002};
 // kFisheye with a moving entrance pupil (e1, e2 in metres).
-const std::vector<double> kNoncentral = {495.0, 494.2,  801.7, 598.4,
-                                         0.02,  -0.005, 0.001, -0.0002,
-                                         0.95e-3, 0.31e-3};
+const std::vector<double> kNoncentral = {
+    495.0, 494.2, 801.7, 598.4, 0.02, -0.005, 0.001, -0.0002, 0.95e-3, 0.31e-3};
 
 const std::vector<double>& ParamsFor(CameraModelId id) {
   switch (id) {
@@ -291,12 +290,10 @@ TEST(CameraModelsTest, NameDispatch) {
                "kannala-brandt-noncentral");
   EXPECT_EQ(CameraModelParamNames(CameraModelId::kKannalaBrandtNoncentral)[8],
             "e1");
-  EXPECT_FALSE(
-      CameraModelIsPinhole(CameraModelId::kKannalaBrandtNoncentral));
+  EXPECT_FALSE(CameraModelIsPinhole(CameraModelId::kKannalaBrandtNoncentral));
   EXPECT_TRUE(CameraModelIsFisheye(CameraModelId::kKannalaBrandtNoncentral));
   EXPECT_FALSE(CameraModelIsFisheye(CameraModelId::kPinholeRadtan));
-  EXPECT_FALSE(
-      CameraModelIsCentral(CameraModelId::kKannalaBrandtNoncentral));
+  EXPECT_FALSE(CameraModelIsCentral(CameraModelId::kKannalaBrandtNoncentral));
   for (CameraModelId id :
        {CameraModelId::kPinholeRadtan, CameraModelId::kPinholeRational,
         CameraModelId::kKannalaBrandt}) {

@@ -35,7 +35,7 @@ Camera MakeCamera(CameraModelId id) {
       camera.params = {495.0, 494.2, 801.7, 598.4, 0.02, -0.005, 0.001, -2e-4};
       break;
     case CameraModelId::kKannalaBrandtNoncentral:
-      camera.params = {495.0, 494.2, 801.7, 598.4,  0.02,
+      camera.params = {495.0,  494.2, 801.7, 598.4,   0.02,
                        -0.005, 0.001, -2e-4, 0.95e-3, 0.31e-3};
       break;
   }
@@ -138,8 +138,8 @@ TEST_F(CameraYamlTest, OpenCvFormatIsReadableByFileStorage) {
     const std::string path =
         Path(std::string("opencv_") + CameraModelName(id) + ".yaml");
     std::string error;
-    ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kOpenCv,
-                                MakeCamera(id), CameraFileStats(), &error))
+    ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kOpenCv, MakeCamera(id),
+                                CameraFileStats(), &error))
         << error;
     cv::FileStorage fs(path, cv::FileStorage::READ);
     ASSERT_TRUE(fs.isOpened());
@@ -182,9 +182,10 @@ TEST_F(CameraYamlTest, NoncentralCameraIntoOtherFormatsSaysWhatIsLeftOut) {
   EXPECT_FALSE(
       DescribeCameraFileOmission(camera, CameraFileFormat::kPuzzlecal, stats)
           .lossy);
-  EXPECT_FALSE(DescribeCameraFileOmission(MakeCamera(CameraModelId::kKannalaBrandt),
-                                          CameraFileFormat::kOpenCv, stats)
-                   .lossy);
+  EXPECT_FALSE(
+      DescribeCameraFileOmission(MakeCamera(CameraModelId::kKannalaBrandt),
+                                 CameraFileFormat::kOpenCv, stats)
+          .lossy);
   // The largest difference between the camera and its far-field part for
   // points 10 cm away that the camera images, by a sweep over directions.
   const Camera far = FarFieldCamera(camera);
@@ -205,9 +206,9 @@ TEST_F(CameraYamlTest, NoncentralCameraIntoOtherFormatsSaysWhatIsLeftOut) {
     }
   }
   ASSERT_GT(expected, 1.0);  // a real effect at this distance
-  for (CameraFileFormat format : {CameraFileFormat::kOpenCv,
-                                  CameraFileFormat::kRos,
-                                  CameraFileFormat::kKalibr}) {
+  for (CameraFileFormat format :
+       {CameraFileFormat::kOpenCv, CameraFileFormat::kRos,
+        CameraFileFormat::kKalibr}) {
     SCOPED_TRACE(CameraFileFormatName(format));
     const CameraFileOmission omission =
         DescribeCameraFileOmission(camera, format, stats);

@@ -24,7 +24,7 @@ using Model = KannalaBrandtNoncentralModel;
 constexpr double kDegree = M_PI / 180.0;
 
 // A deltille-like 1600 x 1200 fisheye with the pupil shift measured on it.
-const std::vector<double> kParams = {296.5, 296.1,  801.7,    598.4,  0.021,
+const std::vector<double> kParams = {296.5,  296.1,  801.7,   598.4,   0.021,
                                      -0.006, 0.0012, -0.0002, 0.95e-3, 0.31e-3};
 
 // Points at field angles up to max_angle and distances in [near, far]
@@ -74,8 +74,8 @@ TEST(NoncentralTest, FixedNewtonCountConvergesCloseUpTo110Degrees) {
           Model::SolveTheta(params.data(), r, z, &residual, &slope);
       ASSERT_GT(slope, 0) << distance << " m, " << deg << " deg";
       EXPECT_LT(residual, 1e-13) << distance << " m, " << deg << " deg";
-      worst = std::max(worst,
-                       std::abs(theta - BisectTheta(params.data(), r, z)));
+      worst =
+          std::max(worst, std::abs(theta - BisectTheta(params.data(), r, z)));
     }
   }
   EXPECT_LT(worst, 1e-13);
@@ -150,11 +150,13 @@ TEST(NoncentralTest, EqualsKannalaBrandtWithoutPupilShiftAndInTheFarField) {
   // To first order the pixels differ by fx * theta_d'(theta) * z0(theta) *
   // sin(theta) / distance.
   const double theta = 100 * kDegree, h = 1e-6;
-  const double slope = (KannalaBrandtModel::DistortTheta(kParams.data(), theta + h) -
-                        KannalaBrandtModel::DistortTheta(kParams.data(), theta - h)) /
-                       (2 * h);
-  const double first_order =
-      kParams[0] * slope * Model::PupilZ(kParams.data(), theta) * std::sin(theta);
+  const double slope =
+      (KannalaBrandtModel::DistortTheta(kParams.data(), theta + h) -
+       KannalaBrandtModel::DistortTheta(kParams.data(), theta - h)) /
+      (2 * h);
+  const double first_order = kParams[0] * slope *
+                             Model::PupilZ(kParams.data(), theta) *
+                             std::sin(theta);
   double previous = 0;
   for (double distance : {1e5, 1e3, 10.0, 0.3}) {
     Eigen::Vector2d a, b;
@@ -207,7 +209,8 @@ TEST(NoncentralTest, JetDerivativesMatchFiniteDifferencesCloseUp) {
     for (int k = 0; k < Model::kNumParams; ++k) {
       jet_params[k] = Jet(kParams[k], k);
     }
-    for (int k = 0; k < 3; ++k) jet_point[k] = Jet(point[k], Model::kNumParams + k);
+    for (int k = 0; k < 3; ++k)
+      jet_point[k] = Jet(point[k], Model::kNumParams + k);
     ASSERT_TRUE(Model::Project(jet_params, jet_point, jet_pixel));
     double value[2];
     ASSERT_TRUE(Model::Project(kParams.data(), point.data(), value));
@@ -248,8 +251,8 @@ TEST(NoncentralTest, PointsNoSingleRayReachesDoNotProject) {
   // (twice the pupil shift seen from 2 cm at 66 degrees: h' < 0 there).
   std::vector<double> params = kParams;
   Eigen::Vector2d pixel;
-  EXPECT_FALSE(
-      ProjectPoint(Model::kId, params.data(), Eigen::Vector3d(0, 0, -1), &pixel));
+  EXPECT_FALSE(ProjectPoint(Model::kId, params.data(),
+                            Eigen::Vector3d(0, 0, -1), &pixel));
   params[8] *= 2;
   params[9] *= 2;
   const double angle = 66 * kDegree;

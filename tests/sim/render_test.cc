@@ -457,7 +457,8 @@ TEST(RenderBoardTest, BadInputGivesAnEmptyImageAndAReason) {
 // A non-central lens close up: the rendered corners sit where the rays with
 // their origins put them (the truth), not where the far-field (central) part
 // of the model would, several pixels away at large field angles.
-TEST(RenderBoardTest, NoncentralLensShowsCornersWhereItsRaysWithOriginsPutThem) {
+TEST(RenderBoardTest,
+     NoncentralLensShowsCornersWhereItsRaysWithOriginsPutThem) {
   const SceneSpec scene = NoncentralFisheyeScene(960, 720);
   const Camera far = FarFieldCamera(scene.camera);
   RenderOptions options = scene.render;
@@ -467,9 +468,9 @@ TEST(RenderBoardTest, NoncentralLensShowsCornersWhereItsRaysWithOriginsPutThem) 
   for (const SceneViewSpec& spec : SceneViewSpecs(scene)) {
     RenderTruth truth;
     RenderSummary summary;
-    const cv::Mat image = RenderBoard(scene.board, scene.camera,
-                                      spec.cam_from_board, options, &truth,
-                                      &summary);
+    const cv::Mat image =
+        RenderBoard(scene.board, scene.camera, spec.cam_from_board, options,
+                    &truth, &summary);
     ASSERT_TRUE(summary.ok) << summary.reason;
     for (const TruthCorner& corner : truth.corners) {
       if (!corner.visible) continue;
@@ -488,13 +489,13 @@ TEST(RenderBoardTest, NoncentralLensShowsCornersWhereItsRaysWithOriginsPutThem) 
           corner.xy.y() > image.rows - 10) {
         continue;
       }
-      std::vector<cv::Point2f> refined = {cv::Point2f(
-          static_cast<float>(corner.xy.x() + 0.6),
-          static_cast<float>(corner.xy.y() - 0.4))};
+      std::vector<cv::Point2f> refined = {
+          cv::Point2f(static_cast<float>(corner.xy.x() + 0.6),
+                      static_cast<float>(corner.xy.y() - 0.4))};
       cv::cornerSubPix(
           image, refined, cv::Size(3, 3), cv::Size(-1, -1),
-          cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
-                           50, 1e-4));
+          cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50,
+                           1e-4));
       const Eigen::Vector2d found(refined[0].x, refined[0].y);
       errors.push_back((found - corner.xy).norm());
       ++checked;
