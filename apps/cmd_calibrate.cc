@@ -421,10 +421,17 @@ int RunCalibrate() {
     CameraFileStats stats =
         CameraFileStatsOfResult(result, view_files, board.Point(board.origin));
     stats.verdict = verdict.Line();
+    const CalibrationRange range = MeasureCalibrationRange(views, result);
+    stats.closest_board_distance_m = range.closest_board_distance_m;
+    stats.max_field_angle_deg = range.max_field_angle_deg;
+    std::string format_note;
     if (!WriteCameraFile(FLAGS_out, format, result.camera, stats, &error,
-                         names)) {
+                         &format_note, names)) {
       std::cerr << "puzzlecal calibrate: " << error << "\n";
       return kExitOutputError;
+    }
+    if (!format_note.empty() && verbosity != Verbosity::kQuiet) {
+      std::cout << "note: " << FLAGS_out << ": " << format_note << "\n";
     }
     g_camera_written = 1;
   }

@@ -10,8 +10,8 @@ DEFINE_string(out, "",
               "into an existing, writable folder.");
 DEFINE_string(model, "pinhole-radtan",
               "Camera model: pinhole-radtan, pinhole-rational, "
-              "kannala-brandt, or auto (calibrate: chosen by held-out "
-              "error).");
+              "kannala-brandt, kannala-brandt-noncentral, or auto (calibrate: "
+              "chosen by held-out error).");
 DEFINE_string(format, "puzzlecal",
               "Camera file format: puzzlecal, opencv, ros or kalibr.");
 DEFINE_string(report, "", "Folder for the calibration report (optional).");

@@ -20,7 +20,13 @@
 // corners, wrong labels, off-board corners in those components, and the
 // visible corners the detector missed; then a summary.
 //
-// Usage: bench_deltille [data_dir] [threads] [-v] [--draw DIR]
+// With --models only the model comparison: kannala-brandt and
+// kannala-brandt-noncentral on the decoded views, each with the default
+// outlier rejection and with rejection off (RMS, rejected fraction, views
+// used, parameters with standard deviations, and for the non-central model
+// how far its far-field part is off at the closest board distance).
+//
+// Usage: bench_deltille [data_dir] [threads] [-v] [--draw DIR] [--models]
 //                       [grid_option=value ...]
 //   -v: per photo the grid's counters, unlabelled board corners and split
 //   board edges on stderr; --draw: an overlay per photo into DIR.
@@ -42,6 +48,7 @@
 
 #include "apps/pipeline.h"
 #include "calib/calibrate.h"
+#include "calib/camera_yaml.h"
 #include "calib/initialization.h"
 #include "tests/grid/grid_test_util.h"
 #include "tests/support/deltille_data.h"
@@ -467,6 +474,67 @@ bool SetGridOption(const std::string& arg, GridOptions* o) {
   return true;
 }
 
+// One calibration of the comparison: model, outlier policy, figures.
+void PrintModelCalibration(const std::vector<CalibrationView>& views,
+                           CameraModelId model, bool rejection, int width,
+                           int height, bool last) {
+  CalibrationOptions options;
+  if (!rejection) options.outlier_k = 0;
+  CalibrationResult result;
+  std::string error;
+  const bool ok =
+      Calibrate(views, model, width, height, options, &result, &error);
+  int corners = 0;
+  for (const CalibrationView& view : views) {
+    corners += static_cast<int>(view.board_points.size());
+  }
+  std::printf("    {\"model\": \"%s\", \"outlier_rejection\": %s, \"ok\": %s",
+              CameraModelName(model), rejection ? "true" : "false",
+              ok ? "true" : "false");
+  if (!ok) {
+    std::printf(", \"error\": \"%s\"}%s\n", error.c_str(), last ? "" : ",");
+    return;
+  }
+  const std::vector<std::string> names = CameraModelParamNames(model);
+  const CalibrationRange range = MeasureCalibrationRange(views, result);
+  std::printf(
+      ", \"rms_px\": %.4f, \"rms_point_px\": %.4f, \"views_used\": %d, "
+      "\"views\": %zu, \"corners\": %d, \"rejected\": %d, "
+      "\"rejected_fraction\": %.4f, \"closest_board_m\": %.4f, "
+      "\"max_field_angle_deg\": %.1f",
+      result.rms_px, result.rms_point_px, result.num_views_used, views.size(),
+      corners, result.num_outliers,
+      corners > 0 ? static_cast<double>(result.num_outliers) / corners : 0.0,
+      range.closest_board_distance_m, range.max_field_angle_deg);
+  for (size_t k = 0; k < names.size(); ++k) {
+    std::printf(", \"%s\": %.6g, \"%s_stddev\": %.3g", names[k].c_str(),
+                result.camera.params[k], names[k].c_str(),
+                result.param_stddev[k]);
+  }
+  if (!CameraModelIsCentral(model)) {
+    std::printf(", \"far_field_error_px_at_closest\": %.3f",
+                FarFieldErrorPx(result.camera, range.closest_board_distance_m,
+                                range.max_field_angle_deg));
+  }
+  std::printf("}%s\n", last ? "" : ",");
+}
+
+// Central and non-central fisheye, with the current outlier policy and
+// with rejection off.
+void PrintModelComparison(const std::vector<CalibrationView>& views, int width,
+                          int height) {
+  std::printf("  \"models\": [\n");
+  const CameraModelId models[] = {CameraModelId::kKannalaBrandt,
+                                  CameraModelId::kKannalaBrandtNoncentral};
+  for (int m = 0; m < 2; ++m) {
+    for (int r = 0; r < 2; ++r) {
+      PrintModelCalibration(views, models[m], r == 0, width, height,
+                            m == 1 && r == 1);
+    }
+  }
+  std::printf("  ],\n");
+}
+
 }  // namespace
 }  // namespace puzzlecal
 
@@ -479,10 +547,13 @@ int main(int argc, char** argv) {
   GridOptions grid_options;
   int positional = 0;
   std::string draw_dir;
+  bool models_only = false;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--draw" && a + 1 < argc) {
       draw_dir = argv[++a];
+    } else if (arg == "--models") {
+      models_only = true;
     } else if (arg == "-v") {
       verbose = true;
     } else if (arg.find('=') != std::string::npos) {
@@ -521,6 +592,13 @@ int main(int argc, char** argv) {
   int width = 0, height = 0;
   const std::vector<CalibrationView> views =
       MakeCalibrationViews(board, &results, &view_of_image, &width, &height);
+  if (models_only) {
+    std::printf("{\n  \"benchmark\": \"deltille_fisheye_models\",\n");
+    PrintModelComparison(views, width, height);
+    std::printf("  \"photos\": %zu, \"views\": %zu\n}\n", files.size(),
+                views.size());
+    return 0;
+  }
   CalibrationOptions calib_options;
   CalibrationResult calibration;
   std::string error;

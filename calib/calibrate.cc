@@ -699,6 +699,48 @@ bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
   return true;
 }
 
+// A non-central model without initial_params starts from the central
+// calibration of its far-field model (kannala-brandt for
+// kannala-brandt-noncentral) with the pupil shift at 0: `options` gets
+// initial_params from it, and `method` says so. Unchanged (and `method`
+// empty) for central models and given initial_params.
+bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
+                            CameraModelId model, int width, int height,
+                            CalibrationOptions* options, std::string* method,
+                            std::string* error) {
+  if (CameraModelIsCentral(model) || !options->initial_params.empty()) {
+    return true;
+  }
+  Camera far;
+  far.model = model;
+  far.params.assign(CameraModelNumParams(model), 0.0);
+  far = FarFieldCamera(far);
+  const std::vector<std::string> far_names = CameraModelParamNames(far.model);
+  CalibrationOptions central = *options;
+  central.compute_covariance = false;
+  central.fixed_params.clear();
+  for (const std::string& name : options->fixed_params) {
+    if (std::find(far_names.begin(), far_names.end(), name) !=
+        far_names.end()) {
+      central.fixed_params.push_back(name);
+    }
+  }
+  CalibrationResult result;
+  std::string why;
+  if (!Calibrate(views, far.model, width, height, central, &result, &why)) {
+    return Fail(std::string("the central ") + CameraModelName(far.model) +
+                    " calibration that starts " + CameraModelName(model) +
+                    " failed: " + why,
+                error);
+  }
+  options->initial_params = result.camera.params;
+  options->initial_params.resize(CameraModelNumParams(model), 0.0);
+  *method = std::string("the central ") + CameraModelName(far.model) +
+            " calibration (RMS " + Format("%.3f", result.rms_px) +
+            " px), pupil shift 0";
+  return true;
+}
+
 }  // namespace
 
 const char* RobustLossName(RobustLoss loss) {
@@ -804,10 +846,26 @@ bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
                     std::to_string(names.size()),
                 error);
   }
-  return DispatchCameraModel(model, [&](auto model_struct) {
-    return CalibrateModel<decltype(model_struct)>(views, width, height, options,
+  CalibrationOptions start = options;
+  std::string start_method;
+  if (!StartFromFarFieldModel(views, model, width, height, &start,
+                              &start_method, error)) {
+    return false;
+  }
+  const bool ok = DispatchCameraModel(model, [&](auto model_struct) {
+    return CalibrateModel<decltype(model_struct)>(views, width, height, start,
                                                   result, error);
   });
+  if (!start_method.empty()) {
+    const std::string line = "initialisation: " + result->initialization_method;
+    const size_t at = result->report.find(line);
+    if (at != std::string::npos) {
+      result->report.replace(at, line.size(),
+                             "initialisation: " + start_method);
+    }
+    result->initialization_method = start_method;
+  }
+  return ok;
 }
 
 }  // namespace puzzlecal

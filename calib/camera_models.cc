@@ -42,6 +42,25 @@ bool CameraModelIsPinhole(CameraModelId id) {
          id == CameraModelId::kPinholeRational;
 }
 
+bool CameraModelIsFisheye(CameraModelId id) {
+  return id == CameraModelId::kKannalaBrandt ||
+         id == CameraModelId::kKannalaBrandtNoncentral;
+}
+
+bool CameraModelIsCentral(CameraModelId id) {
+  return DispatchCameraModel(
+      id, [](auto model) { return decltype(model)::kCentral; });
+}
+
+Camera FarFieldCamera(const Camera& camera) {
+  Camera far = camera;
+  if (camera.model == CameraModelId::kKannalaBrandtNoncentral) {
+    far.model = CameraModelId::kKannalaBrandt;
+    far.params.resize(std::min<size_t>(far.params.size(), kPupilBegin));
+  }
+  return far;
+}
+
 bool ProjectPoint(CameraModelId id, const double* params,
                   const Eigen::Vector3d& point_cam, Eigen::Vector2d* pixel) {
   return DispatchCameraModel(id, [&](auto model) {
@@ -54,6 +73,21 @@ UnprojectStatus UnprojectPixel(CameraModelId id, const double* params,
                                Eigen::Vector3d* ray) {
   return DispatchCameraModel(id, [&](auto model) {
     return decltype(model)::Unproject(params, pixel.data(), ray->data());
+  });
+}
+
+UnprojectStatus UnprojectPixelToRay(CameraModelId id, const double* params,
+                                    const Eigen::Vector2d& pixel,
+                                    ViewingRay* ray) {
+  return DispatchCameraModel(id, [&](auto model) {
+    using Model = decltype(model);
+    if constexpr (Model::kCentral) {
+      ray->origin.setZero();
+      return Model::Unproject(params, pixel.data(), ray->direction.data());
+    } else {
+      return Model::UnprojectRay(params, pixel.data(), ray->origin.data(),
+                                 ray->direction.data());
+    }
   });
 }
 

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "util/atomic_file.h"
@@ -27,6 +29,7 @@ const char* RosDistortionModel(CameraModelId id) {
     case CameraModelId::kPinholeRational:
       return "rational_polynomial";
     case CameraModelId::kKannalaBrandt:
+    case CameraModelId::kKannalaBrandtNoncentral:  // its far-field part
       return "equidistant";
   }
   return "plumb_bob";
@@ -152,7 +155,7 @@ std::string FormatOpenCv(const Camera& camera) {
   // A fisheye's k1..k4 under OpenCV's usual key would be read as pinhole
   // k1 k2 p1 p2 by cv::undistort and friends; its own key (the D of
   // cv::fisheye) makes pinhole readers fail loudly instead.
-  const bool fisheye = camera.model == CameraModelId::kKannalaBrandt;
+  const bool fisheye = CameraModelIsFisheye(camera.model);
   if (fisheye) {
     out << YAML::Key << "distortion_model" << YAML::Value << "fisheye";
   }
@@ -220,6 +223,7 @@ bool FormatKalibr(const Camera& camera, const std::string& rostopic,
       coeffs = {p[4], p[5], p[6], p[7]};
       break;
     case CameraModelId::kKannalaBrandt:
+    case CameraModelId::kKannalaBrandtNoncentral:  // its far-field part
       model = "equidistant";
       coeffs = {p[4], p[5], p[6], p[7]};
       break;
@@ -492,14 +496,14 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
     }
   } else if (root["model"]) {
     if (!r.Model(root["model"], "model", &id)) return false;
-    if ((id == CameraModelId::kKannalaBrandt) !=
+    if (CameraModelIsFisheye(id) !=
         (distortion_key == std::string(kOpenCvFisheyeKey))) {
-      return r.Fail(distortion_key,
-                    std::string("model ") + CameraModelName(id) +
-                        (id == CameraModelId::kKannalaBrandt
-                             ? " keeps its coefficients under "
-                             : " cannot use ") +
-                        kOpenCvFisheyeKey);
+      return r.Fail(
+          distortion_key,
+          std::string("model ") + CameraModelName(id) +
+              (CameraModelIsFisheye(id) ? " keeps its coefficients under "
+                                        : " cannot use ") +
+              kOpenCvFisheyeKey);
     }
   } else if (distortion_key == std::string(kOpenCvFisheyeKey)) {
     id = CameraModelId::kKannalaBrandt;
@@ -632,7 +636,12 @@ bool CameraFormatFixedParams(CameraFileFormat format, CameraModelId model,
     fixed->push_back("k3");  // Kalibr's radtan: k1 k2 p1 p2
     return true;
   }
-  if (model == CameraModelId::kKannalaBrandt) return true;  // equidistant
+  // equidistant; a non-central camera is written as its far-field part
+  // (see DescribeCameraFileOmission).
+  if (model == CameraModelId::kKannalaBrandt ||
+      model == CameraModelId::kKannalaBrandtNoncentral) {
+    return true;
+  }
   return Fail(std::string("the kalibr format cannot hold a ") +
                   CameraModelName(model) +
                   " camera (its camchain has pinhole-radtan with k3 = 0 and "
@@ -641,10 +650,114 @@ bool CameraFormatFixedParams(CameraFileFormat format, CameraModelId model,
               error);
 }
 
+double FarFieldErrorPx(const Camera& camera, double distance_m,
+                       double max_field_angle_deg) {
+  if (CameraModelIsCentral(camera.model) || !(distance_m > 0)) return 0;
+  const Camera far = FarFieldCamera(camera);
+  const double max_angle = max_field_angle_deg > 0
+                               ? max_field_angle_deg * M_PI / 180.0
+                               : std::numeric_limits<double>::infinity();
+  double worst = 0;
+  auto visit = [&](double x, double y) {
+    const Eigen::Vector2d pixel(x, y);
+    ViewingRay ray;
+    if (!camera.UnprojectRay(pixel, &ray).converged) return;
+    const Eigen::Vector3d& d = ray.direction;
+    if (!(std::atan2(d.head<2>().norm(), d.z()) <= max_angle)) return;
+    // The point on the ray at distance_m from the camera origin.
+    const double b = ray.origin.dot(d);
+    const double disc =
+        b * b - ray.origin.squaredNorm() + distance_m * distance_m;
+    if (!(disc >= 0)) return;
+    const Eigen::Vector3d point = ray.origin + (-b + std::sqrt(disc)) * d;
+    Eigen::Vector2d seen;
+    if (!camera.Project(point, &seen) || !far.Project(point, &seen)) return;
+    worst = std::max(worst, (seen - pixel).norm());
+  };
+  constexpr int kStep = 8;
+  for (int y = 0; y < camera.height; y += kStep) {
+    for (int x = 0; x < camera.width; x += kStep) visit(x, y);
+    visit(camera.width - 1, y);
+  }
+  for (int x = 0; x < camera.width; x += kStep) visit(x, camera.height - 1);
+  visit(camera.width - 1, camera.height - 1);
+  return worst;
+}
+
+CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
+                                              CameraFileFormat format,
+                                              const CameraFileStats& stats) {
+  CameraFileOmission omission;
+  if (format == CameraFileFormat::kPuzzlecal ||
+      CameraModelIsCentral(camera.model) ||
+      static_cast<int>(camera.params.size()) !=
+          CameraModelNumParams(camera.model)) {
+    return omission;
+  }
+  omission.lossy = true;
+  const Camera far = FarFieldCamera(camera);
+  const std::vector<std::string> names = CameraModelParamNames(camera.model);
+  char buffer[96];
+  for (size_t k = far.params.size(); k < names.size(); ++k) {
+    std::snprintf(buffer, sizeof(buffer), "%s%s = %.6g m",
+                  omission.left_out.empty() ? "" : ", ", names[k].c_str(),
+                  camera.params[k]);
+    omission.left_out += buffer;
+  }
+  omission.distance_m = stats.closest_board_distance_m;
+  omission.max_field_angle_deg = stats.max_field_angle_deg;
+  std::string note = std::string("the ") + CameraFileFormatName(format) +
+                     " format has no " + CameraModelName(camera.model) +
+                     " model: it holds the far-field part (" +
+                     CameraModelName(far.model) +
+                     ") without the entrance pupil shift " + omission.left_out;
+  if (omission.distance_m > 0) {
+    omission.max_error_px = FarFieldErrorPx(camera, omission.distance_m,
+                                            omission.max_field_angle_deg);
+    std::snprintf(buffer, sizeof(buffer),
+                  "; for points %.3g m away it is off by up to %.2f px",
+                  omission.distance_m, omission.max_error_px);
+    note += buffer;
+    if (omission.distance_m < 1.0) {
+      std::snprintf(buffer, sizeof(buffer), ", %.2f px at 1 m",
+                    FarFieldErrorPx(camera, 1.0, omission.max_field_angle_deg));
+      note += buffer;
+    }
+    if (omission.max_field_angle_deg > 0) {
+      std::snprintf(buffer, sizeof(buffer), " (field angles up to %.0f deg)",
+                    omission.max_field_angle_deg);
+      note += buffer;
+    }
+  }
+  omission.note = note;
+  return omission;
+}
+
 bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
                       CameraFileFormat format, std::string* text,
                       std::string* error, const CameraFileNames& names) {
   if (!CheckCamera(camera, error)) return false;
+  const CameraFileOmission omission =
+      DescribeCameraFileOmission(camera, format, stats);
+  if (omission.lossy) {
+    // The far-field part in the format, and a comment that says what is
+    // missing (after OpenCV's "%YAML:1.0" line, which must come first).
+    std::string body;
+    if (!FormatCameraFile(FarFieldCamera(camera), stats, format, &body,
+                          error, names)) {
+      return false;
+    }
+    const std::string comment = "# " + omission.note + "\n";
+    const size_t line_end = body.find('\n');
+    if (format == CameraFileFormat::kOpenCv && body.rfind("%YAML", 0) == 0 &&
+        line_end != std::string::npos) {
+      *text =
+          body.substr(0, line_end + 1) + comment + body.substr(line_end + 1);
+    } else {
+      *text = comment + body;
+    }
+    return true;
+  }
   switch (format) {
     case CameraFileFormat::kPuzzlecal:
       *text = FormatPuzzlecal(camera, stats);
@@ -663,14 +776,46 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
 
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      const Camera& camera, const CameraFileStats& stats,
-                     std::string* error, const CameraFileNames& names) {
+                     std::string* error, std::string* note,
+                     const CameraFileNames& names) {
   std::string text, why;
   if (!FormatCameraFile(camera, stats, format, &text, &why, names)) {
     return Fail("cannot write '" + path + "' (" + CameraFileFormatName(format) +
                     " format): " + why,
                 error);
   }
-  return WriteFileAtomically(path, text, error);
+  if (!WriteFileAtomically(path, text, error)) return false;
+  if (note != nullptr) {
+    *note = DescribeCameraFileOmission(camera, format, stats).note;
+  }
+  return true;
+}
+
+CalibrationRange MeasureCalibrationRange(
+    const std::vector<CalibrationView>& views,
+    const CalibrationResult& result) {
+  CalibrationRange range;
+  double closest = std::numeric_limits<double>::infinity();
+  double widest = 0;
+  for (size_t v = 0; v < views.size() && v < result.view_used.size(); ++v) {
+    if (!result.view_used[v] || v >= result.cam_from_board.size()) continue;
+    for (size_t i = 0; i < views[v].board_points.size(); ++i) {
+      if (v < result.inlier.size() && i < result.inlier[v].size() &&
+          !result.inlier[v][i]) {
+        continue;
+      }
+      const Eigen::Vector3d p =
+          result.cam_from_board[v] * views[v].board_points[i];
+      if (!p.allFinite()) continue;
+      closest = std::min(closest, p.norm());
+      widest = std::max(widest, std::atan2(p.head<2>().norm(), p.z()));
+    }
+  }
+  if (std::isfinite(closest)) {
+    range.closest_board_distance_m = closest;
+    range.max_field_angle_deg = widest * 180.0 / M_PI;
+  }
+  return range;
 }
 
 CameraFileStats CameraFileStatsOfResult(
@@ -703,6 +848,7 @@ CameraFileStats CameraFileStatsOfResult(
 
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      const CalibrationResult& result, std::string* error,
+                     const CalibrationRange& range, std::string* note,
                      const CameraFileNames& names) {
   CameraFileStats stats;
   stats.has_stats = true;
@@ -711,7 +857,10 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
   stats.num_views_used = result.num_views_used;
   stats.num_corners_used = result.num_corners_used;
   stats.num_outliers = result.num_outliers;
-  return WriteCameraFile(path, format, result.camera, stats, error, names);
+  stats.closest_board_distance_m = range.closest_board_distance_m;
+  stats.max_field_angle_deg = range.max_field_angle_deg;
+  return WriteCameraFile(path, format, result.camera, stats, error, note,
+                         names);
 }
 
 bool ParseCameraFile(const std::string& text, const std::string& source,

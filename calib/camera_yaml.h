@@ -8,8 +8,11 @@
 //   distortion_coefficients as !!opencv-matrix, image size, model);
 // - ros: camera_info (plumb_bob / rational_polynomial / equidistant);
 // - kalibr: a camchain with cam0 (pinhole + radtan / equidistant).
-// Writes are atomic (calib/atomic_file.h) and refuse to lose information
-// (for example k3 != 0 into Kalibr's radtan). Reading recognises all four
+// Writes are atomic (util/atomic_file.h) and refuse to lose information
+// (for example k3 != 0 into Kalibr's radtan), except for a non-central
+// camera: opencv, ros and kalibr get its far-field part, with a comment in
+// the file and a note for the user on what was left out and what it costs
+// (DescribeCameraFileOmission). Reading recognises all four
 // formats; messages name the file and the field.
 
 #include <Eigen/Geometry>
@@ -51,6 +54,12 @@ struct CameraFileStats {
   std::vector<CameraFileView> views;  // the views used, in input order
   // The calibration's verdict line (calib/verdict.h); "" writes none.
   std::string verdict;
+  // Where the calibration's board corners were (see MeasureCalibrationRange):
+  // the error figure of a format that leaves part of the camera out is
+  // given for points this near, up to this field angle. 0: unknown (then
+  // no figure, resp. the whole image).
+  double closest_board_distance_m = 0;
+  double max_field_angle_deg = 0;
 };
 
 // The statistics of `result` with its used views; `view_files[v]` names view
@@ -60,6 +69,42 @@ struct CameraFileStats {
 CameraFileStats CameraFileStatsOfResult(
     const CalibrationResult& result, const std::vector<std::string>& view_files,
     const Eigen::Vector3d& first_corner_m);
+
+// The nearest board corner (distance from the camera origin, metres) and the
+// largest field angle (degrees from the optical axis) over the inlier
+// corners of the views a calibration used.
+struct CalibrationRange {
+  double closest_board_distance_m = 0;
+  double max_field_angle_deg = 0;
+};
+CalibrationRange MeasureCalibrationRange(
+    const std::vector<CalibrationView>& views, const CalibrationResult& result);
+
+// What a format leaves out of a camera. opencv, ros and kalibr have no
+// non-central model: they get the far-field part of kannala-brandt-noncentral
+// (kannala-brandt with the same k1..k4, FarFieldCamera) without the pupil
+// shift e1 e2, and the file says so in a comment.
+struct CameraFileOmission {
+  bool lossy = false;     // false: the file holds the camera exactly
+  std::string left_out;   // e.g. "e1 = 0.00095 m, e2 = 0.00031 m"
+  double distance_m = 0;  // the distance max_error_px is for (0: unknown)
+  // Largest pixel distance between the camera's and the file's projection
+  // of points at distance_m from the camera origin, over the image pixels
+  // up to max_field_angle_deg from the axis (0: all the model can image).
+  double max_error_px = 0;
+  double max_field_angle_deg = 0;
+  std::string note;  // one line for the user; empty when !lossy
+};
+// `stats` supplies closest_board_distance_m and max_field_angle_deg.
+CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
+                                              CameraFileFormat format,
+                                              const CameraFileStats& stats);
+// The largest pixel distance between `camera` and FarFieldCamera(camera) for
+// points at `distance_m` (> 0) along the rays of the image pixels (sampled
+// every 8 pixels and along the border) up to `max_field_angle_deg` (0: no
+// limit). 0 for central cameras.
+double FarFieldErrorPx(const Camera& camera, double distance_m,
+                       double max_field_angle_deg);
 
 // Name written into the ros format's camera_name.
 inline constexpr const char* kDefaultCameraName = "camera";
@@ -88,14 +133,19 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
                       std::string* error,
                       const CameraFileNames& names = CameraFileNames());
 
-// Writes a camera file atomically.
+// Writes a camera file atomically. `note` (optional) returns
+// DescribeCameraFileOmission's note: what the format left out and what that
+// costs (empty when nothing); print it.
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      const Camera& camera, const CameraFileStats& stats,
-                     std::string* error,
+                     std::string* error, std::string* note = nullptr,
                      const CameraFileNames& names = CameraFileNames());
-// The same for a calibration result (camera and its statistics).
+// The same for a calibration result (camera and its statistics); `range`
+// (from MeasureCalibrationRange) sizes the error figure of a lossy format.
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      const CalibrationResult& result, std::string* error,
+                     const CalibrationRange& range = CalibrationRange(),
+                     std::string* note = nullptr,
                      const CameraFileNames& names = CameraFileNames());
 
 // Parses camera file text in any of the four formats; `source` names the

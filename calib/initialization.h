@@ -9,6 +9,9 @@
 //   point at the image centre; f by a 1D search that fits, for every view, a
 //   board-to-ray homography to the rays the candidate f gives (works for rays
 //   beyond 90 degrees, so for 190 degree lenses and partial views);
+// - kannala-brandt-noncentral: as kannala-brandt, with the pupil shift at 0
+//   (the rays are the far-field directions); Calibrate starts it from a
+//   central kannala-brandt calibration instead;
 // - per view: a pose "PnP through the model": pixels are unprojected to rays
 //   with the current intrinsics, a board-to-ray homography gives the pose,
 //   optionally polished by a small robust Ceres refinement

@@ -35,7 +35,7 @@ bool CheckRenderCamera(const Camera& camera, std::string* why) {
 
 double MaxMonotonicRadius(const Camera& camera) {
   const std::vector<double>& p = camera.params;
-  if (camera.model == CameraModelId::kKannalaBrandt) {
+  if (CameraModelIsFisheye(camera.model)) {
     // d theta_d / d theta = 1 + 3 k1 t^2 + 5 k2 t^4 + 7 k3 t^6 + 9 k4 t^8.
     constexpr int kSteps = 4000;
     for (int i = 1; i <= kSteps; ++i) {
@@ -71,7 +71,7 @@ double MaxMonotonicRadius(const Camera& camera) {
 }
 
 double UndistortedRadius(const Camera& camera, const Eigen::Vector3d& ray) {
-  if (camera.model == CameraModelId::kKannalaBrandt) {
+  if (CameraModelIsFisheye(camera.model)) {
     return std::atan2(ray.head<2>().norm(), ray.z());
   }
   if (!(ray.z() > 0)) return std::numeric_limits<double>::infinity();
@@ -80,11 +80,14 @@ double UndistortedRadius(const Camera& camera, const Eigen::Vector3d& ray) {
 
 bool PixelRayGrid::Compute(const Camera& camera, std::string* why) {
   rays_.clear();
+  origin_z_.clear();
   num_invalid_ = 0;
   if (!CheckRenderCamera(camera, why)) return false;
   camera_ = camera;
   const int grid_w = camera.width + 1, grid_h = camera.height + 1;
   rays_.assign(3 * static_cast<size_t>(grid_w) * grid_h, 0.0);
+  const bool central = CameraModelIsCentral(camera.model);
+  if (!central) origin_z_.assign(static_cast<size_t>(grid_w) * grid_h, 0.0);
   std::vector<int> invalid_per_row(grid_h, 0);
   const double max_radius = MaxMonotonicRadius(camera);
   // Rows are independent, so any thread count gives the same grid.
@@ -93,12 +96,15 @@ bool PixelRayGrid::Compute(const Camera& camera, std::string* why) {
       for (int cx = 0; cx < grid_w; ++cx) {
         double* ray =
             rays_.data() + 3 * (static_cast<size_t>(cy) * grid_w + cx);
-        const double pixel[2] = {cx - 0.5, cy - 0.5};
-        const UnprojectStatus status =
-            DispatchCameraModel(camera.model, [&](auto model) {
-              return decltype(model)::Unproject(camera.params.data(), pixel,
-                                                ray);
-            });
+        const Eigen::Vector2d pixel(cx - 0.5, cy - 0.5);
+        ViewingRay viewing_ray;
+        const UnprojectStatus status = UnprojectPixelToRay(
+            camera.model, camera.params.data(), pixel, &viewing_ray);
+        for (int k = 0; k < 3; ++k) ray[k] = viewing_ray.direction(k);
+        if (!central) {
+          origin_z_[static_cast<size_t>(cy) * grid_w + cx] =
+              viewing_ray.origin.z();
+        }
         if (!status.converged || !std::isfinite(ray[0]) ||
             !std::isfinite(ray[1]) || !std::isfinite(ray[2]) ||
             !(UndistortedRadius(camera,

@@ -1,7 +1,8 @@
 #ifndef PUZZLECAL_SIM_PIXEL_RAYS_H_
 #define PUZZLECAL_SIM_PIXEL_RAYS_H_
 
-// Viewing rays through the corners of every pixel of a camera, unprojected
+// Viewing rays (with their origins, for non-central cameras) through the
+// corners of every pixel of a camera, unprojected
 // once so that many renders through the same camera share the iterative
 // Unproject work. Rays at sub-pixel positions are interpolated bilinearly
 // between the four corners of their pixel (the error is second order in the
@@ -21,13 +22,15 @@ namespace puzzlecal {
 bool CheckRenderCamera(const Camera& camera, std::string* why = nullptr);
 
 // Where the camera model stays one-to-one: the largest undistorted radius
-// (pinhole models: |(x/z, y/z)|; kannala-brandt: the angle theta from the
-// axis, at most pi) up to which the radial distortion keeps increasing.
+// (pinhole models: |(x/z, y/z)|; the kannala-brandt models: the angle theta
+// from the axis, at most pi) up to which the radial distortion keeps
+// increasing.
 // Beyond it the polynomial folds back and the image shows nothing real.
 double MaxMonotonicRadius(const Camera& camera);
 
-// The undistorted radius of a camera-frame direction in the sense of
-// MaxMonotonicRadius (infinity for pinhole rays with z <= 0).
+// The undistorted radius of a camera-frame ray direction in the sense of
+// MaxMonotonicRadius (infinity for pinhole rays with z <= 0). For a
+// non-central camera pass the direction from the ray's origin.
 double UndistortedRadius(const Camera& camera, const Eigen::Vector3d& ray);
 
 class PixelRayGrid {
@@ -48,12 +51,22 @@ class PixelRayGrid {
     return rays_.data() +
            3 * (static_cast<size_t>(cy) * (camera_.width + 1) + cx);
   }
+  // Where that ray starts: (0, 0, OriginZ) in the camera frame, metres (0
+  // for central cameras; see ViewingRay).
+  double OriginZ(int cx, int cy) const {
+    return origin_z_.empty()
+               ? 0.0
+               : origin_z_[static_cast<size_t>(cy) * (camera_.width + 1) + cx];
+  }
+  // True when every ray starts at the camera origin.
+  bool central() const { return origin_z_.empty(); }
   // Number of pixel corners without a ray.
   int num_invalid() const { return num_invalid_; }
 
  private:
   Camera camera_;
   std::vector<double> rays_;
+  std::vector<double> origin_z_;  // per pixel corner; empty when central
   int num_invalid_ = 0;
 };
 

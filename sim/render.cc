@@ -143,25 +143,29 @@ std::vector<TruthCorner> ProjectBoardCorners(
       continue;
     }
     corner.xy = xy;
+    Eigen::Vector3d seen_from = point;  // from the origin of its ray
     bool visible = sees_print && xy.x() >= 0.5 &&
                    xy.x() <= camera.width - 1.5 && xy.y() >= 0.5 &&
                    xy.y() <= camera.height - 1.5;
     if (visible) {
       // The pixel must see this corner along its own ray: strong distortion
       // can fold several rays onto one pixel, and the image shows only one.
-      Eigen::Vector3d ray;
-      const UnprojectStatus status = camera.Unproject(xy, &ray);
-      const double cos_angle = ray.dot(point.normalized());
+      // (For a non-central camera: the ray from the pixel's own origin.)
+      ViewingRay ray;
+      const UnprojectStatus status = camera.UnprojectRay(xy, &ray);
+      seen_from = point - ray.origin;
+      const double cos_angle = ray.direction.dot(seen_from.normalized());
       visible = status.converged && cos_angle > std::cos(1e-6) &&
-                UndistortedRadius(camera, point) < max_radius;
+                UndistortedRadius(camera, seen_from) < max_radius;
     }
     if (visible && options.field_of_view_deg > 0) {
       // One pixel of margin, measured by the model's local ray spread.
       Eigen::Vector3d ray_next;
       camera.Unproject(xy + Eigen::Vector2d(1.0, 0.0), &ray_next);
-      const double pixel_angle =
-          std::acos(std::clamp(ray_next.dot(point.normalized()), -1.0, 1.0));
-      const double angle = std::atan2(point.head<2>().norm(), point.z());
+      const double pixel_angle = std::acos(
+          std::clamp(ray_next.dot(seen_from.normalized()), -1.0, 1.0));
+      const double angle =
+          std::atan2(seen_from.head<2>().norm(), seen_from.z());
       visible =
           std::isfinite(pixel_angle) &&
           angle + pixel_angle < 0.5 * options.field_of_view_deg * M_PI / 180.0;
@@ -220,6 +224,10 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
       -(board_from_cam_rotation * cam_from_board.translation()) /
       board.tile_size_m;
   const bool sees_print = center.z() < 0;
+  // A non-central camera's rays start at (0, 0, OriginZ) in the camera
+  // frame: center + OriginZ * axis in the board frame (tiles).
+  const Eigen::Vector3d axis =
+      board_from_cam_rotation.col(2) / board.tile_size_m;
 
   const BoardPattern pattern(board, options.variant,
                              options.paper_margin_tiles);
@@ -268,20 +276,23 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
                                         rays.Ray(x, y + 1),
                                         rays.Ray(x + 1, y + 1)};
         bool has_ray = true;
-        Eigen::Vector3d b[4];
+        Eigen::Vector3d b[4], c[4];  // corner ray directions and origins
         for (int k = 0; k < 4; ++k) {
           const Eigen::Map<const Eigen::Vector3d> r(corner_rays[k]);
           if (!r.allFinite()) has_ray = false;
           b[k] = board_from_cam_rotation * r;
+          c[k] = rays.central()
+                     ? center
+                     : center + rays.OriginZ(x + k % 2, y + k / 2) * axis;
         }
         if (!has_ray) ++no_ray_per_row[y];
         // Where the pixel's corner rays meet the board plane (tiles).
         Eigen::Vector2d hit[4];
         int num_hits = 0;
         for (int k = 0; k < 4 && has_ray; ++k) {
-          if (!(b[k].z() * center.z() < 0)) continue;
-          const double t = -center.z() / b[k].z();
-          hit[k] = center.head<2>() + t * b[k].head<2>();
+          if (!(b[k].z() * c[k].z() < 0)) continue;
+          const double t = -c[k].z() / b[k].z();
+          hit[k] = c[k].head<2>() + t * b[k].head<2>();
           ++num_hits;
         }
         const bool all_hit = has_ray && num_hits == 4;
@@ -318,8 +329,9 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
             // Where the pixel centre's ray meets the plane (the centre
             // ray heads towards it: it is a mean of the corner rays).
             const Eigen::Vector3d d_mid = 0.25 * (b[0] + b[1] + b[2] + b[3]);
+            const Eigen::Vector3d c_mid = 0.25 * (c[0] + c[1] + c[2] + c[3]);
             const Eigen::Vector2d mid =
-                center.head<2>() + (-center.z() / d_mid.z()) * d_mid.head<2>();
+                c_mid.head<2>() + (-c_mid.z() / d_mid.z()) * d_mid.head<2>();
             if (content == BoardPattern::BoxContent::kUniform) {
               const BoardInk ink = pattern.Sample(mid.x(), mid.y());
               out[x] = static_cast<float>(ink_value(ink));
@@ -343,6 +355,9 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
           const Eigen::Vector3d left = b[0] + wy * (b[2] - b[0]);
           const Eigen::Vector3d right = b[1] + wy * (b[3] - b[1]);
           const Eigen::Vector3d step = right - left;
+          const Eigen::Vector3d origin_left = c[0] + wy * (c[2] - c[0]);
+          const Eigen::Vector3d origin_step =
+              c[1] + wy * (c[3] - c[1]) - origin_left;
           for (int i = 0; i < sub.n; ++i) {
             const double wx = sub.offset[i];
             bool occluded = false;
@@ -361,15 +376,16 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
               continue;
             }
             const Eigen::Vector3d d = left + wx * step;
+            const Eigen::Vector3d o = origin_left + wx * origin_step;
             // The ray meets the plane z = 0 in front of the camera only when
             // it heads towards it.
-            if (!(d.z() * center.z() < 0)) {
+            if (!(d.z() * o.z() < 0)) {
               sum += options.background_level;
               continue;
             }
-            const double t = -center.z() / d.z();
-            sum += mix_value(pattern.SampleArea(
-                center.x() + t * d.x(), center.y() + t * d.y(), footprint));
+            const double t = -o.z() / d.z();
+            sum += mix_value(pattern.SampleArea(o.x() + t * d.x(),
+                                                o.y() + t * d.y(), footprint));
           }
         }
         out[x] = static_cast<float>(sum * inv_samples);

@@ -339,6 +339,15 @@ Camera FisheyeLensCamera(int width, int height, double fov_deg,
   return camera;
 }
 
+Camera NoncentralFisheyeCamera(int width, int height, double fov_deg,
+                               double circle_fraction, double e1, double e2) {
+  Camera camera = FisheyeLensCamera(width, height, fov_deg, circle_fraction);
+  camera.model = CameraModelId::kKannalaBrandtNoncentral;
+  camera.params.push_back(e1);
+  camera.params.push_back(e2);
+  return camera;
+}
+
 namespace {
 
 Board PuzzleBoard23x16() {
@@ -493,6 +502,43 @@ SceneSpec DarkFisheyeScene(int width, int height) {
   return scene;
 }
 
+SceneSpec NoncentralFisheyeScene(int width, int height) {
+  SceneSpec scene;
+  scene.name = "noncentral_fisheye";
+  scene.camera = NoncentralFisheyeCamera(width, height);
+  scene.board.type = BoardType::kCheckerboard;
+  scene.board.cols = 11;
+  scene.board.rows = 8;
+  scene.board.tile_size_m = 0.02;
+  scene.render.blur_sigma_px = 0.7;
+  scene.render.noise_sigma = 0.015;
+  scene.render.vignetting = 0.3;
+  scene.render.field_of_view_deg = 190.0;
+  for (int i = 0; i < 2; ++i) {
+    ViewPose view;
+    view.target = BoardCenterTiles(scene.board);
+    view.distance_m = 0.15;
+    view.view_angle_deg = 60;
+    view.tilt_direction_deg = 90 + 180 * i;
+    view.off_axis_deg = 88;
+    view.off_axis_direction_deg = 180 * i;
+    SceneViewSpec spec;
+    spec.name = "rim_" + std::to_string(i);
+    spec.cam_from_board = PoseFromView(scene.board, view);
+    scene.views.push_back(spec);
+  }
+  RandomViews& rv = scene.random_views;
+  rv.count = 8;
+  rv.seed = 15;
+  rv.min_distance_m = 0.08;
+  rv.max_distance_m = 0.25;
+  rv.min_view_angle_deg = 45;
+  rv.max_view_angle_deg = 90;
+  rv.max_roll_deg = 30;
+  rv.max_off_axis_deg = 70;
+  return scene;
+}
+
 SceneSpec SampleScene(int width, int height) {
   SceneSpec scene;
   scene.name = "sample";
@@ -519,8 +565,9 @@ SceneSpec SampleScene(int width, int height) {
 }
 
 std::vector<std::string> StandardSceneNames() {
-  return {"wide_pinhole", "strong_fisheye",       "tilt_series",
-          "small_tiles",  "fisheye_checkerboard", "dark_fisheye"};
+  return {"wide_pinhole",      "strong_fisheye",       "tilt_series",
+          "small_tiles",       "fisheye_checkerboard", "dark_fisheye",
+          "noncentral_fisheye"};
 }
 
 bool MakeStandardScene(const std::string& name, int width, int height,
@@ -537,6 +584,8 @@ bool MakeStandardScene(const std::string& name, int width, int height,
     *scene = FisheyeCheckerboardScene(width, height);
   } else if (name == "dark_fisheye") {
     *scene = DarkFisheyeScene(width, height);
+  } else if (name == "noncentral_fisheye") {
+    *scene = NoncentralFisheyeScene(width, height);
   } else {
     return false;
   }

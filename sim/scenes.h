@@ -122,6 +122,12 @@ Camera WidePinholeCamera(int width, int height, double hfov_deg = 100.0,
 Camera FisheyeLensCamera(int width, int height, double fov_deg = 190.0,
                          double circle_fraction = 0.96);
 
+// FisheyeLensCamera as kannala-brandt-noncentral with the entrance pupil
+// shift e1 e2 (metres; the defaults are as measured on the deltille lens).
+Camera NoncentralFisheyeCamera(int width, int height, double fov_deg = 190.0,
+                               double circle_fraction = 0.96,
+                               double e1 = 0.95e-3, double e2 = 0.31e-3);
+
 // The standard scenes. Default sizes are small so tests stay fast; every
 // factory takes 1600 x 1200 as well.
 // Wide pinhole, boards cut by the image border, two occluders per view.
@@ -138,6 +144,10 @@ SceneSpec FisheyeCheckerboardScene(int width = 640, int height = 480);
 // Dark, strongly vignetted fisheye images with a black image circle, like
 // the deltille photos (their own size is 1600 x 1200).
 SceneSpec DarkFisheyeScene(int width = 800, int height = 600);
+// The deltille checkerboard through a 190-degree lens with a moving entrance
+// pupil (NoncentralFisheyeCamera), close up (8 to 25 cm) where the pupil
+// shift shows, and two views at the rim beyond 90 degrees.
+SceneSpec NoncentralFisheyeScene(int width = 640, int height = 480);
 // The demo's sample set (testdata/sample, recipe testdata/sample_scene.yaml):
 // a 90-degree pinhole with barrel distortion, the 23 x 16 PuzzleBoard from 16
 // seeded random poses, boards often cut by the border, one occluder per view.
@@ -146,7 +156,8 @@ SceneSpec DarkFisheyeScene(int width = 800, int height = 600);
 SceneSpec SampleScene(int width = 800, int height = 600);
 
 // Names of the standard scenes ("wide_pinhole", "strong_fisheye",
-// "tilt_series", "small_tiles", "fisheye_checkerboard", "dark_fisheye").
+// "tilt_series", "small_tiles", "fisheye_checkerboard", "dark_fisheye",
+// "noncentral_fisheye").
 std::vector<std::string> StandardSceneNames();
 // The standard scene of that name at that size; false for unknown names.
 bool MakeStandardScene(const std::string& name, int width, int height,

@@ -19,6 +19,9 @@ const std::vector<double> kRational = {760.0, 761.2, 637.8, 482.6,
                                        0.0005, 0.52, 0.06,  0.001};
 const std::vector<double> kFisheye = {495.0, 494.2, 801.7,  598.4,
                                       0.02,  -0.005, 0.001, -0.0002};
+// kFisheye with a moving entrance pupil (e1, e2 in metres).
+const std::vector<double> kNoncentral = {
+    495.0, 494.2, 801.7, 598.4, 0.02, -0.005, 0.001, -0.0002, 0.95e-3, 0.31e-3};
 
 const std::vector<double>& ParamsFor(CameraModelId id) {
   switch (id) {
@@ -26,6 +29,8 @@ const std::vector<double>& ParamsFor(CameraModelId id) {
       return kRadtan;
     case CameraModelId::kPinholeRational:
       return kRational;
+    case CameraModelId::kKannalaBrandtNoncentral:
+      return kNoncentral;
     default:
       return kFisheye;
   }
@@ -208,7 +213,7 @@ TEST(CameraModelsTest, JetDerivativesMatchFiniteDifferences) {
       using Jet = ceres::Jet<double, kN>;
       const std::vector<double>& params = ParamsFor(id);
       const double max_angle =
-          id == CameraModelId::kKannalaBrandt ? 110 * M_PI / 180 : 0.6;
+          CameraModelIsFisheye(id) ? 110 * M_PI / 180 : 0.6;
       for (const Eigen::Vector3d& point : RandomPoints(max_angle, 50, 5)) {
         Jet jet_params[Model::kNumParams], jet_point[3], jet_pixel[2];
         for (int k = 0; k < Model::kNumParams; ++k) {
@@ -280,6 +285,20 @@ TEST(CameraModelsTest, NameDispatch) {
   EXPECT_EQ(CameraModelNumParams(CameraModelId::kKannalaBrandt), 8);
   EXPECT_TRUE(CameraModelIsPinhole(CameraModelId::kPinholeRational));
   EXPECT_FALSE(CameraModelIsPinhole(CameraModelId::kKannalaBrandt));
+  EXPECT_EQ(CameraModelNumParams(CameraModelId::kKannalaBrandtNoncentral), 10);
+  EXPECT_STREQ(CameraModelName(CameraModelId::kKannalaBrandtNoncentral),
+               "kannala-brandt-noncentral");
+  EXPECT_EQ(CameraModelParamNames(CameraModelId::kKannalaBrandtNoncentral)[8],
+            "e1");
+  EXPECT_FALSE(CameraModelIsPinhole(CameraModelId::kKannalaBrandtNoncentral));
+  EXPECT_TRUE(CameraModelIsFisheye(CameraModelId::kKannalaBrandtNoncentral));
+  EXPECT_FALSE(CameraModelIsFisheye(CameraModelId::kPinholeRadtan));
+  EXPECT_FALSE(CameraModelIsCentral(CameraModelId::kKannalaBrandtNoncentral));
+  for (CameraModelId id :
+       {CameraModelId::kPinholeRadtan, CameraModelId::kPinholeRational,
+        CameraModelId::kKannalaBrandt}) {
+    EXPECT_TRUE(CameraModelIsCentral(id));
+  }
   CameraModelId parsed;
   EXPECT_FALSE(CameraModelIdFromName("pinhole", &parsed));
   EXPECT_FALSE(CameraModelIdFromName("", &parsed));

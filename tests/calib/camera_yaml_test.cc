@@ -4,9 +4,11 @@
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <string>
@@ -33,6 +35,10 @@ Camera MakeCamera(CameraModelId id) {
       break;
     case CameraModelId::kKannalaBrandt:
       camera.params = {495.0, 494.2, 801.7, 598.4, 0.02, -0.005, 0.001, -2e-4};
+      break;
+    case CameraModelId::kKannalaBrandtNoncentral:
+      camera.params = {495.0,  494.2, 801.7, 598.4,   0.02,
+                       -0.005, 0.001, -2e-4, 0.95e-3, 0.31e-3};
       break;
   }
   return camera;
@@ -61,6 +67,8 @@ class CameraYamlTest : public ::testing::Test {
   std::vector<std::string> files_;
 };
 
+// (A non-central camera comes back from opencv, ros and kalibr as its
+// far-field part; see NoncentralCameraIntoOtherFormatsSaysWhatIsLeftOut.)
 TEST_F(CameraYamlTest, RoundTripsEveryModelThroughEveryLosslessFormat) {
   for (CameraModelId id : kAllCameraModels) {
     for (CameraFileFormat format :
@@ -85,6 +93,9 @@ TEST_F(CameraYamlTest, RoundTripsEveryModelThroughEveryLosslessFormat) {
           << error;
       Camera read;
       ASSERT_TRUE(ReadCameraFile(path, &read, &error)) << error;
+      if (format != CameraFileFormat::kPuzzlecal) {
+        camera = FarFieldCamera(camera);
+      }
       EXPECT_EQ(read.model, camera.model);
       EXPECT_EQ(read.width, camera.width);
       EXPECT_EQ(read.height, camera.height);
@@ -124,11 +135,12 @@ TEST_F(CameraYamlTest, PuzzlecalFormatCarriesTheStatistics) {
 
 TEST_F(CameraYamlTest, OpenCvFormatIsReadableByFileStorage) {
   for (CameraModelId id : kAllCameraModels) {
-    const Camera camera = MakeCamera(id);
+    // What the file holds (the far-field part of a non-central camera).
+    const Camera camera = FarFieldCamera(MakeCamera(id));
     const std::string path =
         Path(std::string("opencv_") + CameraModelName(id) + ".yaml");
     std::string error;
-    ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kOpenCv, camera,
+    ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kOpenCv, MakeCamera(id),
                                 CameraFileStats(), &error))
         << error;
     cv::FileStorage fs(path, cv::FileStorage::READ);
@@ -137,7 +149,7 @@ TEST_F(CameraYamlTest, OpenCvFormatIsReadableByFileStorage) {
     fs["camera_matrix"] >> k;
     // A fisheye keeps its k1..k4 (cv::fisheye's D) under its own key, so
     // that pinhole readers cannot take them for k1 k2 p1 p2.
-    const bool fisheye = id == CameraModelId::kKannalaBrandt;
+    const bool fisheye = CameraModelIsFisheye(id);
     fs[fisheye ? "fisheye_distortion_coefficients"
                : "distortion_coefficients"] >>
         d;
@@ -153,14 +165,91 @@ TEST_F(CameraYamlTest, OpenCvFormatIsReadableByFileStorage) {
     EXPECT_EQ(k.at<double>(1, 2), camera.params[3]);
     EXPECT_EQ(k.at<double>(2, 2), 1.0);
     ASSERT_EQ(static_cast<int>(d.total()),
-              CameraModelNumParams(id) - kDistortionBegin);
+              CameraModelNumParams(camera.model) - kDistortionBegin);
     for (int i = 0; i < static_cast<int>(d.total()); ++i) {
       EXPECT_EQ(d.at<double>(i), camera.params[kDistortionBegin + i]);
     }
     EXPECT_EQ(static_cast<int>(fs["image_width"]), camera.width);
     EXPECT_EQ(static_cast<int>(fs["image_height"]), camera.height);
-    EXPECT_EQ(static_cast<std::string>(fs["model"]), CameraModelName(id));
+    EXPECT_EQ(static_cast<std::string>(fs["model"]),
+              CameraModelName(camera.model));
   }
+}
+
+TEST_F(CameraYamlTest, NoncentralCameraIntoOtherFormatsSaysWhatIsLeftOut) {
+  const Camera camera = MakeCamera(CameraModelId::kKannalaBrandtNoncentral);
+  CameraFileStats stats;
+  stats.closest_board_distance_m = 0.1;
+  // The puzzlecal format holds it all.
+  EXPECT_FALSE(
+      DescribeCameraFileOmission(camera, CameraFileFormat::kPuzzlecal, stats)
+          .lossy);
+  EXPECT_FALSE(
+      DescribeCameraFileOmission(MakeCamera(CameraModelId::kKannalaBrandt),
+                                 CameraFileFormat::kOpenCv, stats)
+          .lossy);
+  // The largest difference between the camera and its far-field part for
+  // points 10 cm away that the camera images, by a sweep over directions.
+  const Camera far = FarFieldCamera(camera);
+  double expected = 0;
+  for (double deg = 0; deg <= 130; deg += 0.05) {
+    for (double azimuth_deg = 0; azimuth_deg < 360; azimuth_deg += 5) {
+      const double t = deg * M_PI / 180, a = azimuth_deg * M_PI / 180;
+      const Eigen::Vector3d point =
+          0.1 * Eigen::Vector3d(std::sin(t) * std::cos(a),
+                                std::sin(t) * std::sin(a), std::cos(t));
+      Eigen::Vector2d p, q;
+      if (!camera.Project(point, &p) || !far.Project(point, &q)) continue;
+      if (p.x() < 0 || p.y() < 0 || p.x() > camera.width - 1 ||
+          p.y() > camera.height - 1) {
+        continue;
+      }
+      expected = std::max(expected, (p - q).norm());
+    }
+  }
+  ASSERT_GT(expected, 1.0);  // a real effect at this distance
+  for (CameraFileFormat format :
+       {CameraFileFormat::kOpenCv, CameraFileFormat::kRos,
+        CameraFileFormat::kKalibr}) {
+    SCOPED_TRACE(CameraFileFormatName(format));
+    const CameraFileOmission omission =
+        DescribeCameraFileOmission(camera, format, stats);
+    EXPECT_TRUE(omission.lossy);
+    EXPECT_NEAR(omission.max_error_px, expected, 0.02 * expected);
+    EXPECT_NE(omission.left_out.find("e1 = 0.00095 m"), std::string::npos)
+        << omission.left_out;
+    EXPECT_NE(omission.left_out.find("e2 = 0.00031 m"), std::string::npos);
+    EXPECT_NE(omission.note.find("0.1 m away"), std::string::npos)
+        << omission.note;
+    const std::string path =
+        Path(std::string("noncentral.") + CameraFileFormatName(format));
+    std::string error, note;
+    ASSERT_TRUE(WriteCameraFile(path, format, camera, stats, &error, &note))
+        << error;
+    EXPECT_EQ(note, omission.note);
+    // The file says so, and reads back as the far-field kannala-brandt.
+    std::ifstream in(path);
+    const std::string text((std::istreambuf_iterator<char>(in)),
+                           std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("# " + omission.note), std::string::npos) << text;
+    Camera read;
+    ASSERT_TRUE(ReadCameraFile(path, &read, &error)) << error;
+    EXPECT_EQ(read.model, CameraModelId::kKannalaBrandt);
+    EXPECT_EQ(read.params, far.params);
+    if (format == CameraFileFormat::kOpenCv) {
+      cv::FileStorage fs(path, cv::FileStorage::READ);
+      ASSERT_TRUE(fs.isOpened());
+      cv::Mat d;
+      fs["fisheye_distortion_coefficients"] >> d;
+      EXPECT_EQ(d.total(), 4u);
+    }
+  }
+  // Without a distance no figure, but still the note.
+  const CameraFileOmission bare = DescribeCameraFileOmission(
+      camera, CameraFileFormat::kRos, CameraFileStats());
+  EXPECT_TRUE(bare.lossy);
+  EXPECT_EQ(bare.max_error_px, 0);
+  EXPECT_NE(bare.note.find("far-field"), std::string::npos);
 }
 
 TEST_F(CameraYamlTest, ReadsFilesWrittenByOpenCv) {

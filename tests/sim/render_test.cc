@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "decode/puzzleboard.h"
+#include "sim/scenes.h"
 
 namespace puzzlecal {
 namespace {
@@ -451,6 +452,64 @@ TEST(RenderBoardTest, BadInputGivesAnEmptyImageAndAReason) {
                           nullptr, &summary)
                   .empty());
   EXPECT_NE(summary.reason.find("tile_size_m"), std::string::npos);
+}
+
+// A non-central lens close up: the rendered corners sit where the rays with
+// their origins put them (the truth), not where the far-field (central) part
+// of the model would, several pixels away at large field angles.
+TEST(RenderBoardTest,
+     NoncentralLensShowsCornersWhereItsRaysWithOriginsPutThem) {
+  const SceneSpec scene = NoncentralFisheyeScene(960, 720);
+  const Camera far = FarFieldCamera(scene.camera);
+  RenderOptions options = scene.render;
+  options.noise_sigma = 0;
+  int checked = 0, far_off = 0;
+  std::vector<double> errors;  // refined corner to truth, pixels
+  for (const SceneViewSpec& spec : SceneViewSpecs(scene)) {
+    RenderTruth truth;
+    RenderSummary summary;
+    const cv::Mat image =
+        RenderBoard(scene.board, scene.camera, spec.cam_from_board, options,
+                    &truth, &summary);
+    ASSERT_TRUE(summary.ok) << summary.reason;
+    for (const TruthCorner& corner : truth.corners) {
+      if (!corner.visible) continue;
+      const Eigen::Vector3d point =
+          spec.cam_from_board * scene.board.Point(corner.id);
+      Eigen::Vector2d central;
+      ASSERT_TRUE(far.Project(point, &central));
+      // Tiles of at least 8 px around the corner, away from the border.
+      Eigen::Vector2d next;
+      ASSERT_TRUE(scene.camera.Project(
+          spec.cam_from_board *
+              scene.board.Point(corner.id + Eigen::Vector2i(1, 0)),
+          &next));
+      if ((next - corner.xy).norm() < 8 || corner.xy.x() < 10 ||
+          corner.xy.y() < 10 || corner.xy.x() > image.cols - 10 ||
+          corner.xy.y() > image.rows - 10) {
+        continue;
+      }
+      std::vector<cv::Point2f> refined = {
+          cv::Point2f(static_cast<float>(corner.xy.x() + 0.6),
+                      static_cast<float>(corner.xy.y() - 0.4))};
+      cv::cornerSubPix(
+          image, refined, cv::Size(3, 3), cv::Size(-1, -1),
+          cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50,
+                           1e-4));
+      const Eigen::Vector2d found(refined[0].x, refined[0].y);
+      errors.push_back((found - corner.xy).norm());
+      ++checked;
+      if ((found - central).norm() > 1.0) ++far_off;
+    }
+  }
+  ASSERT_GT(checked, 200);
+  // (cornerSubPix itself strays on a few strongly foreshortened corners.)
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.05);
+  EXPECT_LT(errors[errors.size() * 99 / 100], 0.25);
+  // The pupil shift shows: many corners lie over a pixel from the central
+  // projection.
+  EXPECT_GT(far_off, checked / 10) << far_off << " of " << checked;
 }
 
 }  // namespace
