@@ -229,7 +229,7 @@ int RunCalibrate() {
   }
 
   const double seconds_total = SecondsSince(run_start);
-  std::cout << result.report << "\n";
+  std::cout << CalibrationReport(result) << "\n";
   std::cout << "views used: " << result.num_views_used << " of "
             << images.size() << " images; corners: " << result.num_corners_used
             << "; RMS " << std::setprecision(4) << result.rms_px << " px\n";

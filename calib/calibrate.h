@@ -114,10 +114,29 @@ struct CalibrationOptions {
   bool Check(std::string* why) const;
 };
 
+// What became of one input view.
+enum class ViewOutcome {
+  kUsed,                  // in the final solve
+  kNotReached,            // the calibration stopped before judging it
+  kMismatchedPoints,      // board and image point counts differ
+  kNotPlanar,             // board points off the plane z = 0
+  kTooFewCorners,         // fewer finite corners than min_corners_per_view
+  kNoInitialPose,         // the initialisation could not pose it
+  kTooFewProjecting,      // too few corners project through the initial camera
+  kTooFewAfterRejection,  // outlier rejection left too few corners
+};
+
+// "used", "not reached", "mismatched points", ...
+const char* ViewOutcomeName(ViewOutcome outcome);
+
 struct CalibrationResult {
   Camera camera;  // model, estimated parameters, image size
-  // Per input view: whether it took part, and why not.
+  // Per input view: its name, whether it took part, and why not (the
+  // outcome, and a sentence with the figures; empty when used or not
+  // reached).
+  std::vector<std::string> view_name;
   std::vector<bool> view_used;
+  std::vector<ViewOutcome> view_outcome;
   std::vector<std::string> view_reason;
   std::vector<Eigen::Isometry3d> cam_from_board;  // identity when not used
   // RMS of the inlier residual coordinates (sqrt(sum(dx^2 + dy^2) / 2N)):
@@ -135,6 +154,9 @@ struct CalibrationResult {
   // covariance of the intrinsics, scaled by the residual variance.
   std::vector<double> param_stddev;
   Eigen::MatrixXd covariance;
+  // The covariance was asked for (options.compute_covariance and at least
+  // one free parameter) and whether it was obtained.
+  bool covariance_requested = false;
   bool covariance_ok = false;
   std::vector<bool> param_fixed;
   int num_views_used = 0;
@@ -148,8 +170,15 @@ struct CalibrationResult {
   double orientation_spread_deg = 0;
   double coverage = 0;      // fraction of coverage-grid cells with corners
   std::string termination;  // Ceres' message of the last solve
-  std::string report;       // readable summary of all of the above
+
+  // Readable summary of all of the above (CalibrationReport).
+  std::string FullReport() const;
 };
+
+// The readable summary of a result: model, parameters with their standard
+// deviations, RMS, views and corners used, outliers, coverage, solver, and
+// one line per view not used.
+std::string CalibrationReport(const CalibrationResult& result);
 
 // Calibrates `model` for images of width x height pixels. Returns false with
 // a reason (which says what to change) when the views are too few or

@@ -101,7 +101,7 @@ TEST_P(AccuracyTest, ReachesTheNoiseFloor) {
                         scene.camera.height, CalibrationOptions(), &result,
                         &error))
       << error;
-  std::printf("%s\n", result.report.c_str());
+  std::printf("%s\n", CalibrationReport(result).c_str());
   ExpectAccurate(scene.camera, result, scene.noise_px);
   EXPECT_EQ(result.num_views_used, scene.num_views);
   // Every visible corner of every view counts (partial views included);
@@ -396,7 +396,7 @@ TEST(CalibrateTest, FrontoParallelViewsFailWithAReason) {
   EXPECT_FALSE(
       RunCalibration(data, scene, CalibrationOptions(), &result, &error));
   EXPECT_NE(error.find("tilted by 30 degrees"), std::string::npos) << error;
-  std::printf("%s\n", result.report.c_str());
+  std::printf("%s\n", CalibrationReport(result).c_str());
 }
 
 TEST(CalibrateTest, ViewsAtOneSpotFailWithAReason) {
@@ -432,8 +432,14 @@ TEST(CalibrateTest, BadCorrespondencesAreSkippedWithAReason) {
   EXPECT_NE(result.view_reason[1].find("image points"), std::string::npos);
   EXPECT_FALSE(result.view_used[2]);
   EXPECT_NE(result.view_reason[2].find("only 3 corners"), std::string::npos);
+  EXPECT_EQ(result.view_outcome[0], ViewOutcome::kUsed);
+  EXPECT_EQ(result.view_outcome[1], ViewOutcome::kMismatchedPoints);
+  EXPECT_EQ(result.view_outcome[2], ViewOutcome::kTooFewCorners);
   EXPECT_EQ(result.num_views_used, scene.num_views - 2);
-  EXPECT_NE(result.report.find("synthetic_1"), std::string::npos);
+  const std::string report = CalibrationReport(result);
+  EXPECT_NE(report.find("view 1 (synthetic_1) not used: "), std::string::npos)
+      << report;
+  EXPECT_EQ(result.FullReport(), report);
 }
 
 TEST(CalibrateTest, InvalidOptionsAndInputsAreRejected) {
