@@ -482,24 +482,29 @@ void ComputeResiduals(CalibrationState* s) {
   }
 }
 
-// outlier_k * sigma, sigma = 1.4826 * median |residual coordinate| over every
-// corner of the views in use (not only the current inliers: the median is
-// robust to the outliers already, and a sigma of the inliers alone shrinks
-// with every round and trims good corners).
-double RejectionThreshold(const CalibrationState& s) {
-  std::vector<double> magnitudes;
-  for (size_t v = 0; v < s.views.size(); ++v) {
-    if (!s.view_used[v]) continue;
-    for (size_t i = 0; i < s.residuals[v].size(); ++i) {
-      if (s.projects[v][i]) {
-        magnitudes.push_back(std::abs(s.residuals[v][i].x()));
-        magnitudes.push_back(std::abs(s.residuals[v][i].y()));
+// max(outlier_k * sigma, floor), sigma = 1.4826 * the median absolute
+// deviation of the residual coordinates over every corner of the views in
+// use (not only the current inliers: the median is robust to the outliers
+// already, and a sigma of the inliers alone shrinks with every round and
+// trims good corners).
+double RejectionThreshold(CalibrationState* s) {
+  std::vector<double> coordinates;
+  for (size_t v = 0; v < s->views.size(); ++v) {
+    if (!s->view_used[v]) continue;
+    for (size_t i = 0; i < s->residuals[v].size(); ++i) {
+      if (s->projects[v][i]) {
+        coordinates.push_back(s->residuals[v][i].x());
+        coordinates.push_back(s->residuals[v][i].y());
       }
     }
   }
-  const double sigma = 1.4826 * Median(magnitudes);
-  return std::max(s.options.outlier_k * sigma,
-                  s.options.min_outlier_threshold_px);
+  const double median = Median(coordinates);
+  for (double& c : coordinates) c = std::abs(c - median);
+  const double sigma = 1.4826 * Median(coordinates);
+  s->result->noise_sigma_px = sigma;
+  s->result->outlier_threshold_px = std::max(
+      s->options.outlier_k * sigma, s->options.min_outlier_threshold_px);
+  return s->result->outlier_threshold_px;
 }
 
 // Inliers: the corners that project within `threshold`. False when nothing
@@ -540,7 +545,7 @@ void RejectOutliers(CalibrationState* s) {
   while (s->options.outlier_k > 0 &&
          s->rounds < s->options.outlier_iterations &&
          s->summary.IsSolutionUsable()) {
-    if (!SelectInliers(s, RejectionThreshold(*s))) break;
+    if (!SelectInliers(s, RejectionThreshold(s))) break;
     DropDepletedViews(s);
     ++s->rounds;
     Solve<Model>(s, s->fixed);
@@ -597,6 +602,9 @@ void FillResult(CalibrationState* s) {
     }
     s->sum2 += view_sum2;
     corners += view_corners;
+    const int valid = CountUsed(s->valid[v]);
+    r->view_rejected_fraction[v] =
+        valid > 0 ? static_cast<double>(valid - view_corners) / valid : 0.0;
     r->view_rms_px[v] =
         view_corners > 0 ? std::sqrt(view_sum2 / (2.0 * view_corners)) : 0.0;
   }
@@ -607,6 +615,10 @@ void FillResult(CalibrationState* s) {
   r->orientation_spread_deg =
       OrientationSpreadDeg(r->cam_from_board, s->view_used);
   r->num_outliers = outliers;
+  r->rejected_fraction =
+      corners + outliers > 0
+          ? static_cast<double>(outliers) / (corners + outliers)
+          : 0.0;
   r->rms_px = corners > 0 ? std::sqrt(s->sum2 / (2.0 * corners)) : 0.0;
   r->rms_point_px = corners > 0 ? std::sqrt(s->sum2 / corners) : 0.0;
   s->free_params = kPoseBlockSize * r->num_views_used;
@@ -785,6 +797,7 @@ void ResetResult(const std::vector<CalibrationView>& views,
   result->view_reason.assign(views.size(), "");
   result->cam_from_board.assign(views.size(), Eigen::Isometry3d::Identity());
   result->view_rms_px.assign(views.size(), 0.0);
+  result->view_rejected_fraction.assign(views.size(), 0.0);
   result->residuals.resize(views.size());  // empty: no view used yet
   result->inlier.resize(views.size());
 }

@@ -38,6 +38,18 @@ void ReportParameters(const CalibrationResult& result, std::ostream* out) {
   }
 }
 
+// The views that lost corners to outlier rejection, with the fraction.
+void ReportRejectedPerView(const CalibrationResult& result, std::ostream* out) {
+  for (size_t v = 0; v < result.view_rejected_fraction.size(); ++v) {
+    if (!(result.view_rejected_fraction[v] > 0)) continue;
+    const std::string name =
+        v < result.view_name.size() ? result.view_name[v] : "";
+    *out << "  view " << v << " (" << name << "): "
+         << Format("%.1f", 100 * result.view_rejected_fraction[v])
+         << " % of its corners rejected\n";
+  }
+}
+
 }  // namespace
 
 std::string CalibrationReport(const CalibrationResult& result) {
@@ -53,7 +65,11 @@ std::string CalibrationReport(const CalibrationResult& result) {
          << result.view_used.size()
          << ", corners used: " << result.num_corners_used
          << ", outliers rejected: " << result.num_outliers << " ("
-         << result.outlier_rounds << " rejection rounds)\n";
+         << Format("%.2f", 100 * result.rejected_fraction) << " %, "
+         << result.outlier_rounds << " rejection rounds, threshold "
+         << Format("%.3f", result.outlier_threshold_px) << " px, noise sigma "
+         << Format("%.3f", result.noise_sigma_px) << " px)\n";
+  ReportRejectedPerView(result, &report);
   report << "coverage: " << Format("%.0f", 100 * result.coverage)
          << " % of the image, board orientation spread "
          << Format("%.1f", result.orientation_spread_deg) << " degrees\n";
