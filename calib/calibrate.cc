@@ -452,6 +452,18 @@ bool SolveFromInitialisation(CalibrationState* s) {
                   s->error);
     }
   }
+  if (s->options.coarse_stride > 1) {
+    // The walk from the initialisation on every coarse_stride-th corner of
+    // each view: the same path at a fraction of the cost per iteration.
+    const std::vector<std::vector<bool>> all = s->inlier;
+    for (auto& view : s->inlier) {
+      for (size_t i = 0; i < view.size(); ++i) {
+        view[i] = view[i] && i % s->options.coarse_stride == 0;
+      }
+    }
+    Solve<Model>(s, s->fixed);
+    s->inlier = all;
+  }
   Solve<Model>(s, s->fixed);
   return true;
 }
@@ -856,6 +868,7 @@ bool CalibrationOptions::Check(std::string* why) const {
     return Fail("outlier_iterations must be >= 0", why);
   }
   if (max_iterations < 1) return Fail("max_iterations must be >= 1", why);
+  if (coarse_stride < 1) return Fail("coarse_stride must be >= 1", why);
   if (!(function_tolerance > 0)) {
     return Fail("function_tolerance must be > 0", why);
   }

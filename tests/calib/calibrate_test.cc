@@ -290,7 +290,7 @@ TEST(CalibrateTest, GrossErrorsAmongHeavyTailedOnesAreRemoved) {
   ASSERT_TRUE(
       RunCalibration(data, scene, CalibrationOptions(), &result, &error))
       << error;
-  int missed = 0, false_alarms = 0, valid = 0, used = 0;
+  int missed = 0, false_alarms = 0, used = 0;
   for (size_t v = 0; v < data.views.size(); ++v) {
     int view_rejected = 0;
     for (size_t i = 0; i < data.is_outlier[v].size(); ++i) {
@@ -298,7 +298,6 @@ TEST(CalibrateTest, GrossErrorsAmongHeavyTailedOnesAreRemoved) {
       if (!data.is_outlier[v][i] && !result.inlier[v][i]) ++false_alarms;
       view_rejected += result.inlier[v][i] ? 0 : 1;
     }
-    ++valid;
     used += result.view_used[v] ? 1 : 0;
     EXPECT_DOUBLE_EQ(result.view_rejected_fraction[v],
                      static_cast<double>(view_rejected) /
