@@ -183,6 +183,7 @@ int RunCalibrate() {
 
   const auto calib_start = std::chrono::steady_clock::now();
   CalibrationOptions calibration_options;
+  calibration_options.num_threads = threads;  // same result for any count
   CalibrationResult result;
   std::string calibration_error;
   const bool calibrated =

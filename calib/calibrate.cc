@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "calib/marginal_covariance.h"
+#include "calib/parallel_reprojection.h"
 #include "calib/reprojection_error.h"
 
 namespace puzzlecal {
@@ -106,6 +107,7 @@ struct CalibrationState {
   // The last solve; its problem is kept for the covariance and refers to
   // `loss`.
   std::unique_ptr<ceres::LossFunction> loss;
+  std::unique_ptr<ceres::EvaluationCallback> evaluation;  // multi-threaded
   std::unique_ptr<ceres::Problem> problem;
   ceres::Solver::Summary summary;
   int iterations = 0;  // all solves
@@ -365,11 +367,21 @@ void ResetLoss(const CalibrationOptions& options,
 template <typename Model>
 int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
                  ceres::ParameterBlockOrdering* ordering) {
+  // The old problem refers to the old loss and evaluation: release it
+  // first.
+  s->problem.reset();
+  s->evaluation.reset();
+  ResetLoss(s->options, &s->loss);
+  ParallelReprojection<Model>* parallel = nullptr;
+  if (s->options.deterministic && s->options.num_threads > 1) {
+    parallel = new ParallelReprojection<Model>(s->params.data(),
+                                               s->options.num_threads);
+    s->evaluation.reset(parallel);
+  }
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  // The old problem refers to the old loss: release it first.
+  problem_options.evaluation_callback = s->evaluation.get();
   s->problem = std::make_unique<ceres::Problem>(problem_options);
-  ResetLoss(s->options, &s->loss);
   int num_residuals = 0;
   for (size_t v = 0; v < s->views.size(); ++v) {
     if (!s->view_used[v]) continue;
@@ -377,10 +389,14 @@ int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
     int view_residuals = 0;
     for (size_t i = 0; i < view.board_points.size(); ++i) {
       if (!s->inlier[v][i]) continue;
-      s->problem->AddResidualBlock(
-          ReprojectionError<Model>::Create(view.board_points[i],
-                                           view.image_points[i]),
-          s->loss.get(), s->params.data(), s->poses[v].data());
+      ceres::CostFunction* cost =
+          parallel != nullptr
+              ? parallel->Add(view.board_points[i], view.image_points[i],
+                              s->poses[v].data())
+              : ReprojectionError<Model>::Create(view.board_points[i],
+                                                 view.image_points[i]);
+      s->problem->AddResidualBlock(cost, s->loss.get(), s->params.data(),
+                                   s->poses[v].data());
       ++view_residuals;
     }
     // Only blocks the problem holds may be named in the ordering.

@@ -94,15 +94,17 @@ struct CalibrationOptions {
   // eigenvalue of their (Schur) information matrix is below this fraction of
   // the largest. Default 1e-14. > 0.
   double covariance_min_eigenvalue_ratio = 1e-14;
-  // Threads for the Ceres solve and the covariance. Default 1. Only used
-  // when `deterministic` is false: Ceres sums over residual blocks in the
-  // order its threads finish, so a multi-threaded solve can differ in the
-  // last bits from run to run.
+  // Threads. With `deterministic` (the default) they evaluate the corners'
+  // residuals and Jacobians ahead of a single-threaded Ceres solve, each
+  // corner into its own slot (calib/parallel_reprojection.h), so the result
+  // is bit for bit the same for any count. Without it they go to Ceres's
+  // solve and ceres::Covariance, which sum in the order the threads finish
+  // and change the last bits from run to run. Default 1. >= 1.
   int num_threads = 1;
-  // Run Ceres on one thread and compute the covariance with puzzlecal's own
-  // sequential Schur complement (instead of ceres::Covariance, whose
-  // SuiteSparseQR may thread internally) so that the same input gives the
-  // same output, bit for bit, whatever num_threads says. Default true.
+  // Keep the output independent of num_threads (see there), and compute
+  // the covariance with puzzlecal's own sequential Schur complement instead
+  // of ceres::Covariance (whose SuiteSparseQR may thread internally).
+  // Default true.
   bool deterministic = true;
 
   // A view needs at least this many corners to be used. Default 6.
