@@ -1,11 +1,14 @@
 // `puzzlecal calibrate`: a folder of photos in, a camera file (and a report)
 // out.
 
-#include <glog/logging.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -30,14 +33,22 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr char kUsage[] =
-    "puzzlecal calibrate --images DIR --board BOARD.yaml --model MODEL "
-    "--out camera.yaml\n"
+    "puzzlecal calibrate --images DIR --board BOARD.yaml --out camera.yaml\n"
+    "                    [--model pinhole-radtan|pinhole-rational|"
+    "kannala-brandt]\n"
     "                    [--format puzzlecal|opencv|ros|kalibr] "
-    "[--report DIR] [--threads N]\n\n"
+    "[--report DIR] [--threads N]\n"
+    "                    [--rostopic TOPIC] [--camera-name NAME] "
+    "[--quiet | --verbose]\n\n"
     "Calibrates a camera from every image in DIR (png, jpg, tif, bmp; 8 or 16 "
-    "bit; grey or colour)\nshowing the board of BOARD.yaml. Writes the camera "
-    "file atomically; a run that cannot\nproduce a trustworthy result exits "
-    "non-zero and writes nothing.";
+    "bit; grey or colour)\nshowing the board of BOARD.yaml. --out is the "
+    "camera file to write (a file path in an\nexisting folder; --format "
+    "chooses what it holds). The camera file is written first and\n"
+    "atomically; the report folder is replaced as a whole. A run that cannot "
+    "produce a\ntrustworthy result exits non-zero and writes no camera "
+    "file.\n\nExit codes: 0 done, 2 bad command line, 3 bad input, 4 no "
+    "trustworthy result,\n5 an output cannot be written (checked before the "
+    "work starts), 130 interrupted.";
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
@@ -47,18 +58,23 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 // A one-line progress bar on a terminal, a plain line per image otherwise.
 class Progress {
  public:
-  explicit Progress(size_t total)
-      : total_(total), terminal_(::isatty(::fileno(stderr)) != 0) {}
+  Progress(size_t total, Verbosity verbosity)
+      : total_(total),
+        terminal_(::isatty(::fileno(stderr)) != 0),
+        verbosity_(verbosity) {}
 
+  // Each image's problems are listed once at the end; here a terminal gets
+  // a bar, --verbose a line per image as it finishes.
   void Done(const ImageResult& result) {
     ++done_;
     const std::string name = fs::path(result.file).filename().string();
-    if (!terminal_) {
+    if (verbosity_ == Verbosity::kVerbose) {
       std::cerr << "[" << done_ << "/" << total_ << "] " << name << ": "
                 << ImageOutcomeName(result.outcome) << " (" << result.reason
                 << ")\n";
       return;
     }
+    if (!terminal_ || verbosity_ == Verbosity::kQuiet) return;
     constexpr int kWidth = 30;
     const int filled =
         static_cast<int>(kWidth * done_ / std::max<size_t>(1, total_));
@@ -72,6 +88,7 @@ class Progress {
   size_t total_;
   size_t done_ = 0;
   bool terminal_;
+  Verbosity verbosity_;
 };
 
 // One line per input image for the log and the report.
@@ -102,7 +119,151 @@ std::vector<ReportImage> ReportLines(const std::vector<ImageResult>& images,
   return lines;
 }
 
+// ---- interruption ----
+
+// Set once the camera file is in place; read by the SIGINT handler.
+volatile std::sig_atomic_t g_camera_written = 0;
+
+// Ctrl-C: says so and what is left, then ends the process (exit 130). Files
+// are written by rename, so none is half-written; a camera file written
+// before the interruption stays.
+void OnInterrupt(int) {
+  const char* message =
+      g_camera_written
+          ? "\npuzzlecal calibrate: interrupted; the camera file was written, "
+            "the report was not\n"
+          : "\npuzzlecal calibrate: interrupted; nothing written\n";
+  const ssize_t ignored = ::write(STDERR_FILENO, message, std::strlen(message));
+  (void)ignored;
+  std::_Exit(130);
+}
+
+// ---- outputs ----
+
+// Files a report folder holds (WriteReport's names).
+bool IsReportFile(const fs::path& file) {
+  const std::string name = file.filename().string();
+  return name == "summary.md" || file.extension() == ".png";
+}
+
+// The report goes to `dir` by renaming a finished temporary folder into its
+// place. Checked before the work: `dir` is new, or a folder holding only a
+// report (it is replaced, old overlays included); its parent can be created
+// and written.
+bool CheckReportFolder(const fs::path& dir, std::string* error) {
+  std::error_code ec;
+  if (fs::exists(dir, ec)) {
+    if (!fs::is_directory(dir, ec)) {
+      *error = "--report " + dir.string() + " is a file, not a folder";
+      return false;
+    }
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      if (!entry.is_regular_file() || !IsReportFile(entry.path())) {
+        *error = "--report " + dir.string() + " holds " +
+                 entry.path().filename().string() +
+                 ", which is not part of a report; choose a new or empty "
+                 "folder (a report folder is replaced as a whole)";
+        return false;
+      }
+    }
+  }
+  const fs::path parent =
+      dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
+  fs::create_directories(parent, ec);
+  if (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK) != 0) {
+    *error = "cannot write the report folder " + dir.string() + ": " +
+             parent.string() + " is not a writable folder";
+    return false;
+  }
+  return true;
+}
+
+// Hidden names next to the report folder.
+fs::path SiblingPath(const fs::path& dir, const std::string& suffix) {
+  const fs::path parent =
+      dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
+  return parent / ("." + dir.filename().string() + suffix);
+}
+
+// Writes the report into a temporary folder, then puts it in place of `dir`
+// (the old report, overlays and all, goes).
+bool WriteReportInPlace(const fs::path& dir, const ReportInput& input,
+                        std::string* error) {
+  std::error_code ec;
+  const fs::path partial = SiblingPath(dir, ".partial");
+  const fs::path old = SiblingPath(dir, ".old");
+  fs::remove_all(partial, ec);
+  fs::remove_all(old, ec);
+  if (!WriteReport(partial.string(), input, ReportOptions(), error)) {
+    fs::remove_all(partial, ec);
+    return false;
+  }
+  if (fs::exists(dir, ec)) fs::rename(dir, old, ec);
+  if (!ec) fs::rename(partial, dir, ec);
+  if (ec) {
+    *error = "cannot put the report in place at " + dir.string() + ": " +
+             ec.message();
+    fs::remove_all(partial, ec);
+    return false;
+  }
+  fs::remove_all(old, ec);
+  return true;
+}
+
+// ---- messages ----
+
+// Why no image gave a view, when the photos look like a board but not like
+// the board of the board file: most readable images have a lattice the code
+// (or the size) of the board file does not fit anywhere.
+std::string BoardMismatchMessage(const std::vector<ImageResult>& images,
+                                 const Board& board,
+                                 const std::string& board_file) {
+  constexpr int kManyCorners = 20;
+  int readable = 0, mismatched = 0;
+  for (const ImageResult& image : images) {
+    if (image.outcome == ImageOutcome::kUnreadable) continue;
+    ++readable;
+    const bool many = static_cast<int>(image.corners.size()) >= kManyCorners;
+    mismatched += many && (image.outcome == ImageOutcome::kNotDecoded ||
+                           (board.type == BoardType::kCheckerboard &&
+                            image.outcome == ImageOutcome::kTooFewCorners));
+  }
+  if (mismatched == 0 || 2 * mismatched < readable) return "";
+  std::ostringstream out;
+  out << mismatched << " of " << readable
+      << " images show many corners but none matches ";
+  if (board.type == BoardType::kPuzzleBoard) {
+    out << "the code of " << board_file
+        << " at any position: check cols, rows and origin (" << board.cols
+        << " x " << board.rows << " from [" << board.origin.x() << ", "
+        << board.origin.y() << "])";
+  } else {
+    out << "the " << board.cols << " x " << board.rows << " corners of "
+        << board_file << ": check cols and rows";
+  }
+  return out.str();
+}
+
+// Each image that gave no view, once: "NAME: outcome (reason)".
+void PrintImageProblems(const std::vector<ReportImage>& lines) {
+  const Verbosity verbosity = ConsoleVerbosity();
+  if (verbosity == Verbosity::kQuiet) return;
+  for (const ReportImage& line : lines) {
+    if (line.outcome == "used" && verbosity != Verbosity::kVerbose) continue;
+    // Loading messages start with the path; the line names the file already.
+    std::string reason = line.reason;
+    if (reason.rfind(line.file + ": ", 0) == 0) {
+      reason.erase(0, line.file.size() + 2);
+    }
+    std::cerr << fs::path(line.file).filename().string() << ": " << line.outcome
+              << (reason.empty() ? "" : " (" + reason + ")") << "\n";
+  }
+}
+
+// ---- the command ----
+
 int RunCalibrate() {
+  std::signal(SIGINT, OnInterrupt);
   const auto run_start = std::chrono::steady_clock::now();
   if (FLAGS_images.empty() || FLAGS_board.empty() || FLAGS_out.empty()) {
     std::cerr << "puzzlecal calibrate: --images, --board and --out are "
@@ -115,33 +276,47 @@ int RunCalibrate() {
               << "'; choose one of " << CameraModelNames() << ".\n";
     return kExitUsage;
   }
+  std::string error;
   CameraFileFormat format;
   if (!CameraFileFormatFromName(FLAGS_format, &format)) {
     std::cerr << "puzzlecal calibrate: unknown format '" << FLAGS_format
               << "'; choose one of puzzlecal, opencv, ros, kalibr.\n";
     return kExitUsage;
   }
+  // The format decides the model's free parameters (Kalibr's radtan has no
+  // k3), so it is settled before any image is read.
+  CalibrationOptions calibration_options;
+  if (!CameraFormatFixedParams(format, model, &calibration_options.fixed_params,
+                               &error)) {
+    std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
+              << error << ".\n";
+    return kExitUsage;
+  }
   if (FLAGS_threads < 0) {
     std::cerr << "puzzlecal calibrate: --threads must be >= 0.\n";
     return kExitUsage;
   }
-  std::string error;
+  // Every output is checked before the work starts.
+  if (!CheckOutputPath(FLAGS_out, &error) ||
+      (!FLAGS_report.empty() && !CheckReportFolder(FLAGS_report, &error))) {
+    std::cerr << "puzzlecal calibrate: " << error << "\n";
+    return kExitOutputError;
+  }
   Board board;
   if (!LoadBoardFile(FLAGS_board, &board, &error)) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitBadInput;
-  }
-  if (!CheckOutputPath(FLAGS_out, &error)) {
-    std::cerr << "puzzlecal calibrate: " << error << "\n";
-    return kExitOutputError;
   }
   ImageListing listing;
   if (!ListImages(FLAGS_images, &listing, &error)) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitBadInput;
   }
-  for (const std::string& skipped : listing.skipped) {
-    LOG(INFO) << "skipped " << skipped;
+  const Verbosity verbosity = ConsoleVerbosity();
+  if (verbosity == Verbosity::kVerbose) {
+    for (const std::string& skipped : listing.skipped) {
+      std::cerr << "skipped " << skipped << "\n";
+    }
   }
 
   // Detection, grid and decode on all images, in parallel over images; each
@@ -153,7 +328,7 @@ int RunCalibrate() {
           ? FLAGS_threads
           : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   cv::setNumThreads(1);
-  Progress progress(listing.images.size());
+  Progress progress(listing.images.size(), verbosity);
   std::vector<ImageResult> images = ProcessImageFiles(
       listing.images, board, pipeline_options, threads,
       [&](size_t, const ImageResult& result) { progress.Done(result); });
@@ -182,21 +357,41 @@ int RunCalibrate() {
   }
 
   const auto calib_start = std::chrono::steady_clock::now();
-  CalibrationOptions calibration_options;
   calibration_options.num_threads = threads;  // same result for any count
   CalibrationResult result;
   std::string calibration_error;
-  const bool calibrated =
-      Calibrate(views, model, width, height, calibration_options, &result,
-                &calibration_error);
+  const std::string mismatch = BoardMismatchMessage(images, board, FLAGS_board);
+  bool calibrated = false;
+  if (views.empty()) {
+    calibration_error = "no image gave a view";
+  } else {
+    calibrated = Calibrate(views, model, width, height, calibration_options,
+                           &result, &calibration_error);
+  }
+  if (!calibrated && !mismatch.empty()) calibration_error = mismatch;
   const double seconds_calibrate = SecondsSince(calib_start);
 
   const std::vector<ReportImage> report_images =
       ReportLines(images, view_of_image, calibrated ? &result : nullptr);
-  for (const ReportImage& line : report_images) {
-    if (line.outcome == "used") continue;
-    LOG(WARNING) << line.file << ": " << line.outcome
-                 << (line.reason.empty() ? "" : " (" + line.reason + ")");
+  PrintImageProblems(report_images);
+
+  // The camera file first: a failing report or Ctrl-C does not lose it.
+  if (calibrated) {
+    CameraFileNames names;
+    names.camera_name = FLAGS_camera_name;
+    names.rostopic = FLAGS_rostopic;
+    std::vector<std::string> view_files(views.size());
+    for (size_t i = 0; i < images.size(); ++i) {
+      if (view_of_image[i] >= 0) view_files[view_of_image[i]] = images[i].file;
+    }
+    const CameraFileStats stats =
+        CameraFileStatsOfResult(result, view_files, board.Point(board.origin));
+    if (!WriteCameraFile(FLAGS_out, format, result.camera, stats, &error,
+                         names)) {
+      std::cerr << "puzzlecal calibrate: " << error << "\n";
+      return kExitOutputError;
+    }
+    g_camera_written = 1;
   }
 
   // The report is written also for a failed calibration: it shows why.
@@ -213,8 +408,12 @@ int RunCalibrate() {
     input.seconds_calibrate = seconds_calibrate;
     input.seconds_total = SecondsSince(run_start);
     input.threads = threads;
-    if (!WriteReport(FLAGS_report, input, ReportOptions(), &error)) {
-      std::cerr << "puzzlecal calibrate: report not written: " << error << "\n";
+    if (!WriteReportInPlace(FLAGS_report, input, &error)) {
+      std::cerr << "puzzlecal calibrate: report not written: " << error
+                << (calibrated
+                        ? "\n(the camera file " + FLAGS_out + " was written)"
+                        : "")
+                << "\n";
       // A failed calibration stays the outcome that matters.
       if (calibrated) return kExitOutputError;
     }
@@ -224,30 +423,35 @@ int RunCalibrate() {
               << calibration_error << "\n";
     return kExitNoResult;
   }
-  if (!WriteCameraFile(FLAGS_out, format, result, &error)) {
-    std::cerr << "puzzlecal calibrate: " << error << "\n";
-    return kExitOutputError;
-  }
 
   const double seconds_total = SecondsSince(run_start);
-  std::cout << CalibrationReport(result) << "\n";
-  std::cout << "views used: " << result.num_views_used << " of "
-            << images.size() << " images; corners: " << result.num_corners_used
-            << "; RMS " << std::setprecision(4) << result.rms_px << " px\n";
-  std::cout << std::setprecision(3) << "time: " << seconds_total
-            << " s wall clock on " << threads
-            << " threads; summed over images: image decoding " << seconds_load
-            << " s, detection " << seconds_detect << " s, grid and decode "
-            << seconds_grid_decode << " s; calibration " << seconds_calibrate
-            << " s\n";
-  std::cout << "wrote " << FLAGS_out << "\n";
+  if (verbosity != Verbosity::kQuiet) {
+    std::cout << CalibrationReport(result) << "\n";
+    std::cout << "views used: " << result.num_views_used << " of "
+              << images.size()
+              << " images; corners: " << result.num_corners_used << "; RMS "
+              << std::setprecision(4) << result.rms_px << " px\n";
+  }
+  if (verbosity == Verbosity::kVerbose) {
+    std::cout << std::setprecision(3) << "time: " << seconds_total
+              << " s wall clock on " << threads
+              << " threads; summed over images: image decoding " << seconds_load
+              << " s, detection " << seconds_detect << " s, grid and decode "
+              << seconds_grid_decode << " s; calibration " << seconds_calibrate
+              << " s\n";
+  }
+  std::cout << "wrote " << FLAGS_out
+            << (FLAGS_report.empty() ? "" : " and the report " + FLAGS_report)
+            << "\n";
   return kExitOk;
 }
 
-PUZZLECAL_REGISTER_SUBCOMMAND(
-    calibrate, "calibrate", "calibrate a camera from a folder of photos",
-    kUsage, {"images", "board", "model", "out", "format", "report", "threads"},
-    &RunCalibrate);
+PUZZLECAL_REGISTER_SUBCOMMAND(calibrate, "calibrate",
+                              "calibrate a camera from a folder of photos",
+                              kUsage,
+                              {"images", "board", "model", "out", "format",
+                               "report", "threads", "rostopic", "camera_name"},
+                              &RunCalibrate);
 
 }  // namespace
 }  // namespace puzzlecal

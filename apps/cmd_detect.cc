@@ -1,7 +1,6 @@
 // `puzzlecal detect`: runs detection, grid and (with --board) decoding on one
 // image or a folder and writes detections.yaml (and overlays with --draw).
 
-#include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -21,7 +20,7 @@
 #include "apps/image_io.h"
 #include "apps/pipeline.h"
 #include "apps/subcommand.h"
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {
@@ -221,7 +220,9 @@ int RunDetect() {
     return kExitBadInput;
   }
   for (const std::string& skipped : listing.skipped) {
-    LOG(INFO) << "skipped " << skipped;
+    if (ConsoleVerbosity() == Verbosity::kVerbose) {
+      std::cerr << "skipped " << skipped << "\n";
+    }
   }
   if (!FLAGS_draw.empty()) {
     std::error_code code;
@@ -247,6 +248,7 @@ int RunDetect() {
           std::cerr << "puzzlecal detect: " << image.reason << "\n";
           return;
         }
+        if (ConsoleVerbosity() == Verbosity::kQuiet) return;
         std::cout << image.file << ": " << image.corners.size() << " corners, "
                   << image.components.size() << " lattice components; "
                   << ImageOutcomeName(image.outcome) << " (" << image.reason

@@ -9,7 +9,7 @@
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
 #include "apps/subcommand.h"
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 #include "sim/scenes.h"
 
 namespace puzzlecal {

@@ -1,8 +1,13 @@
 #include "apps/common_flags.h"
 
-DEFINE_string(images, "", "Folder of images, or one image file.");
+DEFINE_string(images, "",
+              "Folder of images (png, jpg, tif, bmp), or one image file.");
 DEFINE_string(board, "", "Board definition YAML (see configs/boards/).");
-DEFINE_string(out, "", "Output file or folder.");
+DEFINE_string(out, "",
+              "Output. calibrate: the camera file (.yaml); detect: the "
+              "detections file (.yaml); board: the page (.svg, .pdf or .png); "
+              "render and undistort: a folder (created if missing). Files go "
+              "into an existing, writable folder.");
 DEFINE_string(model, "pinhole-radtan",
               "Camera model: pinhole-radtan, pinhole-rational or "
               "kannala-brandt.");
@@ -13,3 +18,19 @@ DEFINE_string(draw, "", "Folder for detection overlays (optional).");
 DEFINE_string(scene, "", "Scene recipe YAML (see configs/scenes/).");
 DEFINE_int32(threads, 0, "Worker threads; 0 = all cores.");
 DEFINE_int32(dpi, 300, "Resolution of PNG board output, dots per inch.");
+DEFINE_string(rostopic, "/cam0/image_raw",
+              "Image topic written into the kalibr camchain (cam0/rostopic).");
+DEFINE_string(camera_name, "camera",
+              "Camera name written into the ros camera_info file.");
+DEFINE_bool(quiet, false, "Print only errors and what was written.");
+DEFINE_bool(verbose, false,
+            "Print every image's outcome and the timings as well.");
+
+namespace puzzlecal {
+
+Verbosity ConsoleVerbosity() {
+  if (FLAGS_quiet) return Verbosity::kQuiet;
+  return FLAGS_verbose ? Verbosity::kVerbose : Verbosity::kNormal;
+}
+
+}  // namespace puzzlecal

@@ -15,5 +15,23 @@ DECLARE_string(draw);
 DECLARE_string(scene);
 DECLARE_int32(threads);
 DECLARE_int32(dpi);
+DECLARE_string(rostopic);
+DECLARE_string(camera_name);
+
+DECLARE_bool(quiet);
+DECLARE_bool(verbose);
+
+namespace puzzlecal {
+
+// How much a subcommand prints (--quiet / --verbose; every subcommand takes
+// them). Errors are always printed.
+enum class Verbosity {
+  kQuiet,    // errors and the line that says what was written
+  kNormal,   // plus the result and each image problem, once
+  kVerbose,  // plus every image and the timings
+};
+Verbosity ConsoleVerbosity();
+
+}  // namespace puzzlecal
 
 #endif  // PUZZLECAL_APPS_COMMON_FLAGS_H_

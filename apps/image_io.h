@@ -33,7 +33,8 @@ struct ImageLoadOptions {
 
 // Loads one image as 8-bit grey (colour and alpha are converted, 16-bit is
 // scaled to 8 bits by its own maximum so dark 16-bit photos keep their
-// contrast). False with a message naming the file and the reason (missing,
+// contrast; colour JPEGs give their luma channel). Pixels stay in the
+// sensor's frame: an EXIF orientation tag is not applied. False with a message naming the file and the reason (missing,
 // unreadable, not an image, truncated, too large, empty).
 bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
                    cv::Mat* grey, std::string* error);

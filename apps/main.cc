@@ -4,12 +4,14 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <iostream>
 #include <iterator>
 #include <string>
 #include <vector>
 
+#include "apps/common_flags.h"
 #include "apps/subcommand.h"
 
 namespace puzzlecal {
@@ -32,17 +34,64 @@ void PrintProgramHelp() {
     std::cout << "  " << s.name << std::string(12 - std::strlen(s.name), ' ')
               << s.summary << "\n";
   }
-  std::cout << "\n`puzzlecal SUBCOMMAND --help` explains one subcommand.\n";
+  std::cout << "\n`puzzlecal help SUBCOMMAND` (or `puzzlecal SUBCOMMAND "
+               "--help`) explains one subcommand;\n`puzzlecal --version` "
+               "prints the version. Every subcommand takes --quiet and "
+               "--verbose.\n";
+}
+
+// True when --NAME appears in the synopsis (the usage up to its first blank
+// line) outside square brackets: a flag the subcommand needs.
+bool IsRequiredFlag(const Subcommand& s, const std::string& name) {
+  const std::string usage = s.usage;
+  const std::string synopsis = usage.substr(0, usage.find("\n\n"));
+  std::string dashed = name;
+  std::replace(dashed.begin(), dashed.end(), '_', '-');
+  for (const std::string& spelling : {name, dashed}) {
+    const std::string needle = "--" + spelling;
+    for (size_t at = synopsis.find(needle); at != std::string::npos;
+         at = synopsis.find(needle, at + 1)) {
+      const size_t end = at + needle.size();
+      if (end < synopsis.size() &&
+          (std::isalnum(synopsis[end]) || synopsis[end] == '_' ||
+           synopsis[end] == '-')) {
+        continue;  // a longer flag name
+      }
+      int depth = 0;
+      for (size_t k = 0; k < at; ++k) {
+        depth += synopsis[k] == '[' ? 1 : synopsis[k] == ']' ? -1 : 0;
+      }
+      if (depth == 0) return true;
+    }
+  }
+  return false;
 }
 
 void PrintSubcommandHelp(const Subcommand& s) {
   std::cout << s.usage << "\n\nFlags:\n";
-  for (const std::string& name : s.flags) {
+  std::vector<std::string> names = s.flags;
+  names.push_back("quiet");
+  names.push_back("verbose");
+  for (const std::string& name : names) {
     gflags::CommandLineFlagInfo info;
     if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info)) continue;
-    std::cout << "  --" << info.name << " (" << info.description
-              << ") default: \"" << info.default_value << "\"\n";
+    std::string dashed = info.name;
+    std::replace(dashed.begin(), dashed.end(), '_', '-');
+    std::cout << "  --" << dashed;
+    if (IsRequiredFlag(s, name)) {
+      std::cout << " (required)";
+    } else if (info.default_value.empty()) {
+      std::cout << " (optional)";
+    } else if (info.type != "bool" || info.default_value != "false") {
+      std::cout << " (default: " << info.default_value << ")";
+    }
+    std::cout << "\n      " << info.description << "\n";
   }
+}
+
+// Flags every subcommand accepts: how much it prints, and glog's own.
+bool IsCommonFlag(const std::string& name) {
+  return name == "quiet" || name == "verbose";
 }
 
 // Logging flags every subcommand accepts (glog's own).
@@ -74,6 +123,8 @@ bool ParseSubcommandFlags(const Subcommand& subcommand,
       flag = arg.substr(0, equals);
       value = arg.substr(equals + 1);
     }
+    // --camera-name and --camera_name are the same flag.
+    std::replace(flag.begin(), flag.end(), '-', '_');
     gflags::CommandLineFlagInfo info;
     bool found = gflags::GetCommandLineFlagInfo(flag.c_str(), &info);
     if (!found && !has_value && flag.rfind("no", 0) == 0 &&
@@ -99,7 +150,7 @@ bool ParseSubcommandFlags(const Subcommand& subcommand,
     const bool listed =
         std::find(subcommand.flags.begin(), subcommand.flags.end(), flag) !=
         subcommand.flags.end();
-    if (!listed && !IsLoggingFlag(flag)) {
+    if (!listed && !IsLoggingFlag(flag) && !IsCommonFlag(flag)) {
       *error =
           "flag --" + flag + " does not apply to `" + subcommand.name + "`";
       return false;
@@ -115,11 +166,14 @@ bool ParseSubcommandFlags(const Subcommand& subcommand,
 
 int Main(int argc, char** argv) {
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 ||
-      std::strcmp(argv[1], "-h") == 0 || std::strcmp(argv[1], "help") == 0) {
+      std::strcmp(argv[1], "-h") == 0 ||
+      (std::strcmp(argv[1], "help") == 0 && argc == 2)) {
     PrintProgramHelp();
     return argc < 2 ? kExitUsage : kExitOk;
   }
-  const std::string name = argv[1];
+  const bool help_for = std::strcmp(argv[1], "help") == 0;  // help NAME
+  std::string name = help_for ? argv[2] : argv[1];
+  if (name == "--version" || name == "-V") name = "version";
   const auto& all = Subcommands();
   auto it = std::find_if(all.begin(), all.end(),
                          [&](const Subcommand& s) { return name == s.name; });
@@ -127,6 +181,10 @@ int Main(int argc, char** argv) {
     std::cerr << "puzzlecal: unknown subcommand '" << name
               << "'. Run `puzzlecal --help` for the list.\n";
     return kExitUsage;
+  }
+  if (help_for) {
+    PrintSubcommandHelp(*it);
+    return kExitOk;
   }
   // Drop the subcommand from argv and parse the rest as flags.
   std::vector<char*> args;
@@ -150,7 +208,18 @@ int Main(int argc, char** argv) {
               << name << " --help`.\n";
     return kExitUsage;
   }
+  if (FLAGS_quiet && FLAGS_verbose) {
+    std::cerr << "puzzlecal " << name
+              << ": --quiet and --verbose exclude each other.\n";
+    return kExitUsage;
+  }
+  // User-facing lines are plain text; library logging (Ceres, glog) only
+  // shows errors unless --verbose.
   FLAGS_logtostderr = true;
+  if (!FLAGS_verbose &&
+      gflags::GetCommandLineFlagInfoOrDie("minloglevel").is_default) {
+    FLAGS_minloglevel = google::GLOG_ERROR;
+  }
   google::InitGoogleLogging(argv[0]);
   return it->run();
 }

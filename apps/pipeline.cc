@@ -94,7 +94,8 @@ bool PipelineOptions::Check(std::string* why) const {
 }
 
 void ProcessGreyImage(const cv::Mat& grey, const Board& board,
-                      const PipelineOptions& options, ImageResult* result) {
+                      const PipelineOptions& options, ImageResult* result,
+                      CornerDetector* detector) {
   // The options come from the program, not from the user: a bad value is a
   // programming error.
   std::string why;
@@ -103,7 +104,10 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
   result->height = grey.rows;
   auto start = std::chrono::steady_clock::now();
   DetectorSummary detector_summary;
-  result->corners = DetectCorners(grey, options.detector, &detector_summary);
+  result->corners =
+      detector != nullptr
+          ? detector->Detect(grey, &detector_summary)
+          : DetectCorners(grey, options.detector, &detector_summary);
   result->seconds_detect = SecondsSince(start);
   if (!detector_summary.ok) {
     result->outcome = ImageOutcome::kNoCorners;
@@ -160,7 +164,8 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
 }
 
 ImageResult ProcessImageFile(const std::string& file, const Board& board,
-                             const PipelineOptions& options) {
+                             const PipelineOptions& options,
+                             CornerDetector* detector) {
   ImageResult result;
   result.file = file;
   const auto start = std::chrono::steady_clock::now();
@@ -173,7 +178,7 @@ ImageResult ProcessImageFile(const std::string& file, const Board& board,
     result.reason = error;
     return result;
   }
-  ProcessGreyImage(grey, board, options, &result);
+  ProcessGreyImage(grey, board, options, &result, detector);
   return result;
 }
 
@@ -189,8 +194,9 @@ std::vector<ImageResult> ProcessImageFiles(
   std::atomic<size_t> next{0};
   std::mutex done_mutex;
   auto worker = [&]() {
+    CornerDetector detector(options.detector);
     for (size_t i = next++; i < files.size(); i = next++) {
-      results[i] = ProcessImageFile(files[i], board, options);
+      results[i] = ProcessImageFile(files[i], board, options, &detector);
       if (on_done) {
         std::lock_guard<std::mutex> lock(done_mutex);
         on_done(i, results[i]);
@@ -211,17 +217,26 @@ std::vector<CalibrationView> MakeCalibrationViews(
   *height = 0;
   std::vector<CalibrationView> views;
   view_of_image->assign(images->size(), -1);
+  // The size most usable images have (the first of them on a tie).
+  std::map<std::pair<int, int>, int> count;
+  int best = 0;
+  for (const ImageResult& image : *images) {
+    if (image.outcome != ImageOutcome::kUsable) continue;
+    const int n = ++count[{image.width, image.height}];
+    if (n > best) {
+      best = n;
+      *width = image.width;
+      *height = image.height;
+    }
+  }
   for (size_t i = 0; i < images->size(); ++i) {
     ImageResult& image = (*images)[i];
     if (image.outcome != ImageOutcome::kUsable) continue;
-    if (*width == 0) {
-      *width = image.width;
-      *height = image.height;
-    } else if (image.width != *width || image.height != *height) {
+    if (image.width != *width || image.height != *height) {
       image.outcome = ImageOutcome::kSizeMismatch;
       std::ostringstream reason;
-      reason << image.width << "x" << image.height << " differs from " << *width
-             << "x" << *height << " of the first usable image";
+      reason << image.width << "x" << image.height << " differs from the "
+             << *width << "x" << *height << " most images have";
       image.reason = reason.str();
       continue;
     }

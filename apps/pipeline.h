@@ -28,7 +28,7 @@ enum class ImageOutcome {
   kNoGrid,         // no consistent lattice among the corners
   kNotDecoded,     // PuzzleBoard: no component decoded
   kTooFewCorners,  // decoded, but fewer corners than a view needs
-  kSizeMismatch,   // image size differs from the first image's
+  kSizeMismatch,   // image size differs from the one most images have
 };
 
 // "usable", "unreadable", "no corners", ...
@@ -64,25 +64,32 @@ struct ImageResult {
 };
 
 // Runs detection, grid and decode on a grey image (`board` is not read when
-// options.run_decode is false).
+// options.run_decode is false). `detector`, when given, was made with
+// options.detector and is reused (its buffers kept across images); else one
+// is made for this image.
 void ProcessGreyImage(const cv::Mat& grey, const Board& board,
-                      const PipelineOptions& options, ImageResult* result);
+                      const PipelineOptions& options, ImageResult* result,
+                      CornerDetector* detector = nullptr);
 
 // Loads `file` and processes it; the image is released on return.
 ImageResult ProcessImageFile(const std::string& file, const Board& board,
-                             const PipelineOptions& options);
+                             const PipelineOptions& options,
+                             CornerDetector* detector = nullptr);
 
 // Processes `files` on `num_threads` workers (0 = all cores), each holding
-// one image at a time. Results come in the order of `files` and do not depend
-// on the thread count. `on_done(index, result)` is called (serialised) as each
-// image finishes, for progress output.
+// one image and one CornerDetector at a time: while one worker reads and
+// decodes a file, the others detect in theirs, so reading overlaps
+// detection. Results come in the order of `files` and do not depend on the
+// thread count (each image's result depends on that image alone).
+// `on_done(index, result)` is called (serialised) as each image finishes,
+// for progress output.
 std::vector<ImageResult> ProcessImageFiles(
     const std::vector<std::string>& files, const Board& board,
     const PipelineOptions& options, int num_threads,
     const std::function<void(size_t, const ImageResult&)>& on_done = {});
 
-// The calibration views of a run: one per usable image of the size of the
-// first usable one (images of another size are marked kSizeMismatch).
+// The calibration views of a run: one per usable image of the size most
+// usable images have (images of another size are marked kSizeMismatch).
 // `view_of_image[i]` is the view index of images[i] or -1; `width`/`height`
 // return the image size (0 when no image is usable).
 std::vector<CalibrationView> MakeCalibrationViews(

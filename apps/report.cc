@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "apps/plot.h"
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {

@@ -421,46 +421,46 @@ bool SetGridOption(const std::string& arg, GridOptions* o) {
   const std::string name = arg.substr(0, eq);
   const double value = std::atof(arg.c_str() + eq + 1);
   const std::map<std::string, double*> doubles = {
-      {"min_orientation_difference_deg", &o->min_orientation_difference_deg},
-      {"intensity_difference_fraction", &o->intensity_difference_fraction},
-      {"penalty_factor", &o->penalty_factor},
-      {"neighbor_weight_ratio", &o->neighbor_weight_ratio},
-      {"tree_mean_weight_ratio_min", &o->tree_mean_weight_ratio_min},
-      {"tree_mean_weight_ratio_max", &o->tree_mean_weight_ratio_max},
-      {"max_collinearity_sin", &o->max_collinearity_sin},
-      {"max_line_spacing_ratio", &o->max_line_spacing_ratio},
-      {"max_axis_deviation_deg", &o->max_axis_deviation_deg},
+      {"min_orientation_difference_deg", &o->candidates.min_orientation_difference_deg},
+      {"intensity_difference_fraction", &o->image_tests.intensity_difference_fraction},
+      {"penalty_factor", &o->image_tests.penalty_factor},
+      {"neighbor_weight_ratio", &o->merge.neighbor_weight_ratio},
+      {"tree_mean_weight_ratio_min", &o->merge.tree_mean_weight_ratio_min},
+      {"tree_mean_weight_ratio_max", &o->merge.tree_mean_weight_ratio_max},
+      {"max_collinearity_sin", &o->merge.max_collinearity_sin},
+      {"max_line_spacing_ratio", &o->merge.max_line_spacing_ratio},
+      {"max_axis_deviation_deg", &o->merge.max_axis_deviation_deg},
       {"max_axis_deviation_with_image_deg",
-       &o->max_axis_deviation_with_image_deg},
+       &o->merge.max_axis_deviation_with_image_deg},
       {"max_adjacency_deviation_with_image_deg",
-       &o->max_adjacency_deviation_with_image_deg},
-      {"max_adjacency_length_ratio", &o->max_adjacency_length_ratio},
-      {"max_axis_aspect_ratio", &o->max_axis_aspect_ratio},
-      {"saddle_sample_fraction", &o->saddle_sample_fraction},
-      {"side_offset_fraction", &o->side_offset_fraction},
-      {"side_min_contrast", &o->side_min_contrast},
-      {"line_prediction_tolerance", &o->line_prediction_tolerance},
-      {"attach_tolerance", &o->attach_tolerance},
-      {"attach_contradiction_tolerance", &o->attach_contradiction_tolerance},
-      {"attach_saddle_sample_fraction", &o->attach_saddle_sample_fraction},
+       &o->merge.max_adjacency_deviation_with_image_deg},
+      {"max_adjacency_length_ratio", &o->merge.max_adjacency_length_ratio},
+      {"max_axis_aspect_ratio", &o->merge.max_axis_aspect_ratio},
+      {"saddle_sample_fraction", &o->cleanup.saddle_sample_fraction},
+      {"side_offset_fraction", &o->image_tests.side_offset_fraction},
+      {"side_min_contrast", &o->image_tests.side_min_contrast},
+      {"line_prediction_tolerance", &o->cleanup.line_prediction_tolerance},
+      {"attach_tolerance", &o->attach.tolerance},
+      {"attach_contradiction_tolerance", &o->attach.contradiction_tolerance},
+      {"attach_saddle_sample_fraction", &o->attach.saddle_sample_fraction},
       {"max_join_direction_deviation_deg",
-       &o->max_join_direction_deviation_deg}};
+       &o->attach.max_join_direction_deviation_deg}};
   const std::map<std::string, int*> ints = {
-      {"num_neighbors", &o->num_neighbors},
-      {"intensity_samples", &o->intensity_samples},
-      {"kruskal_passes", &o->kruskal_passes},
-      {"min_component_size", &o->min_component_size},
-      {"attach_rounds", &o->attach_rounds},
-      {"attach_min_support", &o->attach_min_support},
-      {"max_component_joins", &o->max_component_joins}};
+      {"num_neighbors", &o->candidates.num_neighbors},
+      {"intensity_samples", &o->image_tests.intensity_samples},
+      {"kruskal_passes", &o->merge.kruskal_passes},
+      {"min_component_size", &o->cleanup.min_component_size},
+      {"attach_rounds", &o->attach.rounds},
+      {"attach_min_support", &o->attach.min_support},
+      {"max_component_joins", &o->attach.max_component_joins}};
   if (doubles.count(name)) {
     *doubles.at(name) = value;
   } else if (ints.count(name)) {
     *ints.at(name) = static_cast<int>(value);
   } else if (name == "refuse_penalised_edges") {
-    o->refuse_penalised_edges = value != 0;
+    o->image_tests.refuse_penalised_edges = value != 0;
   } else if (name == "check_saddle_pattern") {
-    o->check_saddle_pattern = value != 0;
+    o->cleanup.check_saddle_pattern = value != 0;
   } else {
     return false;
   }

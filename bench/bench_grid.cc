@@ -167,7 +167,7 @@ int main() {
         "\"largest_component\": %d, \"components\": %d, "
         "\"neighbors_ms\": %.4f, \"weights_ms\": %.4f, \"kruskal_ms\": %.4f, "
         "\"cleanup_ms\": %.4f, \"removed_not_saddle\": %d, "
-        "\"removed_by_prediction\": %d}%s\n",
+        "\"removed_by_prediction\": %d, \"removed_off_lattice\": %d}%s\n",
         scene.corners.size(), size.cols, size.rows, scene.image.cols,
         scene.image.rows, times.front(), times[times.size() / 2],
         cpu_times.front(), cpu_times[cpu_times.size() / 2], size.goal_ms,
@@ -175,7 +175,7 @@ int main() {
         best_summary.neighbors_ms, best_summary.weights_ms,
         best_summary.kruskal_ms, best_summary.cleanup_ms,
         summary.num_removed_not_saddle, summary.num_removed_by_prediction,
-        s + 1 < std::size(sizes) ? "," : "");
+        summary.num_removed_off_lattice, s + 1 < std::size(sizes) ? "," : "");
   }
   std::printf("  ]\n}\n");
   return 0;

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {
@@ -67,6 +67,24 @@ bool CheckCamera(const Camera& camera, std::string* error) {
   return true;
 }
 
+// One entry of the puzzlecal format's `views`.
+void EmitView(const CameraFileView& view, YAML::Emitter& out) {
+  out << YAML::BeginMap;
+  out << YAML::Key << "file" << YAML::Value << view.file;
+  out << YAML::Key << "cam_from_board" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "R" << YAML::Value << YAML::BeginSeq;
+  const Eigen::Matrix3d& r = view.cam_from_board.linear();
+  for (int i = 0; i < 3; ++i) Flow(out, {r(i, 0), r(i, 1), r(i, 2)});
+  out << YAML::EndSeq;
+  const Eigen::Vector3d& t = view.cam_from_board.translation();
+  out << YAML::Key << "t" << YAML::Value;
+  Flow(out, {t.x(), t.y(), t.z()});
+  out << YAML::EndMap;
+  out << YAML::Key << "rms_px" << YAML::Value << view.rms_px;
+  out << YAML::Key << "corners" << YAML::Value << view.corners;
+  out << YAML::EndMap;
+}
+
 std::string FormatPuzzlecal(const Camera& camera,
                             const CameraFileStats& stats) {
   const std::vector<std::string> names = CameraModelParamNames(camera.model);
@@ -94,6 +112,11 @@ std::string FormatPuzzlecal(const Camera& camera,
     out << YAML::Key << "views_used" << YAML::Value << stats.num_views_used;
     out << YAML::Key << "corners_used" << YAML::Value << stats.num_corners_used;
     out << YAML::Key << "outliers" << YAML::Value << stats.num_outliers;
+    if (!stats.views.empty()) {
+      out << YAML::Key << "views" << YAML::Value << YAML::BeginSeq;
+      for (const CameraFileView& view : stats.views) EmitView(view, out);
+      out << YAML::EndSeq;
+    }
   }
   out << YAML::EndMap;
   return std::string("# puzzlecal camera calibration\n") + out.c_str() + "\n";
@@ -136,7 +159,7 @@ std::string FormatOpenCv(const Camera& camera) {
   return std::string("%YAML:1.0\n---\n") + out.c_str() + "\n";
 }
 
-std::string FormatRos(const Camera& camera) {
+std::string FormatRos(const Camera& camera, const std::string& camera_name) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   auto matrix = [&](const char* key, int rows, int cols,
@@ -152,7 +175,7 @@ std::string FormatRos(const Camera& camera) {
   out << YAML::BeginMap;
   out << YAML::Key << "image_width" << YAML::Value << camera.width;
   out << YAML::Key << "image_height" << YAML::Value << camera.height;
-  out << YAML::Key << "camera_name" << YAML::Value << kDefaultCameraName;
+  out << YAML::Key << "camera_name" << YAML::Value << camera_name;
   matrix("camera_matrix", 3, 3, CameraMatrix(camera));
   out << YAML::Key << "distortion_model" << YAML::Value
       << RosDistortionModel(camera.model);
@@ -166,7 +189,8 @@ std::string FormatRos(const Camera& camera) {
   return std::string(out.c_str()) + "\n";
 }
 
-bool FormatKalibr(const Camera& camera, std::string* text, std::string* error) {
+bool FormatKalibr(const Camera& camera, const std::string& rostopic,
+                  std::string* text, std::string* error) {
   const auto& p = camera.params;
   std::vector<double> coeffs;
   const char* model = "radtan";
@@ -177,7 +201,7 @@ bool FormatKalibr(const Camera& camera, std::string* text, std::string* error) {
           return Fail("kalibr has no rational distortion model (k" +
                           std::to_string(k - 5) + " = " + std::to_string(p[k]) +
                           "): write the opencv or ros format, or calibrate "
-                          "pinhole-radtan with k3 fixed",
+                          "pinhole-radtan with --format kalibr (k3 held at 0)",
                       error);
         }
       }
@@ -187,7 +211,7 @@ bool FormatKalibr(const Camera& camera, std::string* text, std::string* error) {
         return Fail(
             "kalibr's radtan model has no k3 (k3 = " + std::to_string(p[8]) +
                 "): write the opencv or ros format, or calibrate "
-                "with k3 fixed",
+                "with --format kalibr (k3 held at 0)",
             error);
       }
       coeffs = {p[4], p[5], p[6], p[7]};
@@ -208,6 +232,7 @@ bool FormatKalibr(const Camera& camera, std::string* text, std::string* error) {
   Flow(out, coeffs);
   out << YAML::Key << "resolution" << YAML::Value << YAML::Flow
       << YAML::BeginSeq << camera.width << camera.height << YAML::EndSeq;
+  out << YAML::Key << "rostopic" << YAML::Value << rostopic;
   out << YAML::EndMap << YAML::EndMap;
   *text = std::string(out.c_str()) + "\n";
   return true;
@@ -369,6 +394,61 @@ bool ParsePuzzlecal(const YAML::Node& root, Reader& r, Camera* camera) {
   }
   if (!(camera->params[0] > 0) || !(camera->params[1] > 0)) {
     return r.Fail("parameters/fx", "focal lengths must be positive");
+  }
+  return true;
+}
+
+bool ParseViews(const YAML::Node& root, Reader& r,
+                std::vector<CameraFileView>* views) {
+  views->clear();
+  if (!root["views"]) return true;
+  const YAML::Node list = root["views"];
+  if (!list.IsSequence()) return r.Fail("views", "expected a list");
+  for (size_t v = 0; v < list.size(); ++v) {
+    const std::string field = "views[" + std::to_string(v) + "]";
+    CameraFileView view;
+    YAML::Node node, pose, rows;
+    if (!r.Get(list[v], field + "/file", "file", &node) ||
+        !r.Scalar(node, field + "/file", &view.file) ||
+        !r.Get(list[v], field + "/cam_from_board", "cam_from_board", &pose) ||
+        !r.Get(pose, field + "/cam_from_board/R", "R", &rows)) {
+      return false;
+    }
+    if (!rows.IsSequence() || rows.size() != 3) {
+      return r.Fail(field + "/cam_from_board/R", "expected 3 rows");
+    }
+    Eigen::Matrix3d rotation;
+    for (int i = 0; i < 3; ++i) {
+      std::vector<double> row;
+      const std::string row_field =
+          field + "/cam_from_board/R[" + std::to_string(i) + "]";
+      if (!r.Numbers(rows[i], row_field, &row)) return false;
+      if (row.size() != 3) return r.Fail(row_field, "expected 3 numbers");
+      for (int j = 0; j < 3; ++j) rotation(i, j) = row[j];
+    }
+    if (!((rotation.transpose() * rotation - Eigen::Matrix3d::Identity())
+              .cwiseAbs()
+              .maxCoeff() < 1e-6) ||
+        !(rotation.determinant() > 0)) {
+      return r.Fail(field + "/cam_from_board/R", "not a rotation matrix");
+    }
+    std::vector<double> t;
+    if (!r.Get(pose, field + "/cam_from_board/t", "t", &node) ||
+        !r.Numbers(node, field + "/cam_from_board/t", &t)) {
+      return false;
+    }
+    if (t.size() != 3) {
+      return r.Fail(field + "/cam_from_board/t", "expected 3 numbers");
+    }
+    view.cam_from_board.linear() = rotation;
+    view.cam_from_board.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+    if (!r.Get(list[v], field + "/rms_px", "rms_px", &node) ||
+        !r.Scalar(node, field + "/rms_px", &view.rms_px) ||
+        !r.Get(list[v], field + "/corners", "corners", &node) ||
+        !r.Scalar(node, field + "/corners", &view.corners)) {
+      return false;
+    }
+    views->push_back(view);
   }
   return true;
 }
@@ -540,9 +620,27 @@ bool CameraFileFormatFromName(const std::string& name,
   return false;
 }
 
+bool CameraFormatFixedParams(CameraFileFormat format, CameraModelId model,
+                             std::vector<std::string>* fixed,
+                             std::string* error) {
+  fixed->clear();
+  if (format != CameraFileFormat::kKalibr) return true;
+  if (model == CameraModelId::kPinholeRadtan) {
+    fixed->push_back("k3");  // Kalibr's radtan: k1 k2 p1 p2
+    return true;
+  }
+  if (model == CameraModelId::kKannalaBrandt) return true;  // equidistant
+  return Fail(std::string("the kalibr format cannot hold a ") +
+                  CameraModelName(model) +
+                  " camera (its camchain has pinhole-radtan with k3 = 0 and "
+                  "kannala-brandt only): choose one of those models, or the "
+                  "opencv or ros format",
+              error);
+}
+
 bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
                       CameraFileFormat format, std::string* text,
-                      std::string* error) {
+                      std::string* error, const CameraFileNames& names) {
   if (!CheckCamera(camera, error)) return false;
   switch (format) {
     case CameraFileFormat::kPuzzlecal:
@@ -552,19 +650,19 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
       *text = FormatOpenCv(camera);
       return true;
     case CameraFileFormat::kRos:
-      *text = FormatRos(camera);
+      *text = FormatRos(camera, names.camera_name);
       return true;
     case CameraFileFormat::kKalibr:
-      return FormatKalibr(camera, text, error);
+      return FormatKalibr(camera, names.rostopic, text, error);
   }
   return Fail("unknown camera file format", error);
 }
 
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      const Camera& camera, const CameraFileStats& stats,
-                     std::string* error) {
+                     std::string* error, const CameraFileNames& names) {
   std::string text, why;
-  if (!FormatCameraFile(camera, stats, format, &text, &why)) {
+  if (!FormatCameraFile(camera, stats, format, &text, &why, names)) {
     return Fail("cannot write '" + path + "' (" + CameraFileFormatName(format) +
                     " format): " + why,
                 error);
@@ -572,8 +670,9 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
   return WriteFileAtomically(path, text, error);
 }
 
-bool WriteCameraFile(const std::string& path, CameraFileFormat format,
-                     const CalibrationResult& result, std::string* error) {
+CameraFileStats CameraFileStatsOfResult(
+    const CalibrationResult& result, const std::vector<std::string>& view_files,
+    const Eigen::Vector3d& first_corner_m) {
   CameraFileStats stats;
   stats.has_stats = true;
   stats.param_stddev = result.param_stddev;
@@ -581,7 +680,35 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
   stats.num_views_used = result.num_views_used;
   stats.num_corners_used = result.num_corners_used;
   stats.num_outliers = result.num_outliers;
-  return WriteCameraFile(path, format, result.camera, stats, error);
+  for (size_t v = 0; v < result.view_used.size(); ++v) {
+    if (!result.view_used[v]) continue;
+    CameraFileView view;
+    view.file = v < view_files.size() ? view_files[v] : "";
+    // P_cam = R (P_file + c) + t with P_file = P_board - c.
+    view.cam_from_board = result.cam_from_board[v];
+    view.cam_from_board.translation() +=
+        result.cam_from_board[v].linear() * first_corner_m;
+    if (v < result.view_rms_px.size()) view.rms_px = result.view_rms_px[v];
+    if (v < result.inlier.size()) {
+      view.corners = static_cast<int>(
+          std::count(result.inlier[v].begin(), result.inlier[v].end(), true));
+    }
+    stats.views.push_back(view);
+  }
+  return stats;
+}
+
+bool WriteCameraFile(const std::string& path, CameraFileFormat format,
+                     const CalibrationResult& result, std::string* error,
+                     const CameraFileNames& names) {
+  CameraFileStats stats;
+  stats.has_stats = true;
+  stats.param_stddev = result.param_stddev;
+  stats.rms_px = result.rms_px;
+  stats.num_views_used = result.num_views_used;
+  stats.num_corners_used = result.num_corners_used;
+  stats.num_outliers = result.num_outliers;
+  return WriteCameraFile(path, format, result.camera, stats, error, names);
 }
 
 bool ParseCameraFile(const std::string& text, const std::string& source,
@@ -637,14 +764,40 @@ bool ParseCameraFile(const std::string& text, const std::string& source,
   return true;
 }
 
-bool ReadCameraFile(const std::string& path, Camera* camera,
-                    std::string* error) {
+namespace {
+
+bool ReadText(const std::string& path, std::string* text, std::string* error) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Fail("cannot open '" + path + "'", error);
-  std::ostringstream text;
-  text << in.rdbuf();
+  std::ostringstream contents;
+  contents << in.rdbuf();
   if (in.bad()) return Fail("cannot read '" + path + "'", error);
-  return ParseCameraFile(text.str(), path, camera, nullptr, error);
+  *text = contents.str();
+  return true;
+}
+
+}  // namespace
+
+bool ReadCameraFile(const std::string& path, Camera* camera,
+                    std::string* error) {
+  std::string text;
+  if (!ReadText(path, &text, error)) return false;
+  return ParseCameraFile(text, path, camera, nullptr, error);
+}
+
+bool ReadCameraFileViews(const std::string& path,
+                         std::vector<CameraFileView>* views,
+                         std::string* error) {
+  std::string text;
+  if (!ReadText(path, &text, error)) return false;
+  try {
+    const YAML::Node root = YAML::Load(text);
+    Reader reader(path, error);
+    return root.IsMap() ? ParseViews(root, reader, views)
+                        : Fail(path + ": not a camera file", error);
+  } catch (const YAML::Exception& e) {
+    return Fail(path + ": " + e.what(), error);
+  }
 }
 
 }  // namespace puzzlecal

@@ -1,17 +1,48 @@
+include(GNUInstallDirs)
+
 # puzzlecal_add_library(NAME SOURCES ... DEPS ...)
 # One library target per folder; includes are full paths from the repository
-# root ("grid/kruskal.h").
+# root ("grid/kruskal.h"). Each library and its folder's headers are
+# installed (`cmake --install`) and exported as puzzlecal::NAME through the
+# puzzlecal CMake package (find_package(puzzlecal)).
 function(puzzlecal_add_library name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  set(includes $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+               $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   if(ARG_SOURCES)
     add_library(${name} STATIC ${ARG_SOURCES})
-    target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+    target_include_directories(${name} PUBLIC ${includes})
     target_link_libraries(${name} PUBLIC ${ARG_DEPS})
   else()  # headers only, so far
     add_library(${name} INTERFACE)
-    target_include_directories(${name} INTERFACE ${PROJECT_SOURCE_DIR})
+    target_include_directories(${name} INTERFACE ${includes})
     target_link_libraries(${name} INTERFACE ${ARG_DEPS})
   endif()
+  add_library(puzzlecal::${name} ALIAS ${name})
+  install(TARGETS ${name} EXPORT puzzlecalTargets
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/${folder}
+          FILES_MATCHING PATTERN "*.h")
+endfunction()
+
+# The CMake package: puzzlecalTargets.cmake (every library above) and
+# puzzlecalConfig.cmake, which finds the libraries' own dependencies.
+function(puzzlecal_install_package)
+  include(CMakePackageConfigHelpers)
+  set(dir ${CMAKE_INSTALL_LIBDIR}/cmake/puzzlecal)
+  install(EXPORT puzzlecalTargets NAMESPACE puzzlecal:: DESTINATION ${dir})
+  configure_package_config_file(
+    ${PROJECT_SOURCE_DIR}/cmake/puzzlecalConfig.cmake.in
+    ${PROJECT_BINARY_DIR}/puzzlecalConfig.cmake INSTALL_DESTINATION ${dir})
+  write_basic_package_version_file(
+    ${PROJECT_BINARY_DIR}/puzzlecalConfigVersion.cmake
+    COMPATIBILITY SameMinorVersion)
+  install(FILES ${PROJECT_BINARY_DIR}/puzzlecalConfig.cmake
+                ${PROJECT_BINARY_DIR}/puzzlecalConfigVersion.cmake
+          DESTINATION ${dir})
 endfunction()
 
 # puzzlecal_add_tests(DIR DEPS ...): one GoogleTest binary per *_test.cc file in

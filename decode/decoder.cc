@@ -5,16 +5,16 @@
 #include <cstdio>
 #include <limits>
 #include <map>
-#include <utility>
-
 #include <opencv2/imgproc.hpp>
+#include <utility>
 
 #include "decode/position_search.h"
 
 namespace puzzlecal {
 namespace {
 
-std::string Format(const char* format, double a, double b = 0.0, double c = 0.0) {
+std::string Format(const char* format, double a, double b = 0.0,
+                   double c = 0.0) {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer), format, a, b, c);
   return buffer;
@@ -57,7 +57,8 @@ bool FullCheckerboardMap(const LabelLattice& lattice, int handedness,
     const Eigen::Vector2i a = m * lattice.min_label;
     const Eigen::Vector2i b = m * (lattice.min_label + span);
     const Eigen::Vector2i lo = a.cwiseMin(b), hi = a.cwiseMax(b);
-    if (hi.x() - lo.x() != board.cols - 1 || hi.y() - lo.y() != board.rows - 1) {
+    if (hi.x() - lo.x() != board.cols - 1 ||
+        hi.y() - lo.y() != board.rows - 1) {
       continue;
     }
     // Board +col axis in label steps: m^T (1, 0).
@@ -78,7 +79,8 @@ int RequiredMargin(double agreement, const DecodeOptions& options) {
   const double q = std::max(1.0 - agreement, 0.02);
   if (q >= 0.5) return std::numeric_limits<int>::max();
   const double per_edge = 2.0 * std::log10((1.0 - q) / q);
-  const int needed = static_cast<int>(std::ceil(options.min_log10_odds / per_edge));
+  const int needed =
+      static_cast<int>(std::ceil(options.min_log10_odds / per_edge));
   return std::max(options.min_margin, needed);
 }
 
@@ -88,6 +90,135 @@ struct AcceptedComponent {
   LabelToBoard map;
   std::vector<char> keep;  // per lattice point
 };
+
+}  // namespace
+
+namespace {
+
+// The read edges as votes on the labels shifted to start at (0, 0).
+std::vector<LabelEdgeVote> EdgeVotes(const LabelLattice& lattice,
+                                     const EdgeBitReading& reading) {
+  std::vector<LabelEdgeVote> votes;
+  votes.reserve(reading.num_read);
+  for (const EdgeBit& edge : reading.edges) {
+    if (!edge.read) continue;
+    votes.push_back({edge.from - lattice.min_label, edge.axis,
+                     edge.confidence > 0 ? 1 : 0});
+  }
+  return votes;
+}
+
+// The figures of the acceptance rule at the search's best position.
+void RecordSearchFigures(const PositionSearchResult& search,
+                         ComponentDecoding* decoding) {
+  decoding->bits_agreeing = search.edges_agreeing;
+  decoding->agreement = static_cast<double>(search.edges_agreeing) /
+                        std::max(1, search.num_edges);
+  decoding->bins_read = search.bins_read;
+  decoding->bins_agreeing = search.bins_agreeing;
+  decoding->margin = (search.best_score - search.second_score) / 2;
+  decoding->hypotheses = search.hypotheses;
+  decoding->log10_nfa =
+      std::log10(static_cast<double>(search.hypotheses)) +
+      Log10BinomialTailHalf(search.bins_read, search.bins_agreeing);
+}
+
+// Rules 2-5 of the acceptance rule (decoder.h): empty when they hold, else
+// why not.
+std::string RefusalReason(const PositionSearchResult& search,
+                          const ComponentDecoding& decoding,
+                          const DecodeOptions& options) {
+  if (decoding.agreement < options.min_agreement) {
+    return Format(
+        "best position agrees with %.1f %% of %.0f bits (need %.1f %%)",
+        100.0 * decoding.agreement, decoding.bits_read,
+        100.0 * options.min_agreement);
+  }
+  if (decoding.margin < RequiredMargin(decoding.agreement, options)) {
+    return Format(
+        "ambiguous: best position leads the second by %.0f bits "
+        "(need %.0f at %.1f %% agreement)",
+        decoding.margin, RequiredMargin(decoding.agreement, options),
+        100.0 * decoding.agreement);
+  }
+  if (decoding.log10_nfa > options.max_log10_nfa) {
+    return Format(
+        "too little evidence: a random pattern would match this well "
+        "10^%.1f times (allowed 10^%.1f)",
+        decoding.log10_nfa, options.max_log10_nfa);
+  }
+  if (options.refuse_better_off_board &&
+      search.torus_best_score > search.best_score) {
+    return Format(
+        "a position outside the printed board matches better (%.0f vs "
+        "%.0f agreeing bits): wrong board file or print?",
+        (search.torus_best_score + search.num_edges) / 2,
+        search.edges_agreeing);
+  }
+  return std::string();
+}
+
+// For a refused component: the agreement of mirrored and inverted prints,
+// and a note on `why` when one of them explains the bits better.
+void NameMirroredOrInverted(const std::vector<LabelEdgeVote>& votes,
+                            const Eigen::Vector2i& label_max, int handedness,
+                            int parity, const Board& board,
+                            const PositionSearchResult& search,
+                            const DecodeOptions& options,
+                            ComponentDecoding* decoding, std::string* why) {
+  const PositionSearchResult mirrored =
+      SearchPuzzleBoardPosition(votes, Eigen::Vector2i::Zero(), label_max,
+                                -handedness, parity < 0 ? -1 : parity, board);
+  const PositionSearchResult inverted = SearchPuzzleBoardPosition(
+      votes, Eigen::Vector2i::Zero(), label_max, handedness, parity, board,
+      /*inverted=*/true);
+  const auto agreement = [](const PositionSearchResult& r) {
+    return r.found ? static_cast<double>(r.edges_agreeing) /
+                         std::max(1, r.num_edges)
+                   : 0.0;
+  };
+  decoding->mirrored_agreement = agreement(mirrored);
+  decoding->inverted_agreement = agreement(inverted);
+  if (decoding->mirrored_agreement >= options.min_agreement &&
+      mirrored.edges_agreeing > search.edges_agreeing) {
+    *why += Format(
+        "; the bits match a mirrored PuzzleBoard (%.1f %%): mirrored "
+        "image or print",
+        100.0 * decoding->mirrored_agreement);
+  } else if (decoding->inverted_agreement >= options.min_agreement &&
+             inverted.edges_agreeing > search.edges_agreeing) {
+    *why += Format("; the bits match a contrast-inverted PuzzleBoard (%.1f %%)",
+                   100.0 * decoding->inverted_agreement);
+  }
+}
+
+// Per lattice point: 0 when at least drop_corner_min_disagreeing_edges of
+// its read edges contradict the code at `map` (a mislabelled corner).
+std::vector<char> CornersAgreeingWithCode(const LabelLattice& lattice,
+                                          const EdgeBitReading& reading,
+                                          const LabelToBoard& map,
+                                          const DecodeOptions& options,
+                                          int* dropped) {
+  std::vector<int> disagreeing(lattice.xy.size(), 0);
+  for (const EdgeBit& edge : reading.edges) {
+    if (!edge.read) continue;
+    const int bit = edge.confidence > 0 ? 1 : 0;
+    if (bit == BoardBitOfLabelEdge(map, edge.from, edge.axis)) continue;
+    const Eigen::Vector2i to =
+        edge.from +
+        (edge.axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1));
+    ++disagreeing[lattice.At(edge.from)];
+    ++disagreeing[lattice.At(to)];
+  }
+  std::vector<char> keep(lattice.xy.size(), 1);
+  for (size_t k = 0; k < lattice.xy.size(); ++k) {
+    if (disagreeing[k] >= options.drop_corner_min_disagreeing_edges) {
+      keep[k] = 0;
+      ++*dropped;
+    }
+  }
+  return keep;
+}
 
 }  // namespace
 
@@ -104,19 +235,13 @@ bool DecodeComponentBits(const LabelLattice& lattice,
   decoding->edges = static_cast<int>(reading.edges.size());
   decoding->bits_read = reading.num_read;
   if (reading.num_read < options.min_bits_read) {
-    decoding->reason =
-        Format("only %.0f of %.0f edge bits readable (need %.0f): no discs "
-               "(plain checkerboard?), blur or tiles too small",
-               reading.num_read, decoding->edges, options.min_bits_read);
+    decoding->reason = Format(
+        "only %.0f of %.0f edge bits readable (need %.0f): no discs "
+        "(plain checkerboard?), blur or tiles too small",
+        reading.num_read, decoding->edges, options.min_bits_read);
     return false;
   }
-  std::vector<LabelEdgeVote> votes;
-  votes.reserve(reading.num_read);
-  for (const EdgeBit& edge : reading.edges) {
-    if (!edge.read) continue;
-    votes.push_back({edge.from - lattice.min_label, edge.axis,
-                     edge.confidence > 0 ? 1 : 0});
-  }
+  const std::vector<LabelEdgeVote> votes = EdgeVotes(lattice, reading);
   // Dark-tile parity relative to the shifted labels.
   int parity = reading.dark_tile_parity;
   if (parity >= 0) {
@@ -132,89 +257,22 @@ bool DecodeComponentBits(const LabelLattice& lattice,
         lattice.width, lattice.height, board.cols);
     return false;
   }
-  decoding->bits_agreeing = search.edges_agreeing;
-  decoding->agreement =
-      static_cast<double>(search.edges_agreeing) / std::max(1, search.num_edges);
-  decoding->bins_read = search.bins_read;
-  decoding->bins_agreeing = search.bins_agreeing;
-  decoding->margin = (search.best_score - search.second_score) / 2;
-  decoding->hypotheses = search.hypotheses;
-  decoding->log10_nfa = std::log10(static_cast<double>(search.hypotheses)) +
-                        Log10BinomialTailHalf(search.bins_read, search.bins_agreeing);
-
-  std::string why;
-  if (decoding->agreement < options.min_agreement) {
-    why = Format("best position agrees with %.1f %% of %.0f bits (need %.1f %%)",
-                 100.0 * decoding->agreement, decoding->bits_read,
-                 100.0 * options.min_agreement);
-  } else if (decoding->margin < RequiredMargin(decoding->agreement, options)) {
-    why = Format("ambiguous: best position leads the second by %.0f bits "
-                 "(need %.0f at %.1f %% agreement)",
-                 decoding->margin, RequiredMargin(decoding->agreement, options),
-                 100.0 * decoding->agreement);
-  } else if (decoding->log10_nfa > options.max_log10_nfa) {
-    why = Format("too little evidence: a random pattern would match this well "
-                 "10^%.1f times (allowed 10^%.1f)",
-                 decoding->log10_nfa, options.max_log10_nfa);
-  } else if (options.refuse_better_off_board &&
-             search.torus_best_score > search.best_score) {
-    why = Format("a position outside the printed board matches better (%.0f vs "
-                 "%.0f agreeing bits): wrong board file or print?",
-                 (search.torus_best_score + search.num_edges) / 2,
-                 search.edges_agreeing);
-  }
+  RecordSearchFigures(search, decoding);
+  std::string why = RefusalReason(search, *decoding, options);
   if (!why.empty()) {
-    // Name mirrored or inverted prints when they explain the bits better.
-    const PositionSearchResult mirrored = SearchPuzzleBoardPosition(
-        votes, Eigen::Vector2i::Zero(), label_max, -handedness,
-        parity < 0 ? -1 : parity, board);
-    const PositionSearchResult inverted = SearchPuzzleBoardPosition(
-        votes, Eigen::Vector2i::Zero(), label_max, handedness, parity, board,
-        /*inverted=*/true);
-    const auto agreement = [](const PositionSearchResult& r) {
-      return r.found ? static_cast<double>(r.edges_agreeing) / std::max(1, r.num_edges)
-                     : 0.0;
-    };
-    decoding->mirrored_agreement = agreement(mirrored);
-    decoding->inverted_agreement = agreement(inverted);
-    if (decoding->mirrored_agreement >= options.min_agreement &&
-        mirrored.edges_agreeing > search.edges_agreeing) {
-      why += Format("; the bits match a mirrored PuzzleBoard (%.1f %%): mirrored "
-                    "image or print",
-                    100.0 * decoding->mirrored_agreement);
-    } else if (decoding->inverted_agreement >= options.min_agreement &&
-               inverted.edges_agreeing > search.edges_agreeing) {
-      why += Format("; the bits match a contrast-inverted PuzzleBoard (%.1f %%)",
-                    100.0 * decoding->inverted_agreement);
-    }
+    NameMirroredOrInverted(votes, label_max, handedness, parity, board, search,
+                           options, decoding, &why);
     decoding->reason = why;
     return false;
   }
-
   // Accepted: label -> board map for the original labels.
   map->rotation = search.best.rotation;
   map->offset = search.best.offset - search.best.rotation * lattice.min_label;
   decoding->rotation = map->rotation;
   decoding->offset = map->offset;
   decoding->decoded = true;
-  // Corners whose own edges mostly contradict the code are mislabelled.
-  std::vector<int> disagreeing(lattice.xy.size(), 0);
-  for (const EdgeBit& edge : reading.edges) {
-    if (!edge.read) continue;
-    const int bit = edge.confidence > 0 ? 1 : 0;
-    if (bit == BoardBitOfLabelEdge(*map, edge.from, edge.axis)) continue;
-    const Eigen::Vector2i to =
-        edge.from + (edge.axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1));
-    ++disagreeing[lattice.At(edge.from)];
-    ++disagreeing[lattice.At(to)];
-  }
-  keep->assign(lattice.xy.size(), 1);
-  for (size_t k = 0; k < lattice.xy.size(); ++k) {
-    if (disagreeing[k] >= options.drop_corner_min_disagreeing_edges) {
-      (*keep)[k] = 0;
-      ++decoding->corners_dropped;
-    }
-  }
+  *keep = CornersAgreeingWithCode(lattice, reading, *map, options,
+                                  &decoding->corners_dropped);
   return true;
 }
 
@@ -226,7 +284,8 @@ bool DecodeOptions::Check(std::string* why) const {
   if (!bits.Check(why)) return false;
   if (min_corners < 1) return fail("min_corners must be >= 1");
   if (max_label_extent < 2) return fail("max_label_extent must be >= 2");
-  if (!(max_lattice_deviation > 0.0)) return fail("max_lattice_deviation must be > 0");
+  if (!(max_lattice_deviation > 0.0))
+    return fail("max_lattice_deviation must be > 0");
   if (min_bits_read < 1) return fail("min_bits_read must be >= 1");
   if (!(min_agreement >= 0.5 && min_agreement <= 1.0)) {
     return fail("min_agreement must be in [0.5, 1]");
@@ -240,6 +299,212 @@ bool DecodeOptions::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+
+// Board, options and components DecodeBoard can work with; false with the
+// reason in `result->reason`.
+bool CheckDecodeInputs(const Board& board, const DecodeOptions& options,
+                       const std::vector<GridComponent>& components,
+                       DecodeResult* result) {
+  std::string why;
+  if (!board.Check(&why)) {
+    result->reason = "invalid board: " + why;
+    return false;
+  }
+  if (!options.Check(&why)) {
+    result->reason = "invalid decode options: " + why;
+    return false;
+  }
+  if (components.empty()) {
+    result->reason = "no grid components";
+    return false;
+  }
+  return true;
+}
+
+// The single-channel image the edge bits are read from, or an empty image
+// with the reason in `*reason`.
+cv::Mat GreyForEdgeBits(const cv::Mat& image, std::string* reason) {
+  cv::Mat grey;
+  if (image.empty()) {
+    *reason = "empty image: edge bits cannot be read";
+  } else if (image.channels() == 1) {
+    grey = image;
+  } else if (image.channels() == 3 || image.channels() == 4) {
+    cv::cvtColor(
+        image, grey,
+        image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+  } else {
+    *reason = "image has an unsupported number of channels";
+  }
+  if (!grey.empty() && grey.depth() != CV_8U && grey.depth() != CV_16U &&
+      grey.depth() != CV_32F && grey.depth() != CV_64F) {
+    grey = cv::Mat();
+    *reason = "image depth not supported (8-bit, 16-bit or float)";
+  }
+  return grey;
+}
+
+// The lattice of one component without its invalid, duplicate and
+// off-lattice corners; fills the corner counts and the handedness of
+// `decoding`. False with the reason in `decoding` when the component is not
+// usable.
+bool UsableLattice(const std::vector<Corner>& corners,
+                   const GridComponent& component, const DecodeOptions& options,
+                   LabelLattice* lattice, ComponentDecoding* decoding) {
+  std::string why;
+  if (!BuildLabelLattice(corners, component, options.max_label_extent, lattice,
+                         &why)) {
+    decoding->reason = why;
+    return false;
+  }
+  int dropped = lattice->dropped_duplicates + lattice->dropped_invalid;
+  const std::vector<int> outliers =
+      LatticeOutliers(*lattice, options.max_lattice_deviation);
+  if (!outliers.empty()) {
+    // Rebuild without the mislabelled corners.
+    GridComponent kept;
+    std::vector<char> is_outlier(lattice->xy.size(), 0);
+    for (int k : outliers) is_outlier[k] = 1;
+    for (size_t k = 0; k < lattice->xy.size(); ++k) {
+      if (is_outlier[k]) continue;
+      kept.corner.push_back(lattice->corner_index[k]);
+      kept.ij.push_back(lattice->label[k]);
+    }
+    dropped += static_cast<int>(outliers.size());
+    if (!BuildLabelLattice(corners, kept, options.max_label_extent, lattice,
+                           &why)) {
+      decoding->reason = why;
+      return false;
+    }
+  }
+  decoding->num_corners = static_cast<int>(lattice->xy.size());
+  decoding->corners_dropped = dropped;
+  decoding->handedness = LabelHandedness(*lattice);
+  if (decoding->num_corners < options.min_corners) {
+    decoding->reason = Format("only %.0f usable corners (need %.0f)",
+                              decoding->num_corners, options.min_corners);
+    return false;
+  }
+  return true;
+}
+
+// Appends the points of one lattice with board ids through `map`.
+void AppendBoardIds(const LabelLattice& lattice, const LabelToBoard& map,
+                    int component, DecodeResult* result) {
+  for (size_t k = 0; k < lattice.xy.size(); ++k) {
+    result->observation.id.push_back(map.Apply(lattice.label[k]));
+    result->observation.xy.push_back(lattice.xy[k]);
+    result->corner_index.push_back(lattice.corner_index[k]);
+    result->component.push_back(component);
+  }
+}
+
+// Plain checkerboard: the largest usable component spanning the whole board
+// gets board ids; else every usable component keeps relative labels.
+void DecodeCheckerboard(const Board& board,
+                        const std::vector<LabelLattice>& lattices,
+                        const std::vector<char>& usable, DecodeResult* result) {
+  const size_t num_components = lattices.size();
+  int best = -1;
+  LabelToBoard best_map;
+  for (size_t c = 0; c < num_components; ++c) {
+    LabelToBoard map;
+    if (!usable[c] ||
+        !FullCheckerboardMap(lattices[c], result->components[c].handedness,
+                             board, &map)) {
+      continue;
+    }
+    if (best < 0 || lattices[c].xy.size() > lattices[best].xy.size()) {
+      best = static_cast<int>(c);
+      best_map = map;
+    }
+  }
+  if (best >= 0) {
+    ComponentDecoding& decoding = result->components[best];
+    decoding.decoded = true;
+    decoding.rotation = best_map.rotation;
+    decoding.offset = best_map.offset;
+    AppendBoardIds(lattices[best], best_map, best, result);
+    result->decoded = true;
+    result->absolute_ids = true;
+    for (size_t c = 0; c < num_components; ++c) {
+      if (static_cast<int>(c) != best && result->components[c].reason.empty()) {
+        result->components[c].reason =
+            "another component spans the whole board";
+      }
+    }
+    return;
+  }
+  for (size_t c = 0; c < num_components; ++c) {
+    if (!usable[c]) continue;
+    result->components[c].reason =
+        "component does not span the whole checkerboard: relative labels";
+    AppendRelativeLabels(lattices[c], result->components[c].handedness,
+                         static_cast<int>(c), result);
+  }
+  result->reason =
+      "no component spans the whole checkerboard: labels are relative";
+}
+
+// PuzzleBoard without any accepted component: relative labels for the
+// usable ones and a reason naming the first refusals.
+void ReportNoneDecoded(const std::vector<LabelLattice>& lattices,
+                       const std::vector<char>& usable, DecodeResult* result) {
+  for (size_t c = 0; c < lattices.size(); ++c) {
+    if (usable[c]) {
+      AppendRelativeLabels(lattices[c], result->components[c].handedness,
+                           static_cast<int>(c), result);
+    }
+  }
+  if (!result->reason.empty()) return;
+  result->reason = "no component decoded";
+  int listed = 0;
+  for (const ComponentDecoding& decoding : result->components) {
+    if (decoding.reason.empty() || listed == 3) continue;
+    result->reason += (listed == 0 ? ": component " : "; component ") +
+                      std::to_string(decoding.component) + ": " +
+                      decoding.reason;
+    ++listed;
+  }
+}
+
+// Joins the accepted components into one observation; ids claimed twice are
+// dropped.
+void JoinAccepted(const std::vector<AcceptedComponent>& accepted,
+                  DecodeResult* result) {
+  std::map<std::pair<int, int>, int> claims;
+  for (const AcceptedComponent& a : accepted) {
+    for (size_t k = 0; k < a.lattice->xy.size(); ++k) {
+      if (!a.keep[k]) continue;
+      const Eigen::Vector2i id = a.map.Apply(a.lattice->label[k]);
+      ++claims[{id.x(), id.y()}];
+    }
+  }
+  for (const AcceptedComponent& a : accepted) {
+    ComponentDecoding& decoding = result->components[a.component];
+    for (size_t k = 0; k < a.lattice->xy.size(); ++k) {
+      if (!a.keep[k]) continue;
+      const Eigen::Vector2i id = a.map.Apply(a.lattice->label[k]);
+      if (claims[{id.x(), id.y()}] > 1) {
+        ++decoding.corners_dropped;
+        continue;
+      }
+      result->observation.id.push_back(id);
+      result->observation.xy.push_back(a.lattice->xy[k]);
+      result->corner_index.push_back(a.lattice->corner_index[k]);
+      result->component.push_back(a.component);
+    }
+  }
+  result->decoded = !result->observation.id.empty();
+  result->absolute_ids = result->decoded;
+  if (!result->decoded) {
+    result->reason = "every decoded corner collided with another";
+  }
+}
+
+}  // namespace
+
 DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
                          const std::vector<GridComponent>& components,
                          const cv::Mat& image, const DecodeOptions& options) {
@@ -248,38 +513,10 @@ DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
   for (size_t c = 0; c < components.size(); ++c) {
     result.components[c].component = static_cast<int>(c);
   }
-  std::string why;
-  if (!board.Check(&why)) {
-    result.reason = "invalid board: " + why;
-    return result;
-  }
-  if (!options.Check(&why)) {
-    result.reason = "invalid decode options: " + why;
-    return result;
-  }
-  if (components.empty()) {
-    result.reason = "no grid components";
-    return result;
-  }
+  if (!CheckDecodeInputs(board, options, components, &result)) return result;
   const bool puzzle = board.type == BoardType::kPuzzleBoard;
-  cv::Mat grey;
-  if (puzzle) {
-    if (image.empty()) {
-      result.reason = "empty image: edge bits cannot be read";
-    } else if (image.channels() == 1) {
-      grey = image;
-    } else if (image.channels() == 3 || image.channels() == 4) {
-      cv::cvtColor(image, grey, image.channels() == 3 ? cv::COLOR_BGR2GRAY
-                                                      : cv::COLOR_BGRA2GRAY);
-    } else {
-      result.reason = "image has an unsupported number of channels";
-    }
-    if (!grey.empty() && grey.depth() != CV_8U && grey.depth() != CV_16U &&
-        grey.depth() != CV_32F && grey.depth() != CV_64F) {
-      grey = cv::Mat();
-      result.reason = "image depth not supported (8-bit, 16-bit or float)";
-    }
-  }
+  const cv::Mat grey =
+      puzzle ? GreyForEdgeBits(image, &result.reason) : cv::Mat();
 
   std::vector<LabelLattice> lattices(components.size());
   std::vector<char> usable(components.size(), 0);
@@ -287,36 +524,7 @@ DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
   for (size_t c = 0; c < components.size(); ++c) {
     ComponentDecoding& decoding = result.components[c];
     LabelLattice& lattice = lattices[c];
-    if (!BuildLabelLattice(corners, components[c], options.max_label_extent,
-                           &lattice, &why)) {
-      decoding.reason = why;
-      continue;
-    }
-    int dropped = lattice.dropped_duplicates + lattice.dropped_invalid;
-    const std::vector<int> outliers =
-        LatticeOutliers(lattice, options.max_lattice_deviation);
-    if (!outliers.empty()) {
-      // Rebuild without the mislabelled corners.
-      GridComponent kept;
-      std::vector<char> is_outlier(lattice.xy.size(), 0);
-      for (int k : outliers) is_outlier[k] = 1;
-      for (size_t k = 0; k < lattice.xy.size(); ++k) {
-        if (is_outlier[k]) continue;
-        kept.corner.push_back(lattice.corner_index[k]);
-        kept.ij.push_back(lattice.label[k]);
-      }
-      dropped += static_cast<int>(outliers.size());
-      if (!BuildLabelLattice(corners, kept, options.max_label_extent, &lattice, &why)) {
-        decoding.reason = why;
-        continue;
-      }
-    }
-    decoding.num_corners = static_cast<int>(lattice.xy.size());
-    decoding.corners_dropped = dropped;
-    decoding.handedness = LabelHandedness(lattice);
-    if (decoding.num_corners < options.min_corners) {
-      decoding.reason = Format("only %.0f usable corners (need %.0f)",
-                               decoding.num_corners, options.min_corners);
+    if (!UsableLattice(corners, components[c], options, &lattice, &decoding)) {
       continue;
     }
     usable[c] = 1;
@@ -334,103 +542,13 @@ DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
       accepted.push_back(std::move(candidate));
     }
   }
-
   if (!puzzle) {
-    // A component spanning the whole board gets board ids (the largest one).
-    int best = -1;
-    LabelToBoard best_map;
-    for (size_t c = 0; c < components.size(); ++c) {
-      LabelToBoard map;
-      if (!usable[c] ||
-          !FullCheckerboardMap(lattices[c], result.components[c].handedness, board,
-                               &map)) {
-        continue;
-      }
-      if (best < 0 || lattices[c].xy.size() > lattices[best].xy.size()) {
-        best = static_cast<int>(c);
-        best_map = map;
-      }
-    }
-    if (best >= 0) {
-      const LabelLattice& lattice = lattices[best];
-      ComponentDecoding& decoding = result.components[best];
-      decoding.decoded = true;
-      decoding.rotation = best_map.rotation;
-      decoding.offset = best_map.offset;
-      for (size_t k = 0; k < lattice.xy.size(); ++k) {
-        result.observation.id.push_back(best_map.Apply(lattice.label[k]));
-        result.observation.xy.push_back(lattice.xy[k]);
-        result.corner_index.push_back(lattice.corner_index[k]);
-        result.component.push_back(best);
-      }
-      result.decoded = true;
-      result.absolute_ids = true;
-      for (size_t c = 0; c < components.size(); ++c) {
-        if (static_cast<int>(c) != best && result.components[c].reason.empty()) {
-          result.components[c].reason = "another component spans the whole board";
-        }
-      }
-      return result;
-    }
-    for (size_t c = 0; c < components.size(); ++c) {
-      if (!usable[c]) continue;
-      result.components[c].reason =
-          "component does not span the whole checkerboard: relative labels";
-      AppendRelativeLabels(lattices[c], result.components[c].handedness,
-                           static_cast<int>(c), &result);
-    }
-    result.reason =
-        "no component spans the whole checkerboard: labels are relative";
-    return result;
+    DecodeCheckerboard(board, lattices, usable, &result);
+  } else if (accepted.empty()) {
+    ReportNoneDecoded(lattices, usable, &result);
+  } else {
+    JoinAccepted(accepted, &result);
   }
-
-  if (accepted.empty()) {
-    for (size_t c = 0; c < components.size(); ++c) {
-      if (usable[c]) {
-        AppendRelativeLabels(lattices[c], result.components[c].handedness,
-                             static_cast<int>(c), &result);
-      }
-    }
-    if (result.reason.empty()) {
-      result.reason = "no component decoded";
-      int listed = 0;
-      for (const ComponentDecoding& decoding : result.components) {
-        if (decoding.reason.empty() || listed == 3) continue;
-        result.reason += (listed == 0 ? ": component " : "; component ") +
-                         std::to_string(decoding.component) + ": " + decoding.reason;
-        ++listed;
-      }
-    }
-    return result;
-  }
-
-  // Join the accepted components; ids claimed twice are dropped.
-  std::map<std::pair<int, int>, int> claims;
-  for (const AcceptedComponent& a : accepted) {
-    for (size_t k = 0; k < a.lattice->xy.size(); ++k) {
-      if (!a.keep[k]) continue;
-      const Eigen::Vector2i id = a.map.Apply(a.lattice->label[k]);
-      ++claims[{id.x(), id.y()}];
-    }
-  }
-  for (const AcceptedComponent& a : accepted) {
-    ComponentDecoding& decoding = result.components[a.component];
-    for (size_t k = 0; k < a.lattice->xy.size(); ++k) {
-      if (!a.keep[k]) continue;
-      const Eigen::Vector2i id = a.map.Apply(a.lattice->label[k]);
-      if (claims[{id.x(), id.y()}] > 1) {
-        ++decoding.corners_dropped;
-        continue;
-      }
-      result.observation.id.push_back(id);
-      result.observation.xy.push_back(a.lattice->xy[k]);
-      result.corner_index.push_back(a.lattice->corner_index[k]);
-      result.component.push_back(a.component);
-    }
-  }
-  result.decoded = !result.observation.id.empty();
-  result.absolute_ids = result.decoded;
-  if (!result.decoded) result.reason = "every decoded corner collided with another";
   return result;
 }
 

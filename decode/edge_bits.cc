@@ -224,15 +224,111 @@ bool EdgeBitOptions::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+
+// The image position of label ij, or null when it holds no corner.
+const Eigen::Vector2d* PointAt(const LabelLattice& lattice,
+                               const Eigen::Vector2i& ij) {
+  const int k = lattice.At(ij);
+  return k < 0 ? nullptr : &lattice.xy[k];
+}
+
+// Where the tiles, the edge and its disc are sampled for the lattice edge
+// a -> b = a + e (f: the other axis).
+struct EdgeGeometry {
+  Eigen::Vector2d mid;        // edge midpoint (the disc's centre)
+  Eigen::Vector2d along;      // the edge vector a -> b
+  Eigen::Vector2d across;     // one lattice step along f
+  Eigen::Vector2d centre[2];  // tile centres, [0]: side +f, [1]: side -f
+};
+
+EdgeGeometry EdgeSamplePoints(const LabelLattice& lattice,
+                              const Eigen::Vector2i& a,
+                              const Eigen::Vector2i& e,
+                              const Eigen::Vector2i& f,
+                              const Eigen::Vector2d& pa,
+                              const Eigen::Vector2d& pb) {
+  const Eigen::Vector2i b = a + e;
+  EdgeGeometry g;
+  // Edge midpoint by Lagrange interpolation at t = 1/2 through the corners
+  // at t = -1, 0, 1, 2 along the lattice line.
+  const Eigen::Vector2d* before = PointAt(lattice, a - e);
+  const Eigen::Vector2d* after = PointAt(lattice, b + e);
+  if (before != nullptr && after != nullptr) {
+    g.mid = (9.0 * (pa + pb) - *before - *after) / 16.0;
+  } else if (before != nullptr) {
+    g.mid = -0.125 * *before + 0.75 * pa + 0.375 * pb;
+  } else if (after != nullptr) {
+    g.mid = 0.375 * pa + 0.75 * pb - 0.125 * *after;
+  } else {
+    g.mid = 0.5 * (pa + pb);
+  }
+  g.along = pb - pa;
+  // Tile centres on both sides: the mean of the tile's four corners when
+  // all are labelled, else half a lattice step across from the midpoint.
+  g.across = Eigen::Vector2d(-g.along.y(), g.along.x());
+  if (const Eigen::Vector2d* q = PointAt(lattice, Eigen::Vector2i(a + f))) {
+    g.across = *q - pa;
+  } else if (const Eigen::Vector2d* q =
+                 PointAt(lattice, Eigen::Vector2i(b + f))) {
+    g.across = *q - pb;
+  } else if (const Eigen::Vector2d* q =
+                 PointAt(lattice, Eigen::Vector2i(a - f))) {
+    g.across = pa - *q;
+  } else if (const Eigen::Vector2d* q =
+                 PointAt(lattice, Eigen::Vector2i(b - f))) {
+    g.across = pb - *q;
+  }
+  for (int side = 0; side < 2; ++side) {
+    const Eigen::Vector2i s = side == 0 ? f : Eigen::Vector2i(-f);
+    const Eigen::Vector2d* qa = PointAt(lattice, a + s);
+    const Eigen::Vector2d* qb = PointAt(lattice, b + s);
+    if (qa != nullptr && qb != nullptr) {
+      g.centre[side] = 0.25 * (pa + pb + *qa + *qb);
+    } else {
+      g.centre[side] = g.mid + (side == 0 ? 0.5 : -0.5) * g.across;
+    }
+  }
+  return g;
+}
+
+// Samples the two tiles and the disc of one edge: fills edge->confidence and
+// edge->read; `dark_side` gets 0 when the tile on side +f is the darker one,
+// 1 when the one on side -f is, -1 when the tiles could not be compared.
+void SampleEdge(const Sampler& sampler, const EdgeGeometry& g,
+                const EdgeBitOptions& options, EdgeBit* edge, int* dark_side) {
+  *dark_side = -1;
+  double level[2] = {0.0, 0.0};
+  bool ok = SampleStencil(sampler, g.centre[0], g.along, g.across,
+                          options.tile_sample_offset, &level[0]) &&
+            SampleStencil(sampler, g.centre[1], g.along, g.across,
+                          options.tile_sample_offset, &level[1]);
+  double disc = 0.0;
+  if (ok) {
+    const double o = options.disc_sample_offset;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    ok = sampler.Sample(g.mid, &s0) &&
+         sampler.Sample(g.mid + o * g.along, &s1) &&
+         sampler.Sample(g.mid - o * g.along, &s2);
+    disc = (s0 + s1 + s2) / 3.0;
+  }
+  const double contrast = std::abs(level[0] - level[1]);
+  if (ok && contrast >= options.min_tile_contrast && contrast > 0.0) {
+    const double mid_level = 0.5 * (level[0] + level[1]);
+    edge->confidence =
+        std::clamp((disc - mid_level) / (0.5 * contrast), -1.0, 1.0);
+    edge->read = std::abs(edge->confidence) >= options.min_confidence;
+    *dark_side = level[0] < level[1] ? 0 : 1;
+  }
+}
+
+}  // namespace
+
 EdgeBitReading ReadEdgeBits(const LabelLattice& lattice, const cv::Mat& image,
                             const EdgeBitOptions& options) {
   EdgeBitReading reading;
   if (image.empty() || image.channels() != 1) return reading;
   const Sampler sampler(image);
-  auto point = [&lattice](const Eigen::Vector2i& ij) -> const Eigen::Vector2d* {
-    const int k = lattice.At(ij);
-    return k < 0 ? nullptr : &lattice.xy[k];
-  };
   int parity_votes[2] = {0, 0};
   reading.edges.reserve(2 * lattice.xy.size());
   for (size_t k = 0; k < lattice.xy.size(); ++k) {
@@ -242,74 +338,20 @@ EdgeBitReading ReadEdgeBits(const LabelLattice& lattice, const cv::Mat& image,
           axis == 0 ? Eigen::Vector2i(1, 0) : Eigen::Vector2i(0, 1);
       const Eigen::Vector2i f =
           axis == 0 ? Eigen::Vector2i(0, 1) : Eigen::Vector2i(1, 0);
-      const Eigen::Vector2i b = a + e;
-      const Eigen::Vector2d* pb = point(b);
+      const Eigen::Vector2d* pb = PointAt(lattice, a + e);
       if (pb == nullptr) continue;
-      const Eigen::Vector2d& pa = lattice.xy[k];
       EdgeBit edge;
       edge.from = a;
       edge.axis = axis;
-      // Edge midpoint by Lagrange interpolation at t = 1/2 through the
-      // corners at t = -1, 0, 1, 2 along the lattice line.
-      const Eigen::Vector2d* before = point(a - e);
-      const Eigen::Vector2d* after = point(b + e);
-      Eigen::Vector2d mid;
-      if (before != nullptr && after != nullptr) {
-        mid = (9.0 * (pa + *pb) - *before - *after) / 16.0;
-      } else if (before != nullptr) {
-        mid = -0.125 * *before + 0.75 * pa + 0.375 * *pb;
-      } else if (after != nullptr) {
-        mid = 0.375 * pa + 0.75 * *pb - 0.125 * *after;
-      } else {
-        mid = 0.5 * (pa + *pb);
-      }
-      const Eigen::Vector2d along = *pb - pa;
-      // Tile centres on both sides: the mean of the tile's four corners when
-      // all are labelled, else half a lattice step across from the midpoint.
-      Eigen::Vector2d across(-along.y(), along.x());
-      if (const Eigen::Vector2d* q = point(Eigen::Vector2i(a + f))) {
-        across = *q - pa;
-      } else if (const Eigen::Vector2d* q = point(Eigen::Vector2i(b + f))) {
-        across = *q - *pb;
-      } else if (const Eigen::Vector2d* q = point(Eigen::Vector2i(a - f))) {
-        across = pa - *q;
-      } else if (const Eigen::Vector2d* q = point(Eigen::Vector2i(b - f))) {
-        across = *pb - *q;
-      }
-      Eigen::Vector2d centre[2];  // [0]: side +f, [1]: side -f
-      for (int side = 0; side < 2; ++side) {
-        const Eigen::Vector2i g = side == 0 ? f : Eigen::Vector2i(-f);
-        const Eigen::Vector2d* qa = point(a + g);
-        const Eigen::Vector2d* qb = point(b + g);
-        if (qa != nullptr && qb != nullptr) {
-          centre[side] = 0.25 * (pa + *pb + *qa + *qb);
-        } else {
-          centre[side] = mid + (side == 0 ? 0.5 : -0.5) * across;
-        }
-      }
-      double level[2] = {0.0, 0.0};
-      bool ok = SampleStencil(sampler, centre[0], along, across,
-                              options.tile_sample_offset, &level[0]) &&
-                SampleStencil(sampler, centre[1], along, across,
-                              options.tile_sample_offset, &level[1]);
-      double disc = 0.0;
-      if (ok) {
-        const double o = options.disc_sample_offset;
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-        ok = sampler.Sample(mid, &s0) && sampler.Sample(mid + o * along, &s1) &&
-             sampler.Sample(mid - o * along, &s2);
-        disc = (s0 + s1 + s2) / 3.0;
-      }
-      const double contrast = std::abs(level[0] - level[1]);
-      if (ok && contrast >= options.min_tile_contrast && contrast > 0.0) {
-        const double mid_level = 0.5 * (level[0] + level[1]);
-        edge.confidence =
-            std::clamp((disc - mid_level) / (0.5 * contrast), -1.0, 1.0);
-        edge.read = std::abs(edge.confidence) >= options.min_confidence;
+      const EdgeGeometry g =
+          EdgeSamplePoints(lattice, a, e, f, lattice.xy[k], *pb);
+      int dark_side;
+      SampleEdge(sampler, g, options, &edge, &dark_side);
+      if (dark_side >= 0) {
         // The tile on side +f has min corner a (axis 0: tile (i, j); axis 1:
         // tile (i, j)) and the one on side -f has min corner a - f.
         const Eigen::Vector2i dark_tile =
-            level[0] < level[1] ? a : Eigen::Vector2i(a - f);
+            dark_side == 0 ? a : Eigen::Vector2i(a - f);
         ++parity_votes[(dark_tile.x() + dark_tile.y()) & 1];
       }
       if (edge.read) ++reading.num_read;

@@ -32,26 +32,26 @@ bool PassesCornerMask(const cv::Mat& image, int x, int y) {
   return junction > edge;
 }
 
-RingMeasure MeasureRing(const cv::Mat& image, double x, double y, double radius,
-                        int samples) {
+RingSampler::RingSampler(int samples)
+    : samples_(std::clamp(samples / 4 * 4, 8, 64)) {
+  const double step = 2.0 * M_PI / samples_;
+  for (int i = 0; i < samples_; ++i) {
+    cos_[i] = std::cos(i * step);
+    sin_[i] = std::sin(i * step);
+  }
+}
+
+RingMeasure RingSampler::Measure(const cv::Mat& image, double x, double y,
+                                 double radius) const {
   RingMeasure m;
-  samples = std::clamp(samples / 4 * 4, 8, 64);
   if (!(x - radius >= 0.0 && y - radius >= 0.0 &&
         x + radius < image.cols - 1.0 && y + radius < image.rows - 1.0)) {
     return m;
   }
   m.inside = true;
-  // Unit circle offsets, computed once per sample count.
-  static thread_local int table_samples = 0;
-  static thread_local double table_cos[64], table_sin[64];
-  const double step = 2.0 * M_PI / samples;
-  if (table_samples != samples) {
-    for (int i = 0; i < samples; ++i) {
-      table_cos[i] = std::cos(i * step);
-      table_sin[i] = std::sin(i * step);
-    }
-    table_samples = samples;
-  }
+  const int samples = samples_;
+  const double* table_cos = cos_;
+  const double* table_sin = sin_;
   float v[64];
   double mean = 0.0;
   for (int i = 0; i < samples; ++i) {
@@ -83,6 +83,11 @@ RingMeasure MeasureRing(const cv::Mat& image, double x, double y, double radius,
       even_energy > 0.0 ? 0.5 * amplitude * amplitude / (even_energy / half)
                         : 0.0;
   return m;
+}
+
+RingMeasure MeasureRing(const cv::Mat& image, double x, double y, double radius,
+                        int samples) {
+  return RingSampler(samples).Measure(image, x, y, radius);
 }
 
 }  // namespace puzzlecal

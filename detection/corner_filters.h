@@ -39,8 +39,26 @@ struct RingMeasure {
   double centre_offset = 0.0;
 };
 
-// Samples `samples` (a multiple of 4, at most 64) points on the circle of
-// `radius` around (x, y) of `image` (CV_32FC1, bilinear).
+// The ring test's sampler: the unit-circle offsets of `samples` points
+// (clamped to a multiple of 4 in 8..64), computed once and shared by every
+// measurement.
+class RingSampler {
+ public:
+  explicit RingSampler(int samples);
+
+  // Samples the circle of `radius` around (x, y) of `image` (CV_32FC1,
+  // bilinear).
+  RingMeasure Measure(const cv::Mat& image, double x, double y,
+                      double radius) const;
+
+ private:
+  int samples_;
+  double cos_[64];
+  double sin_[64];
+};
+
+// One measurement with a sampler of `samples` points (a multiple of 4, at
+// most 64) made for it.
 RingMeasure MeasureRing(const cv::Mat& image, double x, double y, double radius,
                         int samples);
 

@@ -10,97 +10,120 @@
 #include "detection/corner_filters.h"
 #include "detection/hessian_response.h"
 #include "detection/subpixel.h"
+#include "detection/vector_clones.h"
 
 namespace puzzlecal {
 
+namespace {
+
+// The first preprocessing, pyramid, response and suppression field out of
+// range, or nullptr.
+const char* PyramidResponseError(const DetectorOptions& o) {
+  if (!(o.blur_sigma_px >= 0.0 && o.blur_sigma_px <= 20.0)) {
+    return "blur_sigma_px must be in [0, 20]";
+  }
+  if (o.num_levels < 1 || o.num_levels > 6) return "num_levels must be 1..6";
+  if (o.first_level < 0 || o.first_level >= o.num_levels) {
+    return "first_level must be in [0, num_levels)";
+  }
+  if (!(o.trace_weight_k >= 0.0 && std::isfinite(o.trace_weight_k))) {
+    return "trace_weight_k must be >= 0";
+  }
+  if (!(o.min_response > 0.0 && std::isfinite(o.min_response))) {
+    return "min_response must be > 0";
+  }
+  if (!(o.noise_response_factor >= 0.0 &&
+        std::isfinite(o.noise_response_factor))) {
+    return "noise_response_factor must be >= 0";
+  }
+  if (o.nms_radius_px < 1 || o.nms_radius_px > 50) {
+    return "nms_radius_px must be in [1, 50]";
+  }
+  if (o.nms_radius_coarse_px < 1 || o.nms_radius_coarse_px > 50) {
+    return "nms_radius_coarse_px must be in [1, 50]";
+  }
+  return nullptr;
+}
+
+// The first candidate filters field out of range, or nullptr.
+const char* FilterError(const DetectorOptions& o) {
+  if (!(o.ring_radius_px >= 1.5 && o.ring_radius_px <= 20.0)) {
+    return "ring_radius_px must be in [1.5, 20]";
+  }
+  if (o.ring_samples < 8 || o.ring_samples > 64 || o.ring_samples % 4 != 0) {
+    return "ring_samples must be a multiple of 4 in [8, 64]";
+  }
+  if (!(o.min_ring_contrast >= 0.0)) return "min_ring_contrast must be >= 0";
+  if (!(o.max_ring_asymmetry > 0.0)) return "max_ring_asymmetry must be > 0";
+  if (!(o.min_contrast_factor_clean >= 1.0)) {
+    return "min_contrast_factor_clean must be >= 1";
+  }
+  if (!(o.max_ring_asymmetry_clean > 0.0)) {
+    return "max_ring_asymmetry_clean must be > 0";
+  }
+  if (!(o.min_ring_second_harmonic_clean >= 0.0 &&
+        o.min_ring_second_harmonic_clean <= 1.0)) {
+    return "min_ring_second_harmonic_clean must be in [0, 1]";
+  }
+  if (!(o.min_ring_second_harmonic >= 0.0 &&
+        o.min_ring_second_harmonic <= 1.0)) {
+    return "min_ring_second_harmonic must be in [0, 1]";
+  }
+  if (!(o.ring_noise_factor >= 0.0 && std::isfinite(o.ring_noise_factor))) {
+    return "ring_noise_factor must be >= 0";
+  }
+  if (!(o.max_ring_centre_offset > 0.0)) {
+    return "max_ring_centre_offset must be > 0";
+  }
+  return nullptr;
+}
+
+// The first sub-pixel refinement and orientation field out of range, or
+// nullptr.
+const char* RefinementError(const DetectorOptions& o) {
+  if (!(o.window_fraction_of_neighbor > 0.0 &&
+        o.window_fraction_of_neighbor <= 1.0)) {
+    return "window_fraction_of_neighbor must be in (0, 1]";
+  }
+  if (o.min_window_px < 2 || o.max_window_px > 64 ||
+      o.min_window_px > o.max_window_px) {
+    return "need 2 <= min_window_px <= max_window_px <= 64";
+  }
+  if (!(o.saddle_sigma_fraction > 0.0 && o.saddle_sigma_fraction <= 1.0)) {
+    return "saddle_sigma_fraction must be in (0, 1]";
+  }
+  if (!(o.min_saddle_sigma_px >= 0.5 &&
+        o.min_saddle_sigma_px <= o.max_saddle_sigma_px &&
+        o.max_saddle_sigma_px <= 16.0)) {
+    return "need 0.5 <= min_saddle_sigma_px <= max_saddle_sigma_px <= 16";
+  }
+  if (o.saddle_max_iterations < 1 || o.saddle_max_iterations > 100) {
+    return "saddle_max_iterations must be in [1, 100]";
+  }
+  if (!(o.saddle_convergence_px > 0.0)) {
+    return "saddle_convergence_px must be > 0";
+  }
+  if (o.max_iterations < 1 || o.max_iterations > 100) {
+    return "max_iterations must be in [1, 100]";
+  }
+  if (!(o.convergence_px > 0.0)) return "convergence_px must be > 0";
+  if (!(o.max_shift_fraction > 0.0)) return "max_shift_fraction must be > 0";
+  if (!(o.merge_distance_px >= 0.0)) return "merge_distance_px must be >= 0";
+  if (!(o.orientation_spacing_fraction > 0.0)) {
+    return "orientation_spacing_fraction must be > 0";
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 bool DetectorOptions::Check(std::string* why) const {
-  auto fail = [why](const char* text) {
-    if (why != nullptr) *why = text;
-    return false;
-  };
-  if (!(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0)) {
-    return fail("blur_sigma_px must be in [0, 20]");
-  }
-  if (num_levels < 1 || num_levels > 6) return fail("num_levels must be 1..6");
-  if (first_level < 0 || first_level >= num_levels) {
-    return fail("first_level must be in [0, num_levels)");
-  }
-  if (!(trace_weight_k >= 0.0 && std::isfinite(trace_weight_k))) {
-    return fail("trace_weight_k must be >= 0");
-  }
-  if (!(min_response > 0.0 && std::isfinite(min_response))) {
-    return fail("min_response must be > 0");
-  }
-  if (!(noise_response_factor >= 0.0 && std::isfinite(noise_response_factor))) {
-    return fail("noise_response_factor must be >= 0");
-  }
-  if (nms_radius_px < 1 || nms_radius_px > 50) {
-    return fail("nms_radius_px must be in [1, 50]");
-  }
-  if (nms_radius_coarse_px < 1 || nms_radius_coarse_px > 50) {
-    return fail("nms_radius_coarse_px must be in [1, 50]");
-  }
-  if (!(ring_radius_px >= 1.5 && ring_radius_px <= 20.0)) {
-    return fail("ring_radius_px must be in [1.5, 20]");
-  }
-  if (ring_samples < 8 || ring_samples > 64 || ring_samples % 4 != 0) {
-    return fail("ring_samples must be a multiple of 4 in [8, 64]");
-  }
-  if (!(min_ring_contrast >= 0.0))
-    return fail("min_ring_contrast must be >= 0");
-  if (!(max_ring_asymmetry > 0.0))
-    return fail("max_ring_asymmetry must be > 0");
-  if (!(min_contrast_factor_clean >= 1.0)) {
-    return fail("min_contrast_factor_clean must be >= 1");
-  }
-  if (!(max_ring_asymmetry_clean > 0.0)) {
-    return fail("max_ring_asymmetry_clean must be > 0");
-  }
-  if (!(min_ring_second_harmonic_clean >= 0.0 &&
-        min_ring_second_harmonic_clean <= 1.0)) {
-    return fail("min_ring_second_harmonic_clean must be in [0, 1]");
-  }
-  if (!(min_ring_second_harmonic >= 0.0 && min_ring_second_harmonic <= 1.0)) {
-    return fail("min_ring_second_harmonic must be in [0, 1]");
-  }
-  if (!(ring_noise_factor >= 0.0 && std::isfinite(ring_noise_factor))) {
-    return fail("ring_noise_factor must be >= 0");
-  }
-  if (!(max_ring_centre_offset > 0.0)) {
-    return fail("max_ring_centre_offset must be > 0");
-  }
-  if (!(window_fraction_of_neighbor > 0.0 &&
-        window_fraction_of_neighbor <= 1.0)) {
-    return fail("window_fraction_of_neighbor must be in (0, 1]");
-  }
-  if (min_window_px < 2 || max_window_px > 64 ||
-      min_window_px > max_window_px) {
-    return fail("need 2 <= min_window_px <= max_window_px <= 64");
-  }
-  if (!(saddle_sigma_fraction > 0.0 && saddle_sigma_fraction <= 1.0)) {
-    return fail("saddle_sigma_fraction must be in (0, 1]");
-  }
-  if (!(min_saddle_sigma_px >= 0.5 &&
-        min_saddle_sigma_px <= max_saddle_sigma_px &&
-        max_saddle_sigma_px <= 16.0)) {
-    return fail("need 0.5 <= min_saddle_sigma_px <= max_saddle_sigma_px <= 16");
-  }
-  if (saddle_max_iterations < 1 || saddle_max_iterations > 100) {
-    return fail("saddle_max_iterations must be in [1, 100]");
-  }
-  if (!(saddle_convergence_px > 0.0)) {
-    return fail("saddle_convergence_px must be > 0");
-  }
-  if (max_iterations < 1 || max_iterations > 100) {
-    return fail("max_iterations must be in [1, 100]");
-  }
-  if (!(convergence_px > 0.0)) return fail("convergence_px must be > 0");
-  if (!(max_shift_fraction > 0.0))
-    return fail("max_shift_fraction must be > 0");
-  if (!(merge_distance_px >= 0.0))
-    return fail("merge_distance_px must be >= 0");
-  if (!(orientation_spacing_fraction > 0.0)) {
-    return fail("orientation_spacing_fraction must be > 0");
+  for (const char* error : {PyramidResponseError(*this), FilterError(*this),
+                            RefinementError(*this)}) {
+    if (error != nullptr) {
+      if (why != nullptr) *why = error;
+      return false;
+    }
   }
   return true;
 }
@@ -119,18 +142,6 @@ struct Clock {
 };
 
 double MsSince(Clock::time_point start) { return Clock::now() - start; }
-
-// Buffers reused by consecutive calls on one thread (same-size images then
-// cause no allocation and no page faults).
-struct Workspace {
-  cv::Mat single;                // one-channel input (colour converted)
-  cv::Mat finite;                // float input with non-finite pixels zeroed
-  std::vector<cv::Mat> blurred;  // per level, CV_32FC1, grey in [0, 1]
-  std::vector<float> response_rows;  // ring of response rows
-  std::vector<float> row;            // one row of the downsampling
-  cv::Mat band;                      // blurred rows of a band of level 0
-  std::vector<float> scratch;
-};
 
 // Largest pixel value of a one-channel image (a loop the compiler
 // vectorises; cv::minMaxLoc also tracks locations).
@@ -167,8 +178,10 @@ double MaxValue(const cv::Mat& image) {
 // [i0, i1) of `dst` (already of the output size) from `src`, which holds
 // input rows [src_first, src_first + src.rows) of an image `height` rows
 // high; the input rows 2 i - 1 .. 2 i + 1 (clamped) must be in `src`.
-void DownsampleRows(const cv::Mat& src, int src_first, int height, int i0,
-                    int i1, std::vector<float>* row, cv::Mat* dst) {
+PUZZLECAL_VECTOR_CLONES void DownsampleRows(const cv::Mat& src, int src_first,
+                                            int height, int i0, int i1,
+                                            std::vector<float>* row,
+                                            cv::Mat* dst) {
   const int width = src.cols;
   const int out_width = dst->cols;
   row->resize(width);
@@ -185,7 +198,13 @@ void DownsampleRows(const cv::Mat& src, int src_first, int height, int i0,
     }
     float* __restrict out = dst->ptr<float>(i);
     out[0] = 0.25f * (3.0f * tmp[0] + (width > 1 ? tmp[1] : tmp[0]));
-    for (int j = 1; j < out_width; ++j) {
+    // Interior outputs (2 j + 1 inside the row) without clamping, so the
+    // loop vectorises; the last one or two clamp at the border.
+    const int interior_end = std::min(out_width, std::max(1, width / 2));
+    for (int j = 1; j < interior_end; ++j) {
+      out[j] = 0.25f * (tmp[2 * j - 1] + 2.0f * tmp[2 * j] + tmp[2 * j + 1]);
+    }
+    for (int j = interior_end; j < out_width; ++j) {
       const int x = 2 * j;
       out[j] = 0.25f * (tmp[x - 1] + 2.0f * tmp[std::min(x, width - 1)] +
                         tmp[std::min(x + 1, width - 1)]);
@@ -203,18 +222,20 @@ constexpr float kMaxFloatPixel = 1e6f;
 
 // Picks the one-channel, finite version of the input and the grey value
 // that maps to 1.0. Returns false with a reason for unsupported types.
-bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
-                  const cv::Mat** single, double* normalizer,
-                  std::string* why) {
+// `converted` and `finite` are the buffers of a colour conversion and of
+// the cleaned float copy.
+bool PrepareInput(const cv::Mat& image, bool normalize_by_max,
+                  cv::Mat* converted, cv::Mat* finite, const cv::Mat** single,
+                  double* normalizer, std::string* why) {
   if (image.channels() == 1) {
     *single = &image;
   } else if ((image.channels() == 3 || image.channels() == 4) &&
              (image.depth() == CV_8U || image.depth() == CV_16U ||
               image.depth() == CV_32F)) {
     cv::cvtColor(
-        image, ws->single,
+        image, *converted,
         image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
-    *single = &ws->single;
+    *single = converted;
   } else {
     *why = "unsupported number of channels";
     return false;
@@ -238,10 +259,10 @@ bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
     // Non-finite pixels become 0, and magnitudes are capped at
     // kMaxFloatPixel: the response multiplies four second derivatives, which
     // would overflow float for values near its range.
-    (*single)->copyTo(ws->finite);
-    for (int y = 0; y < ws->finite.rows; ++y) {
-      float* row = ws->finite.ptr<float>(y);
-      for (int x = 0; x < ws->finite.cols; ++x) {
+    (*single)->copyTo(*finite);
+    for (int y = 0; y < finite->rows; ++y) {
+      float* row = finite->ptr<float>(y);
+      for (int x = 0; x < finite->cols; ++x) {
         if (!std::isfinite(row[x])) {
           row[x] = 0.0f;
         } else {
@@ -249,7 +270,7 @@ bool PrepareInput(const cv::Mat& image, bool normalize_by_max, Workspace* ws,
         }
       }
     }
-    *single = &ws->finite;
+    *single = finite;
   }
   double scale = full_scale;
   if (normalize_by_max) {
@@ -358,381 +379,112 @@ class PointGrid {
   std::vector<std::vector<int>> cells_;
 };
 
+// A level-0 peak above the absolute threshold, kept until the
+// noise-adaptive threshold (known only after the whole level) decides.
+struct Level0Peak {
+  float value;    // the response (product form)
+  bool masked;    // passed the corner mask
+  int candidate;  // index into the candidates, -1 when filtered out
+};
+
 }  // namespace
 
-std::vector<Corner> DetectCorners(const cv::Mat& image,
-                                  const DetectorOptions& options,
-                                  DetectorSummary* summary) {
-  DetectorSummary local_summary;
-  DetectorSummary& s = summary != nullptr ? *summary : local_summary;
-  s = DetectorSummary();
-  const Clock::time_point t_start = Clock::now();
-  std::vector<Corner> corners;
-  std::string why;
-  if (!options.Check(&why)) {
-    s.message = "invalid detector options: " + why;
-    return corners;
-  }
-  if (image.empty()) {
-    s.message = "empty image";
-    return corners;
-  }
-  if (image.dims != 2) {
-    s.message = "image is not two-dimensional";
-    return corners;
-  }
-  s.width = image.cols;
-  s.height = image.rows;
-  constexpr int kMinSide = 8;
-  if (image.cols < kMinSide || image.rows < kMinSide) {
-    s.ok = true;
-    s.message = "image smaller than 8x8 pixels: no corners";
-    return corners;
-  }
+// Buffers of one detection, kept between the images of a CornerDetector
+// (same-size images then cause no allocation and no page faults).
+struct CornerDetector::Buffers {
+  explicit Buffers(int ring_samples) : ring(ring_samples) {}
 
-  // --- preprocessing ---
-  Clock::time_point t = Clock::now();
-  static thread_local Workspace ws;
-  const cv::Mat* single = nullptr;
-  if (!PrepareInput(image, options.normalize_by_max, &ws, &single,
-                    &s.normalizer, &why)) {
-    s.message = why;
-    return corners;
-  }
-  std::vector<cv::Mat>& blurred = ws.blurred;
-  blurred.resize(options.num_levels);
-  // Grey rows [a, b) of the input, normalised and blurred, into `out`: one
-  // separable pass from the input type straight to float, with the
-  // normalisation folded into the kernel. On a band the filter reads the
-  // input rows around it, so a band equals those rows of the whole image.
-  cv::Mat kernel, kernel_scaled;
-  if (options.blur_sigma_px > 0.0) {
-    const int ksize =
-        2 * static_cast<int>(std::ceil(2.0 * options.blur_sigma_px)) + 1;
-    kernel = cv::getGaussianKernel(ksize, options.blur_sigma_px, CV_32F);
-    kernel_scaled = kernel * (1.0 / s.normalizer);
-  }
-  auto blur_rows = [&](int a, int b, cv::Mat* out) {
-    const cv::Mat band = single->rowRange(a, b);
-    if (options.blur_sigma_px > 0.0) {
-      cv::sepFilter2D(band, *out, CV_32F, kernel_scaled, kernel,
-                      cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
-    } else {
-      band.convertTo(*out, CV_32F, 1.0 / s.normalizer);
-    }
-  };
+  RingSampler ring;              // circle offsets of the ring test
+  cv::Mat single;                // one-channel input (colour converted)
+  cv::Mat finite;                // float input with non-finite pixels zeroed
+  std::vector<cv::Mat> blurred;  // per level, CV_32FC1, grey in [0, 1]
+  cv::Mat band;                  // blurred rows of a band of level 0
+  std::vector<float> response_rows;  // ring of response rows
+  std::vector<float> row;            // one row of the downsampling
+  std::vector<float> scratch;        // response and noise samples
+  std::vector<ResponsePeak> peaks;   // of one band or one level
+  GradientRefineScratch gradient;    // gradient-orthogonality patches
+};
+
+namespace {
+
+constexpr int kMinSide = 8;      // smaller images (and levels) have no corners
+constexpr int kBandRows = 64;    // level-0 rows streamed at a time
+constexpr int kMedianStep = 12;  // sampling of the noise-adaptive threshold
+
+// One detection in one image: the stages in order (input checks,
+// preprocessing, per level response + suppression + filters, merging the
+// levels, sub-pixel refinement, duplicate removal, final order), sharing
+// the options, the buffers, the summary and what earlier stages found.
+class DetectionPass {
+ public:
+  DetectionPass(const DetectorOptions& options,
+                CornerDetector::Buffers* buffers, DetectorSummary* summary)
+      : options_(options), b_(*buffers), s_(*summary) {}
+
+  std::vector<Corner> Run(const cv::Mat& image);
+
+ private:
+  bool AcceptInput(const cv::Mat& image);
+  bool Preprocess(const cv::Mat& image);
+  int CountLevels() const;
+  void MakeBlurKernels();
+  void BuildCoarseLevels();
+  void BlurRows(int a, int b, cv::Mat* out) const;
+
+  void DetectLevel0Streamed();
+  void DetectBand(int y0, int y1, int halo, std::vector<Level0Peak>* kept);
+  void ApplyLevel0Threshold(const std::vector<Level0Peak>& kept);
+  void DetectLevel(int level);
+  bool FilterPeak(const cv::Mat& level_image, int y_offset,
+                  const ResponsePeak& peak, int level, bool* masked);
+  bool PassesRingTest(const RingMeasure& ring) const;
+  Candidate MakeCandidate(const ResponsePeak& peak, int y_offset,
+                          int level) const;
+
+  std::vector<Candidate> MergeLevels() const;
+  std::vector<Corner> Refine(const std::vector<Candidate>& merged,
+                             std::vector<int>* windows);
+  bool RefineOne(const Candidate& c, double nearest, Corner* corner,
+                 int* window) const;
+  std::vector<Corner> DropDuplicates(const std::vector<Corner>& refined,
+                                     const std::vector<int>& windows);
+
+  const DetectorOptions& options_;
+  CornerDetector::Buffers& b_;
+  DetectorSummary& s_;
+  int width_ = 0;
+  int height_ = 0;
+  const cv::Mat* single_ = nullptr;  // one-channel, finite input
+  cv::Mat kernel_;                   // Gaussian blur (empty: no blur)
+  cv::Mat kernel_scaled_;            // the same divided by the normalizer
+  int levels_ = 1;                   // pyramid levels that exist
   // Level 0 is streamed in bands of rows (blur, response, suppression,
   // filters and the next level's rows while the band is in cache) unless a
   // later step needs the whole blurred image (gradient orthogonality and
   // the circle orientation of the other refinements).
-  const bool stream_level0 = options.first_level == 0 &&
-                             options.subpixel == SubpixelMethod::kSaddleFit;
-  int levels = 1;
-  for (int l = 1; l < options.num_levels; ++l) {
-    const int rows = l == 1 ? image.rows : blurred[l - 1].rows;
-    const int cols = l == 1 ? image.cols : blurred[l - 1].cols;
-    if (cols < 2 * kMinSide || rows < 2 * kMinSide) break;
-    levels = l + 1;
+  bool stream_level0_ = false;
+  double min_contrast_ = 0.0;          // of the ring test, from the pixel noise
+  std::vector<Candidate> candidates_;  // verified, ordered by level
+};
+
+std::vector<Corner> DetectionPass::Run(const cv::Mat& image) {
+  const Clock::time_point t_start = Clock::now();
+  if (!AcceptInput(image) || !Preprocess(image)) return {};
+  if (stream_level0_) {
+    DetectLevel0Streamed();  // also writes level 1
+    BuildCoarseLevels();
   }
-  if (!stream_level0) {
-    blur_rows(0, image.rows, &blurred[0]);
-    for (int l = 1; l < levels; ++l) {
-      Downsample(blurred[l - 1], &ws.row, &blurred[l]);
-    }
-  } else if (levels > 1) {
-    blurred[1].create((image.rows + 1) / 2, (image.cols + 1) / 2, CV_32FC1);
+  for (int l = stream_level0_ ? 1 : options_.first_level; l < levels_; ++l) {
+    DetectLevel(l);
   }
-  s.levels_used = std::max(0, levels - options.first_level);
-  // Pixel noise of the input, grey normalised to [0, 1].
-  const double noise = options.ring_noise_factor > 0.0
-                           ? NoiseSigma(*single, 11, &ws.scratch) / s.normalizer
-                           : 0.0;
-  s.noise_sigma = noise;
-  s.ms_preprocess = MsSince(t);
-
-  // --- per level: response, threshold, NMS, filters ---
-  std::vector<Candidate> candidates;
-  std::vector<float>& scratch = ws.scratch;
-  std::vector<ResponsePeak> peaks;
-  const float k = static_cast<float>(options.trace_weight_k);
-  const double min_contrast =
-      std::max(options.min_ring_contrast, options.ring_noise_factor * noise);
-  constexpr int kMedianStep = 12;  // sampling of the noise-adaptive threshold
-  // The corner mask and the ring test on `level_image` (rows offset by
-  // `y_offset` from the level's first row); appends a candidate in
-  // full-resolution pixels when the peak passes.
-  auto filter_peak = [&](const cv::Mat& level_image, int y_offset,
-                         const ResponsePeak& peak, int l, bool* masked) {
-    *masked = false;
-    if (options.use_corner_mask &&
-        !PassesCornerMask(level_image, peak.x, peak.y)) {
-      return false;
-    }
-    *masked = true;
-    if (options.use_ring_test) {
-      const RingMeasure ring =
-          MeasureRing(level_image, peak.centroid_x, peak.centroid_y,
-                      options.ring_radius_px, options.ring_samples);
-      const bool passes =
-          ring.inside && ring.contrast >= min_contrast &&
-          (ring.asymmetry <= options.max_ring_asymmetry ||
-           (ring.asymmetry <= options.max_ring_asymmetry_clean &&
-            ring.second_harmonic_share >=
-                options.min_ring_second_harmonic_clean &&
-            ring.contrast >=
-                options.min_contrast_factor_clean * min_contrast)) &&
-          ring.second_harmonic_share >= options.min_ring_second_harmonic &&
-          ring.centre_offset <= options.max_ring_centre_offset;
-      if (!passes) return false;
-    }
-    const double scale = std::ldexp(1.0, l);
-    Candidate c;
-    c.level = l;
-    c.peak_x = peak.x;
-    c.peak_y = peak.y + y_offset;
-    c.response = std::sqrt(peak.value);
-    c.xy = Eigen::Vector2d(peak.x * scale, c.peak_y * scale);
-    // The centroid is also the start of the iterative refinements (closer
-    // than the integer peak: fewer iterations).
-    if (options.subpixel != SubpixelMethod::kNone) {
-      c.xy =
-          Eigen::Vector2d(peak.centroid_x, peak.centroid_y + y_offset) * scale;
-    }
-    candidates.push_back(c);
-    return true;
-  };
-
-  if (stream_level0) {
-    // Peaks above the absolute threshold per band, filtered while the band
-    // is in cache; the noise-adaptive threshold (from the response sampled
-    // on the way) then only drops weak peaks: a peak of the whole image is
-    // a peak above the lower threshold that exceeds the higher one.
-    constexpr int kBand = 64;
-    // Rows around a band: response (2) + suppression radius + ring test.
-    const int halo =
-        2 + std::max(options.nms_radius_px,
-                     static_cast<int>(std::ceil(options.ring_radius_px)) + 2);
-    struct Kept {
-      float value;
-      bool masked;
-      int candidate;  // index into candidates, -1 when filtered out
-    };
-    std::vector<Kept> kept;
-    scratch.clear();
-    const float absolute =
-        static_cast<float>(options.min_response * options.min_response);
-    for (int y0 = 0; y0 < image.rows; y0 += kBand) {
-      t = Clock::now();
-      const int y1 = std::min(y0 + kBand, image.rows);
-      const int a = std::max(0, y0 - halo);
-      const int b = std::min(image.rows, y1 + halo);
-      blur_rows(a, b, &ws.band);
-      if (levels > 1) {
-        DownsampleRows(ws.band, a, image.rows, (y0 + 1) / 2, (y1 + 1) / 2,
-                       &ws.row, &blurred[1]);
-      }
-      s.ms_preprocess += MsSince(t);
-
-      t = Clock::now();
-      PeakRows part;
-      part.begin = y0 - a;
-      part.end = y1 - a;
-      part.y_offset = a;
-      part.sample_step = kMedianStep;
-      part.samples = options.noise_response_factor > 0.0 ? &scratch : nullptr;
-      peaks.clear();
-      s.candidates +=
-          FindSaddlePeaksInRows(ws.band, k, absolute, options.nms_radius_px,
-                                part, &ws.response_rows, &peaks);
-      s.ms_response += MsSince(t);
-
-      t = Clock::now();
-      for (const ResponsePeak& peak : peaks) {
-        const size_t before = candidates.size();
-        bool masked = false;
-        const bool passed = filter_peak(ws.band, a, peak, 0, &masked);
-        kept.push_back(
-            {peak.value, masked, passed ? static_cast<int>(before) : -1});
-      }
-      s.ms_filter += MsSince(t);
-    }
-    t = Clock::now();
-    double threshold = options.min_response;
-    if (options.noise_response_factor > 0.0 && !scratch.empty()) {
-      auto middle = scratch.begin() + scratch.size() / 2;
-      std::nth_element(scratch.begin(), middle, scratch.end());
-      threshold = std::max(threshold,
-                           options.noise_response_factor * std::sqrt(*middle));
-    }
-    s.threshold = threshold;
-    const float squared = static_cast<float>(threshold * threshold);
-    std::vector<Candidate> strong;
-    for (const Kept& p : kept) {
-      if (!(p.value > squared)) continue;
-      ++s.after_nms;
-      s.after_mask += p.masked ? 1 : 0;
-      if (p.candidate >= 0) {
-        ++s.after_ring;
-        strong.push_back(candidates[p.candidate]);
-      }
-    }
-    candidates = std::move(strong);
-    s.ms_nms += MsSince(t);
-  }
-
-  for (int l = stream_level0 ? 1 : options.first_level; l < levels; ++l) {
-    t = Clock::now();
-    double threshold = options.min_response;
-    if (options.noise_response_factor > 0.0) {
-      const double median =
-          SampledResponseMedian(blurred[l], k, kMedianStep, &scratch);
-      threshold = std::max(threshold,
-                           options.noise_response_factor * std::sqrt(median));
-    }
-    if (l == options.first_level) s.threshold = threshold;
-    s.ms_nms += MsSince(t);
-
-    t = Clock::now();
-    peaks.clear();
-    s.candidates += FindSaddlePeaks(
-        blurred[l], k, static_cast<float>(threshold * threshold),
-        NmsRadius(options, l), &ws.response_rows, &peaks);
-    s.after_nms += static_cast<int>(peaks.size());
-    s.ms_response += MsSince(t);
-
-    t = Clock::now();
-    for (const ResponsePeak& peak : peaks) {
-      bool masked = false;
-      const bool passed = filter_peak(blurred[l], 0, peak, l, &masked);
-      s.after_mask += masked ? 1 : 0;
-      s.after_ring += passed ? 1 : 0;
-    }
-    s.ms_filter += MsSince(t);
-  }
-
-  // --- merge levels (finer levels first), refine at full resolution ---
-  t = Clock::now();
-  std::vector<Candidate> merged;
-  {
-    PointGrid grid(8.0 * NmsRadius(options, 1), image.cols, image.rows);
-    for (const Candidate& c : candidates) {  // already ordered by level
-      const double radius =
-          std::ldexp(1.0, c.level) * NmsRadius(options, c.level);
-      bool taken = false;
-      grid.ForNear(c.xy, radius, [&](int index) {
-        if ((merged[index].xy - c.xy).norm() <= radius) taken = true;
-      });
-      if (taken) continue;
-      grid.Add(c.xy, static_cast<int>(merged.size()));
-      merged.push_back(c);
-    }
-  }
-  s.after_merge_levels = static_cast<int>(merged.size());
-
-  // Window half-size from the distance to the nearest other candidate.
-  const double reach =
-      options.max_window_px / options.window_fraction_of_neighbor;
-  PointGrid neighbours(reach, image.cols, image.rows);
-  for (size_t i = 0; i < merged.size(); ++i) {
-    neighbours.Add(merged[i].xy, static_cast<int>(i));
-  }
-  std::vector<Corner> refined;
-  std::vector<int> refined_window;
-  refined.reserve(merged.size());
-  for (size_t i = 0; i < merged.size(); ++i) {
-    const Candidate& c = merged[i];
-    double nearest = std::numeric_limits<double>::infinity();
-    neighbours.ForNear(c.xy, reach, [&](int index) {
-      if (index == static_cast<int>(i)) return;
-      nearest = std::min(nearest, (merged[index].xy - c.xy).norm());
-    });
-    int window = options.max_window_px;
-    if (std::isfinite(nearest)) {
-      window = static_cast<int>(
-          std::floor(options.window_fraction_of_neighbor * nearest));
-    }
-    window = std::clamp(window, options.min_window_px, options.max_window_px);
-    // Near the image border the window shrinks instead of failing.
-    const int room = static_cast<int>(std::floor(std::min(
-                         {c.xy.x(), c.xy.y(), image.cols - 1.0 - c.xy.x(),
-                          image.rows - 1.0 - c.xy.y()}))) -
-                     2;
-    window = std::max(options.min_window_px, std::min(window, room));
-    Corner corner;
-    corner.xy = c.xy;
-    corner.response = c.response;
-    if (options.subpixel == SubpixelMethod::kGradientOrthogonality) {
-      const GradientRefineResult r = RefineByGradientOrthogonality(
-          blurred[0], c.xy, window, options.max_iterations,
-          options.convergence_px);
-      if (!r.ok || (r.xy - c.xy).norm() > options.max_shift_fraction * window +
-                                              std::ldexp(0.5, c.level)) {
-        ++s.refine_failed;
-        continue;
-      }
-      corner.xy = r.xy;
-    } else if (options.subpixel == SubpixelMethod::kSaddleFit) {
-      double sigma = options.max_saddle_sigma_px;
-      if (std::isfinite(nearest)) {
-        sigma = options.saddle_sigma_fraction * nearest;
-      }
-      sigma = std::clamp(sigma, options.min_saddle_sigma_px,
-                         options.max_saddle_sigma_px);
-      // Near the image border the window shrinks instead of failing.
-      sigma = std::max(options.min_saddle_sigma_px,
-                       std::min(sigma, (room + 1.0) / 3.0));
-      // On the input grey values: the detector's blur would carry the
-      // structures around a corner (PuzzleBoard discs) closer to it.
-      const SaddleRefineResult r = RefineBySaddleFit(
-          *single, c.xy, sigma, options.saddle_max_iterations,
-          options.saddle_convergence_px,
-          options.max_shift_fraction * window + std::ldexp(0.5, c.level));
-      if (!r.ok) {
-        ++s.refine_failed;
-        continue;
-      }
-      corner.xy = r.xy;
-      corner.orientation = r.orientation;
-    }
-    refined.push_back(corner);
-    refined_window.push_back(window);
-  }
-
-  // Merge duplicates (strongest first), then orientation and order.
-  std::vector<int> order(refined.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    return refined[a].response > refined[b].response;
-  });
-  {
-    PointGrid kept_grid(std::max(options.merge_distance_px, 1.0) * 4.0,
-                        image.cols, image.rows);
-    std::vector<Corner> kept_corners;
-    for (int index : order) {
-      const Corner& c = refined[index];
-      bool duplicate = false;
-      kept_grid.ForNear(c.xy, options.merge_distance_px, [&](int k) {
-        if ((kept_corners[k].xy - c.xy).norm() < options.merge_distance_px) {
-          duplicate = true;
-        }
-      });
-      if (duplicate) {
-        ++s.merged_duplicates;
-        continue;
-      }
-      kept_grid.Add(c.xy, static_cast<int>(kept_corners.size()));
-      Corner out = c;
-      if (options.subpixel != SubpixelMethod::kSaddleFit) {
-        out.orientation = HessianOrientation(
-            blurred[0], c.xy,
-            options.orientation_spacing_fraction * refined_window[index]);
-      }
-      kept_corners.push_back(out);
-    }
-    corners = std::move(kept_corners);
-  }
+  const Clock::time_point t = Clock::now();
+  const std::vector<Candidate> merged = MergeLevels();
+  std::vector<int> windows;
+  const std::vector<Corner> refined = Refine(merged, &windows);
+  std::vector<Corner> corners = DropDuplicates(refined, windows);
   // The promise to every caller: finite positions, responses and
-  // orientations, whatever the input held.
+  // orientations, whatever the input held; sorted by y, then x.
   corners.erase(std::remove_if(corners.begin(), corners.end(),
                                [](const Corner& c) {
                                  return !c.xy.allFinite() ||
@@ -745,11 +497,453 @@ std::vector<Corner> DetectCorners(const cv::Mat& image,
               if (a.xy.y() != b.xy.y()) return a.xy.y() < b.xy.y();
               return a.xy.x() < b.xy.x();
             });
-  s.ms_refine = MsSince(t);
-  s.corners = static_cast<int>(corners.size());
-  s.ok = true;
-  s.ms_total = MsSince(t_start);
+  s_.ms_refine = MsSince(t);
+  s_.corners = static_cast<int>(corners.size());
+  s_.ok = true;
+  s_.ms_total = MsSince(t_start);
   return corners;
+}
+
+// False (with the reason in the summary) when there is nothing to detect.
+bool DetectionPass::AcceptInput(const cv::Mat& image) {
+  std::string why;
+  if (!options_.Check(&why)) {
+    s_.message = "invalid detector options: " + why;
+    return false;
+  }
+  if (image.empty()) {
+    s_.message = "empty image";
+    return false;
+  }
+  if (image.dims != 2) {
+    s_.message = "image is not two-dimensional";
+    return false;
+  }
+  s_.width = width_ = image.cols;
+  s_.height = height_ = image.rows;
+  if (image.cols < kMinSide || image.rows < kMinSide) {
+    s_.ok = true;
+    s_.message = "image smaller than 8x8 pixels: no corners";
+    return false;
+  }
+  return true;
+}
+
+// Grey conversion, normalisation, blur and pyramid (level 0 and the first
+// coarse level only when not streamed), pixel noise.
+bool DetectionPass::Preprocess(const cv::Mat& image) {
+  const Clock::time_point t = Clock::now();
+  std::string why;
+  if (!PrepareInput(image, options_.normalize_by_max, &b_.single, &b_.finite,
+                    &single_, &s_.normalizer, &why)) {
+    s_.message = why;
+    return false;
+  }
+  MakeBlurKernels();
+  stream_level0_ = options_.first_level == 0 &&
+                   options_.subpixel == SubpixelMethod::kSaddleFit;
+  levels_ = CountLevels();
+  std::vector<cv::Mat>& blurred = b_.blurred;
+  blurred.resize(options_.num_levels);
+  if (!stream_level0_) {
+    BlurRows(0, height_, &blurred[0]);
+    for (int l = 1; l < levels_; ++l) {
+      Downsample(blurred[l - 1], &b_.row, &blurred[l]);
+    }
+  } else if (levels_ > 1) {
+    blurred[1].create((height_ + 1) / 2, (width_ + 1) / 2, CV_32FC1);
+  }
+  s_.levels_used = std::max(0, levels_ - options_.first_level);
+  // Pixel noise of the input, grey normalised to [0, 1].
+  const double noise =
+      options_.ring_noise_factor > 0.0
+          ? NoiseSigma(*single_, 11, &b_.scratch) / s_.normalizer
+          : 0.0;
+  s_.noise_sigma = noise;
+  min_contrast_ =
+      std::max(options_.min_ring_contrast, options_.ring_noise_factor * noise);
+  s_.ms_preprocess = MsSince(t);
+  return true;
+}
+
+// Levels up to options.num_levels while the level above is at least twice
+// the minimum side (level sizes as cv::pyrDown's).
+int DetectionPass::CountLevels() const {
+  int levels = 1;
+  int rows = height_, cols = width_;
+  for (int l = 1; l < options_.num_levels; ++l) {
+    if (cols < 2 * kMinSide || rows < 2 * kMinSide) break;
+    levels = l + 1;
+    rows = (rows + 1) / 2;
+    cols = (cols + 1) / 2;
+  }
+  return levels;
+}
+
+// Levels 2 and coarser from level 1 (after level 0 was streamed).
+void DetectionPass::BuildCoarseLevels() {
+  const Clock::time_point t = Clock::now();
+  for (int l = 2; l < levels_; ++l) {
+    Downsample(b_.blurred[l - 1], &b_.row, &b_.blurred[l]);
+  }
+  s_.ms_preprocess += MsSince(t);
+}
+
+void DetectionPass::MakeBlurKernels() {
+  if (!(options_.blur_sigma_px > 0.0)) return;
+  const int ksize =
+      2 * static_cast<int>(std::ceil(2.0 * options_.blur_sigma_px)) + 1;
+  kernel_ = cv::getGaussianKernel(ksize, options_.blur_sigma_px, CV_32F);
+  kernel_scaled_ = kernel_ * (1.0 / s_.normalizer);
+}
+
+// Grey rows [a, b) of the input, normalised and blurred, into `out`: one
+// separable pass from the input type straight to float, with the
+// normalisation folded into the kernel. On a band the filter reads the
+// input rows around it, so a band equals those rows of the whole image.
+void DetectionPass::BlurRows(int a, int b, cv::Mat* out) const {
+  const cv::Mat band = single_->rowRange(a, b);
+  if (options_.blur_sigma_px > 0.0) {
+    cv::sepFilter2D(band, *out, CV_32F, kernel_scaled_, kernel_,
+                    cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
+  } else {
+    band.convertTo(*out, CV_32F, 1.0 / s_.normalizer);
+  }
+}
+
+// Level 0: peaks above the absolute threshold per band, filtered while the
+// band is in cache; the noise-adaptive threshold (from the response sampled
+// on the way) then only drops weak peaks: a peak of the whole image is a
+// peak above the lower threshold that exceeds the higher one.
+void DetectionPass::DetectLevel0Streamed() {
+  // Rows around a band: response (2) + suppression radius + ring test.
+  const int halo =
+      2 + std::max(options_.nms_radius_px,
+                   static_cast<int>(std::ceil(options_.ring_radius_px)) + 2);
+  std::vector<Level0Peak> kept;
+  b_.scratch.clear();
+  for (int y0 = 0; y0 < height_; y0 += kBandRows) {
+    DetectBand(y0, std::min(y0 + kBandRows, height_), halo, &kept);
+  }
+  ApplyLevel0Threshold(kept);
+}
+
+// Level-0 rows [y0, y1): blur (with `halo` rows around), the next level's
+// rows, response + suppression, filters.
+void DetectionPass::DetectBand(int y0, int y1, int halo,
+                               std::vector<Level0Peak>* kept) {
+  Clock::time_point t = Clock::now();
+  const int a = std::max(0, y0 - halo);
+  const int b = std::min(height_, y1 + halo);
+  BlurRows(a, b, &b_.band);
+  if (levels_ > 1) {
+    DownsampleRows(b_.band, a, height_, (y0 + 1) / 2, (y1 + 1) / 2, &b_.row,
+                   &b_.blurred[1]);
+  }
+  s_.ms_preprocess += MsSince(t);
+
+  t = Clock::now();
+  PeakRows part;
+  part.begin = y0 - a;
+  part.end = y1 - a;
+  part.y_offset = a;
+  part.sample_step = kMedianStep;
+  part.samples = options_.noise_response_factor > 0.0 ? &b_.scratch : nullptr;
+  b_.peaks.clear();
+  const float absolute =
+      static_cast<float>(options_.min_response * options_.min_response);
+  s_.candidates += FindSaddlePeaksInRows(
+      b_.band, static_cast<float>(options_.trace_weight_k), absolute,
+      options_.nms_radius_px, part, &b_.response_rows, &b_.peaks);
+  s_.ms_response += MsSince(t);
+
+  t = Clock::now();
+  for (const ResponsePeak& peak : b_.peaks) {
+    const size_t before = candidates_.size();
+    bool masked = false;
+    const bool passed = FilterPeak(b_.band, a, peak, 0, &masked);
+    kept->push_back(
+        {peak.value, masked, passed ? static_cast<int>(before) : -1});
+  }
+  s_.ms_filter += MsSince(t);
+}
+
+// The noise-adaptive threshold of level 0 from the sampled response; drops
+// the weaker peaks and their candidates.
+void DetectionPass::ApplyLevel0Threshold(const std::vector<Level0Peak>& kept) {
+  const Clock::time_point t = Clock::now();
+  std::vector<float>& samples = b_.scratch;
+  double threshold = options_.min_response;
+  if (options_.noise_response_factor > 0.0 && !samples.empty()) {
+    auto middle = samples.begin() + samples.size() / 2;
+    std::nth_element(samples.begin(), middle, samples.end());
+    threshold = std::max(threshold,
+                         options_.noise_response_factor * std::sqrt(*middle));
+  }
+  s_.threshold = threshold;
+  const float squared = static_cast<float>(threshold * threshold);
+  std::vector<Candidate> strong;
+  for (const Level0Peak& p : kept) {
+    if (!(p.value > squared)) continue;
+    ++s_.after_nms;
+    s_.after_mask += p.masked ? 1 : 0;
+    if (p.candidate >= 0) {
+      ++s_.after_ring;
+      strong.push_back(candidates_[p.candidate]);
+    }
+  }
+  candidates_ = std::move(strong);
+  s_.ms_nms += MsSince(t);
+}
+
+// One whole level: noise-adaptive threshold, response + suppression,
+// filters.
+void DetectionPass::DetectLevel(int level) {
+  const cv::Mat& blurred = b_.blurred[level];
+  const float k = static_cast<float>(options_.trace_weight_k);
+  Clock::time_point t = Clock::now();
+  double threshold = options_.min_response;
+  if (options_.noise_response_factor > 0.0) {
+    const double median =
+        SampledResponseMedian(blurred, k, kMedianStep, &b_.scratch);
+    threshold =
+        std::max(threshold, options_.noise_response_factor * std::sqrt(median));
+  }
+  if (level == options_.first_level) s_.threshold = threshold;
+  s_.ms_nms += MsSince(t);
+
+  t = Clock::now();
+  b_.peaks.clear();
+  s_.candidates +=
+      FindSaddlePeaks(blurred, k, static_cast<float>(threshold * threshold),
+                      NmsRadius(options_, level), &b_.response_rows, &b_.peaks);
+  s_.after_nms += static_cast<int>(b_.peaks.size());
+  s_.ms_response += MsSince(t);
+
+  t = Clock::now();
+  for (const ResponsePeak& peak : b_.peaks) {
+    bool masked = false;
+    const bool passed = FilterPeak(blurred, 0, peak, level, &masked);
+    s_.after_mask += masked ? 1 : 0;
+    s_.after_ring += passed ? 1 : 0;
+  }
+  s_.ms_filter += MsSince(t);
+}
+
+// The corner mask and the ring test on `level_image` (rows offset by
+// `y_offset` from the level's first row); appends a candidate when the peak
+// passes. `masked`: it passed the corner mask.
+bool DetectionPass::FilterPeak(const cv::Mat& level_image, int y_offset,
+                               const ResponsePeak& peak, int level,
+                               bool* masked) {
+  *masked = false;
+  if (options_.use_corner_mask &&
+      !PassesCornerMask(level_image, peak.x, peak.y)) {
+    return false;
+  }
+  *masked = true;
+  if (options_.use_ring_test &&
+      !PassesRingTest(b_.ring.Measure(level_image, peak.centroid_x,
+                                      peak.centroid_y,
+                                      options_.ring_radius_px))) {
+    return false;
+  }
+  candidates_.push_back(MakeCandidate(peak, y_offset, level));
+  return true;
+}
+
+bool DetectionPass::PassesRingTest(const RingMeasure& ring) const {
+  const DetectorOptions& o = options_;
+  const bool clean_second_harmonic =
+      ring.asymmetry <= o.max_ring_asymmetry_clean &&
+      ring.second_harmonic_share >= o.min_ring_second_harmonic_clean &&
+      ring.contrast >= o.min_contrast_factor_clean * min_contrast_;
+  return ring.inside && ring.contrast >= min_contrast_ &&
+         (ring.asymmetry <= o.max_ring_asymmetry || clean_second_harmonic) &&
+         ring.second_harmonic_share >= o.min_ring_second_harmonic &&
+         ring.centre_offset <= o.max_ring_centre_offset;
+}
+
+// A peak of `level` as a candidate in full-resolution pixels.
+Candidate DetectionPass::MakeCandidate(const ResponsePeak& peak, int y_offset,
+                                       int level) const {
+  const double scale = std::ldexp(1.0, level);
+  Candidate c;
+  c.level = level;
+  c.peak_x = peak.x;
+  c.peak_y = peak.y + y_offset;
+  c.response = std::sqrt(peak.value);
+  c.xy = Eigen::Vector2d(peak.x * scale, c.peak_y * scale);
+  // The centroid is also the start of the iterative refinements (closer
+  // than the integer peak: fewer iterations).
+  if (options_.subpixel != SubpixelMethod::kNone) {
+    c.xy = Eigen::Vector2d(peak.centroid_x, peak.centroid_y + y_offset) * scale;
+  }
+  return c;
+}
+
+// The candidates of all levels, finer levels first: a candidate within the
+// suppression radius (at its level) of one already taken is dropped.
+std::vector<Candidate> DetectionPass::MergeLevels() const {
+  std::vector<Candidate> merged;
+  PointGrid grid(8.0 * NmsRadius(options_, 1), width_, height_);
+  for (const Candidate& c : candidates_) {  // already ordered by level
+    const double radius =
+        std::ldexp(1.0, c.level) * NmsRadius(options_, c.level);
+    bool taken = false;
+    grid.ForNear(c.xy, radius, [&](int index) {
+      if ((merged[index].xy - c.xy).norm() <= radius) taken = true;
+    });
+    if (taken) continue;
+    grid.Add(c.xy, static_cast<int>(merged.size()));
+    merged.push_back(c);
+  }
+  s_.after_merge_levels = static_cast<int>(merged.size());
+  return merged;
+}
+
+// Sub-pixel refinement of every merged candidate at full resolution, with
+// the window sized from the distance to its nearest neighbour; `windows`
+// gets the window half-size of each refined corner.
+std::vector<Corner> DetectionPass::Refine(const std::vector<Candidate>& merged,
+                                          std::vector<int>* windows) {
+  const double reach =
+      options_.max_window_px / options_.window_fraction_of_neighbor;
+  PointGrid neighbours(reach, width_, height_);
+  for (size_t i = 0; i < merged.size(); ++i) {
+    neighbours.Add(merged[i].xy, static_cast<int>(i));
+  }
+  std::vector<Corner> refined;
+  refined.reserve(merged.size());
+  for (size_t i = 0; i < merged.size(); ++i) {
+    const Candidate& c = merged[i];
+    double nearest = std::numeric_limits<double>::infinity();
+    neighbours.ForNear(c.xy, reach, [&](int index) {
+      if (index == static_cast<int>(i)) return;
+      nearest = std::min(nearest, (merged[index].xy - c.xy).norm());
+    });
+    Corner corner;
+    int window = 0;
+    if (!RefineOne(c, nearest, &corner, &window)) {
+      ++s_.refine_failed;
+      continue;
+    }
+    refined.push_back(corner);
+    windows->push_back(window);
+  }
+  return refined;
+}
+
+// One candidate, `nearest` pixels from its nearest neighbour (infinite when
+// alone). False when the refinement failed.
+bool DetectionPass::RefineOne(const Candidate& c, double nearest,
+                              Corner* corner, int* window_out) const {
+  int window = options_.max_window_px;
+  if (std::isfinite(nearest)) {
+    window = static_cast<int>(
+        std::floor(options_.window_fraction_of_neighbor * nearest));
+  }
+  window = std::clamp(window, options_.min_window_px, options_.max_window_px);
+  // Near the image border the window shrinks instead of failing.
+  const int room = static_cast<int>(std::floor(
+                       std::min({c.xy.x(), c.xy.y(), width_ - 1.0 - c.xy.x(),
+                                 height_ - 1.0 - c.xy.y()}))) -
+                   2;
+  window = std::max(options_.min_window_px, std::min(window, room));
+  *window_out = window;
+  corner->xy = c.xy;
+  corner->response = c.response;
+  const double max_shift =
+      options_.max_shift_fraction * window + std::ldexp(0.5, c.level);
+  if (options_.subpixel == SubpixelMethod::kGradientOrthogonality) {
+    const GradientRefineResult r = RefineByGradientOrthogonality(
+        b_.blurred[0], c.xy, window, options_.max_iterations,
+        options_.convergence_px, &b_.gradient);
+    if (!r.ok || (r.xy - c.xy).norm() > max_shift) return false;
+    corner->xy = r.xy;
+  } else if (options_.subpixel == SubpixelMethod::kSaddleFit) {
+    double sigma = options_.max_saddle_sigma_px;
+    if (std::isfinite(nearest))
+      sigma = options_.saddle_sigma_fraction * nearest;
+    sigma = std::clamp(sigma, options_.min_saddle_sigma_px,
+                       options_.max_saddle_sigma_px);
+    // Near the image border the window shrinks instead of failing.
+    sigma = std::max(options_.min_saddle_sigma_px,
+                     std::min(sigma, (room + 1.0) / 3.0));
+    // On the input grey values: the detector's blur would carry the
+    // structures around a corner (PuzzleBoard discs) closer to it.
+    const SaddleRefineResult r =
+        RefineBySaddleFit(*single_, c.xy, sigma, options_.saddle_max_iterations,
+                          options_.saddle_convergence_px, max_shift);
+    if (!r.ok) return false;
+    corner->xy = r.xy;
+    corner->orientation = r.orientation;
+  }
+  return true;
+}
+
+// Corners closer than merge_distance_px: the stronger stays. Orientation
+// from the circle of the blurred image for the refinements other than the
+// saddle fit (which measured its own).
+std::vector<Corner> DetectionPass::DropDuplicates(
+    const std::vector<Corner>& refined, const std::vector<int>& windows) {
+  std::vector<int> order(refined.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return refined[a].response > refined[b].response;
+  });
+  const double merge = options_.merge_distance_px;
+  PointGrid kept_grid(std::max(merge, 1.0) * 4.0, width_, height_);
+  std::vector<Corner> kept;
+  for (int index : order) {
+    const Corner& c = refined[index];
+    bool duplicate = false;
+    kept_grid.ForNear(c.xy, merge, [&](int k) {
+      if ((kept[k].xy - c.xy).norm() < merge) duplicate = true;
+    });
+    if (duplicate) {
+      ++s_.merged_duplicates;
+      continue;
+    }
+    kept_grid.Add(c.xy, static_cast<int>(kept.size()));
+    Corner out = c;
+    if (options_.subpixel != SubpixelMethod::kSaddleFit) {
+      out.orientation = HessianOrientation(
+          b_.blurred[0], c.xy,
+          options_.orientation_spacing_fraction * windows[index]);
+    }
+    kept.push_back(out);
+  }
+  return kept;
+}
+
+}  // namespace
+
+CornerDetector::CornerDetector(const DetectorOptions& options)
+    : options_(options),
+      buffers_(std::make_unique<Buffers>(options.ring_samples)) {}
+
+CornerDetector::~CornerDetector() = default;
+CornerDetector::CornerDetector(CornerDetector&&) noexcept = default;
+CornerDetector& CornerDetector::operator=(CornerDetector&&) noexcept = default;
+
+std::vector<Corner> CornerDetector::Detect(const cv::Mat& image,
+                                           DetectorSummary* summary) {
+  DetectorSummary local_summary;
+  DetectorSummary& s = summary != nullptr ? *summary : local_summary;
+  s = DetectorSummary();
+  if (buffers_ == nullptr) {  // moved from
+    buffers_ = std::make_unique<Buffers>(options_.ring_samples);
+  }
+  DetectionPass pass(options_, buffers_.get(), &s);
+  return pass.Run(image);
+}
+
+std::vector<Corner> DetectCorners(const cv::Mat& image,
+                                  const DetectorOptions& options,
+                                  DetectorSummary* summary) {
+  CornerDetector detector(options);
+  return detector.Detect(image, summary);
 }
 
 }  // namespace puzzlecal

@@ -26,6 +26,7 @@
 //     fit's Hessian, or from the second angular harmonic of a circle for the
 //     other refinements.
 
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -204,11 +205,39 @@ struct DetectorSummary {
   double ms_total = 0.0;
 };
 
-// Detects checkerboard corners in a grey image (CV_8UC1, CV_16UC1 or
-// CV_32FC1; a 3- or 4-channel 8-bit image is converted to grey). Returns the
-// corners sorted by y, then x. Empty, tiny, constant or unsupported images
-// give no corners and a reason in `summary`; non-finite float pixels are
-// treated as 0. Invalid options give no corners (summary->message says why).
+// Detects checkerboard corners in grey images (CV_8UC1, CV_16UC1 or
+// CV_32FC1; a 3- or 4-channel 8-bit image is converted to grey). Holds the
+// buffers of a detection (blurred levels, response rows, scratch), so a
+// caller that detects in many images of one size keeps one detector and
+// pays no allocation after the first image. The corners do not depend on
+// what was detected before. One detector serves one thread at a time;
+// detectors on different threads share nothing.
+class CornerDetector {
+ public:
+  explicit CornerDetector(const DetectorOptions& options = {});
+  ~CornerDetector();
+  CornerDetector(CornerDetector&&) noexcept;
+  CornerDetector& operator=(CornerDetector&&) noexcept;
+  CornerDetector(const CornerDetector&) = delete;
+  CornerDetector& operator=(const CornerDetector&) = delete;
+
+  const DetectorOptions& options() const { return options_; }
+
+  // The corners of `image`, sorted by y, then x. Empty, tiny, constant or
+  // unsupported images give no corners and a reason in `summary`;
+  // non-finite float pixels are treated as 0. Invalid options give no
+  // corners (summary->message says why).
+  std::vector<Corner> Detect(const cv::Mat& image,
+                             DetectorSummary* summary = nullptr);
+
+  struct Buffers;  // defined in detector.cc
+
+ private:
+  DetectorOptions options_;
+  std::unique_ptr<Buffers> buffers_;
+};
+
+// A detection with a detector made for this one call (see CornerDetector).
 std::vector<Corner> DetectCorners(const cv::Mat& image,
                                   const DetectorOptions& options = {},
                                   DetectorSummary* summary = nullptr);

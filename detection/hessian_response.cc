@@ -4,15 +4,7 @@
 #include <cstdint>
 #include <cstring>
 
-// The per-pixel loops gain from 256-bit vectors; with GCC on x86-64 they
-// are compiled twice and the AVX2 version is picked at load time when the
-// processor has it (the default build targets baseline x86-64).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PUZZLECAL_VECTOR_CLONES \
-  __attribute__((target_clones("avx2", "default")))
-#else
-#define PUZZLECAL_VECTOR_CLONES
-#endif
+#include "detection/vector_clones.h"
 
 namespace puzzlecal {
 
@@ -110,6 +102,132 @@ int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
                                rows, peaks);
 }
 
+namespace {
+
+// The last 2 radius + 1 response rows and their horizontal 3-maxima, kept
+// in a ring of rows inside the caller's buffer, and one row of flags.
+class ResponseRing {
+ public:
+  ResponseRing(int width, int radius, std::vector<float>* buffer)
+      : width_(width), ring_(2 * radius + 1) {
+    const size_t row_size = static_cast<size_t>(width);
+    buffer->resize(2 * ring_ * row_size + row_size);
+    response_ = buffer->data();
+    max3_ = buffer->data() + ring_ * row_size;
+    flags_ = reinterpret_cast<uint8_t*>(buffer->data() + 2 * ring_ * row_size);
+  }
+
+  float* Row(int y) const { return response_ + Offset(y); }
+  float* Max3(int y) const { return max3_ + Offset(y); }
+  uint8_t* Flags() const { return flags_; }
+
+ private:
+  size_t Offset(int y) const {
+    return static_cast<size_t>(y % ring_) * static_cast<size_t>(width_);
+  }
+  int width_;
+  int ring_;
+  float* response_;
+  float* max3_;
+  uint8_t* flags_;
+};
+
+// Response row `y` into the ring, its samples for the median (see
+// PeakRows) and its horizontal 3-maxima.
+inline void AddResponseRow(const cv::Mat& blurred, int y, float k,
+                           const PeakRows& part, int row_begin, int row_end,
+                           const ResponseRing& ring) {
+  const int width = blurred.cols;
+  float* __restrict out = ring.Row(y);
+  ComputeSaddleResponseRow(blurred, y, k, out);
+  if (part.samples != nullptr && y >= row_begin && y < row_end &&
+      (y + part.y_offset) % part.sample_step == part.sample_step / 2) {
+    for (int x = part.sample_step / 2; x < width; x += part.sample_step) {
+      part.samples->push_back(out[x]);
+    }
+  }
+  float* __restrict max3 = ring.Max3(y);
+  max3[0] = out[0];
+  max3[width - 1] = out[width - 1];
+  for (int x = 1; x < width - 1; ++x) {
+    max3[x] = std::max(std::max(out[x - 1], out[x]), out[x + 1]);
+  }
+}
+
+// Flags the pixels of row y above the threshold that equal the maximum of
+// their 3x3 neighbourhood, without branches (most of the image is
+// neither). Returns the number of pixels above the threshold.
+inline int FlagLocalMaxima(const ResponseRing& ring, int y, int width,
+                           float threshold) {
+  const float* __restrict row = ring.Row(y);
+  const float* __restrict m_up = ring.Max3(y - 1);
+  const float* __restrict m_row = ring.Max3(y);
+  const float* __restrict m_down = ring.Max3(y + 1);
+  uint8_t* __restrict flags = ring.Flags();
+  int count = 0;
+  for (int x = 1; x < width - 1; ++x) {
+    const float v = row[x];
+    const float m = std::max(std::max(m_up[x], m_row[x]), m_down[x]);
+    const int is_above = v > threshold;
+    count += is_above;
+    flags[x] = static_cast<uint8_t>(is_above & (v >= m));
+  }
+  flags[0] = 0;
+  flags[width - 1] = 0;
+  return count;
+}
+
+// Whether the flagged pixel (x, y) of value v is the maximum of its
+// (2 radius + 1)^2 window (clipped to the image); ties go to the first
+// pixel in scan order.
+inline bool IsWindowMaximum(const ResponseRing& ring, int x, int y, float v,
+                            int radius, int width, int height) {
+  const float* up = ring.Row(y - 1);
+  const float* row = ring.Row(y);
+  // Ties in the 3x3 neighbourhood: earlier pixels in scan order must be
+  // smaller, later ones not larger.
+  if (up[x - 1] >= v || up[x] >= v || up[x + 1] >= v || row[x - 1] >= v) {
+    return false;
+  }
+  if (radius <= 1) return true;
+  const int ya = std::max(y - radius, 0);
+  const int yb = std::min(y + radius, height - 1);
+  const int xa = std::max(x - radius, 0);
+  const int xb = std::min(x + radius, width - 1);
+  for (int yy = ya; yy <= yb; ++yy) {
+    const float* r = ring.Row(yy);
+    for (int xx = xa; xx <= xb; ++xx) {
+      const bool earlier = yy < y || (yy == y && xx < x);
+      if (earlier ? r[xx] >= v : r[xx] > v) return false;
+    }
+  }
+  return true;
+}
+
+// The peak at (x, y) with the thesis's centroid of the squared response
+// over its 3x3 neighbourhood.
+inline ResponsePeak PeakAt(const ResponseRing& ring, int x, int y, float v) {
+  ResponsePeak peak;
+  peak.x = x;
+  peak.y = y;
+  peak.value = v;
+  double sum = 0.0, sx = 0.0, sy = 0.0;
+  for (int dy = -1; dy <= 1; ++dy) {
+    const float* r = ring.Row(y + dy);
+    for (int dx = -1; dx <= 1; ++dx) {
+      const double w = static_cast<double>(r[x + dx]) * r[x + dx];
+      sum += w;
+      sx += w * dx;
+      sy += w * dy;
+    }
+  }
+  peak.centroid_x = static_cast<float>(x + (sum > 0.0 ? sx / sum : 0.0));
+  peak.centroid_y = static_cast<float>(y + (sum > 0.0 ? sy / sum : 0.0));
+  return peak;
+}
+
+}  // namespace
+
 PUZZLECAL_VECTOR_CLONES int FindSaddlePeaksInRows(
     const cv::Mat& blurred, float trace_weight_k, float threshold, int radius,
     const PeakRows& part, std::vector<float>* rows,
@@ -120,63 +238,18 @@ PUZZLECAL_VECTOR_CLONES int FindSaddlePeaksInRows(
   const int row_begin = std::max(part.begin, 0);
   const int row_end = std::min(part.end, height);
   radius = std::max(radius, 1);
-  const int ring = 2 * radius + 1;
-  // Ring of response rows, then a ring of their horizontal 3-maxima, then
-  // one row of flags.
-  const size_t row_size = static_cast<size_t>(width);
-  rows->resize(2 * ring * row_size + row_size);
-  float* response_rows = rows->data();
-  float* max3_rows = rows->data() + ring * row_size;
-  uint8_t* flags =
-      reinterpret_cast<uint8_t*>(rows->data() + 2 * ring * row_size);
-  auto row_of = [&](int y) -> const float* {
-    return response_rows + static_cast<size_t>(y % ring) * row_size;
-  };
-  auto max3_of = [&](int y) -> const float* {
-    return max3_rows + static_cast<size_t>(y % ring) * row_size;
-  };
+  const ResponseRing ring(width, radius, rows);
+  const uint8_t* flags = ring.Flags();
   int above = 0;
   for (int y_new = 0; y_new < height + radius; ++y_new) {
     if (y_new < height) {
-      float* __restrict out =
-          response_rows + static_cast<size_t>(y_new % ring) * row_size;
-      ComputeSaddleResponseRow(blurred, y_new, trace_weight_k, out);
-      if (part.samples != nullptr && y_new >= row_begin && y_new < row_end &&
-          (y_new + part.y_offset) % part.sample_step == part.sample_step / 2) {
-        for (int x = part.sample_step / 2; x < width; x += part.sample_step) {
-          part.samples->push_back(out[x]);
-        }
-      }
-      float* __restrict max3 =
-          max3_rows + static_cast<size_t>(y_new % ring) * row_size;
-      max3[0] = out[0];
-      max3[width - 1] = out[width - 1];
-      for (int x = 1; x < width - 1; ++x) {
-        max3[x] = std::max(std::max(out[x - 1], out[x]), out[x + 1]);
-      }
+      AddResponseRow(blurred, y_new, trace_weight_k, part, row_begin, row_end,
+                     ring);
     }
     const int y = y_new - radius;  // the row whose window is complete
     if (y < 1 || y > height - 2 || y < row_begin || y >= row_end) continue;
-    const float* __restrict up = row_of(y - 1);
-    const float* __restrict row = row_of(y);
-    {
-      // Pixels above the threshold that equal the maximum of their 3x3
-      // neighbourhood, without branches (most of the image is neither).
-      const float* __restrict m_up = max3_of(y - 1);
-      const float* __restrict m_row = max3_of(y);
-      const float* __restrict m_down = max3_of(y + 1);
-      int count = 0;
-      for (int x = 1; x < width - 1; ++x) {
-        const float v = row[x];
-        const float m = std::max(std::max(m_up[x], m_row[x]), m_down[x]);
-        const int is_above = v > threshold;
-        count += is_above;
-        flags[x] = static_cast<uint8_t>(is_above & (v >= m));
-      }
-      above += count;
-    }
-    flags[0] = 0;
-    flags[width - 1] = 0;
+    above += FlagLocalMaxima(ring, y, width, threshold);
+    const float* row = ring.Row(y);
     for (int x8 = 0; x8 < width; x8 += 8) {
       // Skip eight flags at once (almost all are zero).
       if (x8 + 8 <= width) {
@@ -185,48 +258,10 @@ PUZZLECAL_VECTOR_CLONES int FindSaddlePeaksInRows(
         if (word == 0) continue;
       }
       for (int x = x8; x < std::min(x8 + 8, width); ++x) {
-        if (!flags[x]) continue;
-        const float v = row[x];
-        // Ties in the 3x3 neighbourhood: earlier pixels in scan order must be
-        // smaller, later ones not larger.
-        if (up[x - 1] >= v || up[x] >= v || up[x + 1] >= v || row[x - 1] >= v) {
-          continue;
+        if (flags[x] &&
+            IsWindowMaximum(ring, x, y, row[x], radius, width, height)) {
+          peaks->push_back(PeakAt(ring, x, y, row[x]));
         }
-        bool is_max = true;
-        if (radius > 1) {
-          const int ya = std::max(y - radius, 0);
-          const int yb = std::min(y + radius, height - 1);
-          const int xa = std::max(x - radius, 0);
-          const int xb = std::min(x + radius, width - 1);
-          for (int yy = ya; yy <= yb && is_max; ++yy) {
-            const float* r = row_of(yy);
-            for (int xx = xa; xx <= xb; ++xx) {
-              const bool earlier = yy < y || (yy == y && xx < x);
-              if (earlier ? r[xx] >= v : r[xx] > v) {
-                is_max = false;
-                break;
-              }
-            }
-          }
-        }
-        if (!is_max) continue;
-        ResponsePeak peak;
-        peak.x = x;
-        peak.y = y;
-        peak.value = v;
-        double sum = 0.0, sx = 0.0, sy = 0.0;
-        for (int dy = -1; dy <= 1; ++dy) {
-          const float* r = row_of(y + dy);
-          for (int dx = -1; dx <= 1; ++dx) {
-            const double w = static_cast<double>(r[x + dx]) * r[x + dx];
-            sum += w;
-            sx += w * dx;
-            sy += w * dy;
-          }
-        }
-        peak.centroid_x = static_cast<float>(x + (sum > 0.0 ? sx / sum : 0.0));
-        peak.centroid_y = static_cast<float>(y + (sum > 0.0 ? sy / sum : 0.0));
-        peaks->push_back(peak);
       }
     }
   }

@@ -16,6 +16,9 @@ namespace {
 // per corner and reused by every solve.
 class GradientPatch {
  public:
+  explicit GradientPatch(GradientRefineScratch* scratch)
+      : gxx_(scratch->gxx), gxy_(scratch->gxy), gyy_(scratch->gyy) {}
+
   // Fills the patch of radius `radius` around (cx, cy); false when it does
   // not fit into the image (with one pixel for the differences).
   bool Fill(const cv::Mat& image, int cx, int cy, int radius) {
@@ -120,17 +123,17 @@ class GradientPatch {
  private:
   static constexpr int kLanes = 8;
   int x0_ = 0, y0_ = 0, size_ = 0, stride_ = 0;
-  // Gradient products per pixel, rows of `stride_` floats; reused between
-  // corners.
-  std::vector<float> gxx_, gxy_, gyy_;
+  // Gradient products per pixel, rows of `stride_` floats (the caller's
+  // scratch).
+  std::vector<float>& gxx_;
+  std::vector<float>& gxy_;
+  std::vector<float>& gyy_;
 };
 }  // namespace
 
-GradientRefineResult RefineByGradientOrthogonality(const cv::Mat& image,
-                                                   const Eigen::Vector2d& start,
-                                                   int half_window,
-                                                   int max_iterations,
-                                                   double convergence_px) {
+GradientRefineResult RefineByGradientOrthogonality(
+    const cv::Mat& image, const Eigen::Vector2d& start, int half_window,
+    int max_iterations, double convergence_px, GradientRefineScratch* scratch) {
   GradientRefineResult result;
   result.xy = start;
   if (!std::isfinite(start.x()) || !std::isfinite(start.y()) ||
@@ -139,7 +142,8 @@ GradientRefineResult RefineByGradientOrthogonality(const cv::Mat& image,
     return result;
   }
   // Room for the window plus a few pixels of movement.
-  static thread_local GradientPatch patch;
+  GradientRefineScratch local_scratch;
+  GradientPatch patch(scratch != nullptr ? scratch : &local_scratch);
   const double h = half_window;
   if (!patch.Fill(image, static_cast<int>(std::lround(start.x())),
                   static_cast<int>(std::lround(start.y())), half_window + 3)) {
@@ -209,33 +213,34 @@ void GaussianRun(double u0, double h, int n, double* out) {
   }
 }
 
-template <typename Pixel>
-bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
-                int radius, Eigen::Vector2d* step, double* orientation) {
-  const int cx = static_cast<int>(std::floor(p.x() + 0.5));
-  const int cy = static_cast<int>(std::floor(p.y() + 0.5));
-  if (cx - radius < 0 || cy - radius < 0 || cx + radius >= image.cols ||
-      cy + radius >= image.rows) {
-    return false;
-  }
-  constexpr int kLanes = 8;
-  constexpr int kMaxSide = 2 * 48 + 1;
-  constexpr int kMaxPadded = (kMaxSide + kLanes - 1) / kLanes * kLanes;
-  const int side = 2 * radius + 1;
-  const int padded = (side + kLanes - 1) / kLanes * kLanes;
-  // 1-D weights and powers of the coordinates relative to p, in units of
-  // sigma: wu[k][i] = w(u) u^k for k = 0..2 (zero in the padding), and the
-  // moments sum w u^k for k = 0..4 for the normal matrix.
+constexpr int kLanes = 8;
+constexpr int kMaxSide = 2 * 48 + 1;
+constexpr int kMaxPadded = (kMaxSide + kLanes - 1) / kLanes * kLanes;
+
+// The weights of one saddle-fit window of `side` = 2 radius + 1 pixels
+// centred on the pixel nearest p: 1-D weights and powers of the coordinates
+// relative to p, in units of sigma: wu[k][i] = w(u) u^k for k = 0..2 (zero
+// in the padding up to `padded`), and the moments sum w u^k for k = 0..4
+// for the normal matrix.
+struct SaddleWindow {
+  int side = 0;
+  int padded = 0;
   alignas(32) float wu[3][kMaxPadded] = {};
   float wv[3][kMaxSide];
   double mu[5] = {}, mv[5] = {};
+};
+
+void MakeSaddleWindow(const Eigen::Vector2d& p, int cx, int cy, double sigma,
+                      int radius, SaddleWindow* w) {
+  w->side = 2 * radius + 1;
+  w->padded = (w->side + kLanes - 1) / kLanes * kLanes;
   const double inv_s = 1.0 / sigma;
   const double u0 = (cx - radius - p.x()) * inv_s;
   const double v0 = (cy - radius - p.y()) * inv_s;
   double gauss_u[kMaxSide], gauss_v[kMaxSide];
-  GaussianRun(u0, inv_s, side, gauss_u);
-  GaussianRun(v0, inv_s, side, gauss_v);
-  for (int i = 0; i < side; ++i) {
+  GaussianRun(u0, inv_s, w->side, gauss_u);
+  GaussianRun(v0, inv_s, w->side, gauss_v);
+  for (int i = 0; i < w->side; ++i) {
     const double u = u0 + i * inv_s;
     const double v = v0 + i * inv_s;
     // Gaussian tapered smoothly to zero at 3 sigma from p, so the window is
@@ -244,35 +249,40 @@ bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
     const double tv = std::max(0.0, 1.0 - v * v * (1.0 / 9.0));
     const double w_u = gauss_u[i] * tu * tu;
     const double w_v = gauss_v[i] * tv * tv;
-    wu[0][i] = static_cast<float>(w_u);
-    wu[1][i] = static_cast<float>(w_u * u);
-    wu[2][i] = static_cast<float>(w_u * u * u);
-    wv[0][i] = static_cast<float>(w_v);
-    wv[1][i] = static_cast<float>(w_v * v);
-    wv[2][i] = static_cast<float>(w_v * v * v);
+    w->wu[0][i] = static_cast<float>(w_u);
+    w->wu[1][i] = static_cast<float>(w_u * u);
+    w->wu[2][i] = static_cast<float>(w_u * u * u);
+    w->wv[0][i] = static_cast<float>(w_v);
+    w->wv[1][i] = static_cast<float>(w_v * v);
+    w->wv[2][i] = static_cast<float>(w_v * v * v);
     double pu = w_u, pv = w_v;
     for (int k = 0; k < 5; ++k) {
-      mu[k] += pu;
-      mv[k] += pv;
+      w->mu[k] += pu;
+      w->mv[k] += pv;
       pu *= u;
       pv *= v;
     }
   }
-  // Right-hand side: sum w u^a v^b I for (a, b) in the basis
-  // 1, u, v, u^2, u v, v^2. Rows in kLanes independent float lanes so the
-  // loop vectorises.
+}
+
+// Right-hand side of the fit: sum w u^a v^b I for (a, b) in the basis
+// 1, u, v, u^2, u v, v^2, over the window whose top-left pixel is (x0, y0).
+// Rows in kLanes independent float lanes so the loop vectorises.
+template <typename Pixel>
+Eigen::Matrix<double, 6, 1> SaddleRightHandSide(const cv::Mat& image, int x0,
+                                                int y0, const SaddleWindow& w) {
   alignas(32) float values[kMaxPadded] = {};
   double r00 = 0, r10 = 0, r01 = 0, r20 = 0, r11 = 0, r02 = 0;
-  for (int j = 0; j < side; ++j) {
-    const Pixel* row = image.ptr<Pixel>(cy - radius + j) + (cx - radius);
-    for (int i = 0; i < side; ++i) values[i] = static_cast<float>(row[i]);
+  for (int j = 0; j < w.side; ++j) {
+    const Pixel* row = image.ptr<Pixel>(y0 + j) + x0;
+    for (int i = 0; i < w.side; ++i) values[i] = static_cast<float>(row[i]);
     float s0[kLanes] = {}, s1[kLanes] = {}, s2[kLanes] = {};
-    for (int i = 0; i < padded; i += kLanes) {
+    for (int i = 0; i < w.padded; i += kLanes) {
       for (int l = 0; l < kLanes; ++l) {
         const float value = values[i + l];
-        s0[l] += wu[0][i + l] * value;
-        s1[l] += wu[1][i + l] * value;
-        s2[l] += wu[2][i + l] * value;
+        s0[l] += w.wu[0][i + l] * value;
+        s1[l] += w.wu[1][i + l] * value;
+        s2[l] += w.wu[2][i + l] * value;
       }
     }
     float t0 = 0.0f, t1 = 0.0f, t2 = 0.0f;
@@ -281,24 +291,32 @@ bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
       t1 += s1[l];
       t2 += s2[l];
     }
-    r00 += wv[0][j] * t0;
-    r10 += wv[0][j] * t1;
-    r20 += wv[0][j] * t2;
-    r01 += wv[1][j] * t0;
-    r11 += wv[1][j] * t1;
-    r02 += wv[2][j] * t0;
+    r00 += w.wv[0][j] * t0;
+    r10 += w.wv[0][j] * t1;
+    r20 += w.wv[0][j] * t2;
+    r01 += w.wv[1][j] * t0;
+    r11 += w.wv[1][j] * t1;
+    r02 += w.wv[2][j] * t0;
   }
+  Eigen::Matrix<double, 6, 1> right;
+  right << r00, r10, r01, r20, r11, r02;
+  return right;
+}
+
+// Solves the fit and returns the step (pixels) to its stationary point and
+// the orientation of its Hessian; false when the fit is no saddle.
+bool SolveSaddle(const SaddleWindow& w,
+                 const Eigen::Matrix<double, 6, 1>& right, double sigma,
+                 Eigen::Vector2d* step, double* orientation) {
   // Normal matrix: entry (A, B) = mu[a_A + a_B] * mv[b_A + b_B].
   static const int kPowU[6] = {0, 1, 0, 2, 1, 0};
   static const int kPowV[6] = {0, 0, 1, 0, 1, 2};
   Eigen::Matrix<double, 6, 6> normal;
   for (int a = 0; a < 6; ++a) {
     for (int b = 0; b < 6; ++b) {
-      normal(a, b) = mu[kPowU[a] + kPowU[b]] * mv[kPowV[a] + kPowV[b]];
+      normal(a, b) = w.mu[kPowU[a] + kPowU[b]] * w.mv[kPowV[a] + kPowV[b]];
     }
   }
-  Eigen::Matrix<double, 6, 1> right;
-  right << r00, r10, r01, r20, r11, r02;
   const Eigen::Matrix<double, 6, 1> q = normal.ldlt().solve(right);
   // Gradient (q1, q2) and Hessian [[2 q3, q4], [q4, 2 q5]] at p.
   const double hxx = 2.0 * q[3], hxy = q[4], hyy = 2.0 * q[5];
@@ -315,6 +333,24 @@ bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
   *step = sigma * Eigen::Vector2d((-hyy * q[1] + hxy * q[2]) / det,
                                   (hxy * q[1] - hxx * q[2]) / det);
   return std::isfinite(step->x()) && std::isfinite(step->y());
+}
+
+// One step of the saddle fit with the window centred on p.
+template <typename Pixel>
+bool SaddleStep(const cv::Mat& image, const Eigen::Vector2d& p, double sigma,
+                int radius, Eigen::Vector2d* step, double* orientation) {
+  const int cx = static_cast<int>(std::floor(p.x() + 0.5));
+  const int cy = static_cast<int>(std::floor(p.y() + 0.5));
+  if (cx - radius < 0 || cy - radius < 0 || cx + radius >= image.cols ||
+      cy + radius >= image.rows) {
+    return false;
+  }
+  SaddleWindow window;
+  MakeSaddleWindow(p, cx, cy, sigma, radius, &window);
+  return SolveSaddle(
+      window,
+      SaddleRightHandSide<Pixel>(image, cx - radius, cy - radius, window),
+      sigma, step, orientation);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace puzzlecal {
 
@@ -23,11 +24,15 @@ struct GradientRefineResult {
 // (blurred). Fails when the window leaves the image, the system is
 // ill-conditioned (fewer than two edge directions) or the estimate leaves
 // the window.
-GradientRefineResult RefineByGradientOrthogonality(const cv::Mat& image,
-                                                   const Eigen::Vector2d& start,
-                                                   int half_window,
-                                                   int max_iterations,
-                                                   double convergence_px);
+// `scratch`, when given, holds the gradient products between calls (a
+// caller refining many corners saves the allocations).
+struct GradientRefineScratch {
+  std::vector<float> gxx, gxy, gyy;  // per patch pixel
+};
+GradientRefineResult RefineByGradientOrthogonality(
+    const cv::Mat& image, const Eigen::Vector2d& start, int half_window,
+    int max_iterations, double convergence_px,
+    GradientRefineScratch* scratch = nullptr);
 
 struct SaddleRefineResult {
   bool ok = false;  // converged to a saddle (Hessian of the fit indefinite)

@@ -191,9 +191,9 @@ inline std::string RunGridDecodeCase(const uint8_t* data, size_t size) {
   lattice.angle = reader.DoubleInRange(-M_PI, M_PI);
 
   GridOptions grid_options;
-  grid_options.num_neighbors = 2 + (option_bits & 7);           // 2..9
-  grid_options.min_component_size = 1 + ((option_bits >> 3) & 3) * 2;
-  grid_options.kruskal_passes = 1 + ((option_bits >> 5) & 1);
+  grid_options.candidates.num_neighbors = 2 + (option_bits & 7);  // 2..9
+  grid_options.cleanup.min_component_size = 1 + ((option_bits >> 3) & 3) * 2;
+  grid_options.merge.kruskal_passes = 1 + ((option_bits >> 5) & 1);
   DecodeOptions decode_options;
   decode_options.min_corners = 1 + ((option_bits >> 6) & 3) * 2;
 

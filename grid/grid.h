@@ -14,7 +14,10 @@
 // - a final pass removes corners that their lattice lines do not predict and
 //   splits components that fall apart; then, with an image, corners left out
 //   join a component, and components join one another, where the lattice
-//   around a free label predicts them.
+//   around a free label predicts them;
+// - last, a corner removed where the predictions of its neighbours agree
+//   with each other but not with it (a false corner at a lattice position
+//   whose corner was not detected).
 
 #include <opencv2/core.hpp>
 #include <string>
@@ -25,150 +28,245 @@
 
 namespace puzzlecal {
 
-struct GridOptions {
-  // Nearest neighbours per corner that become candidate edges (thesis: 8).
+// Candidate edges: k nearest neighbours, filtered (thesis section 4.1).
+struct GridCandidateOptions {
+  // Nearest neighbours per corner that become candidate edges. Default 8
+  // (the thesis's value: the 4 tile-edge neighbours and the 4 diagonal ones
+  // of an interior corner); in [1, 64].
   int num_neighbors = 8;
-  // Candidate edges are kept only when the two corners' eigenvector
-  // orientations differ by more than this (mod 180 degrees); tile-edge
-  // neighbours differ by about 90, diagonal ones by about 0 (thesis: 45).
+  // A candidate edge is kept only when the two corners' eigenvector
+  // orientations differ by more than this (mod 180 degrees): tile-edge
+  // neighbours differ by about 90, diagonal ones by about 0. Default 45 (the
+  // thesis's value, halfway); in [0, 90).
   double min_orientation_difference_deg = 45.0;
-  // Edges shorter than this (pixels) are dropped: duplicate detections.
+  // Edges shorter than this (pixels) are dropped: two detections of one
+  // corner. Default 1; finite, >= 0.
   double min_edge_length_px = 1.0;
-  // Corners with |x| or |y| above this (pixels) are ignored as invalid.
+  // Corners with |x| or |y| above this (pixels) are ignored as invalid (keeps
+  // the arithmetic finite). Default 1e6; in (0, 1e9].
   double max_abs_coordinate_px = 1e6;
 
+  // False with a reason when a field is out of range.
+  bool Check(std::string* why = nullptr) const;
+};
+
+// Image tests of a candidate edge (with an image only).
+struct GridEdgeImageOptions {
   // Grey levels sampled evenly along an edge (at (s + 0.5) / n of its length)
-  // for the intensity penalty (thesis: 15).
+  // for the intensity penalty. Default 15 (the thesis's value: 5 per third);
+  // in [3, 1000].
   int intensity_samples = 15;
-  // An edge is penalised when the mean grey level of its first and last
-  // thirds differ by more than this fraction of its mean (thesis: 0.5): it
-  // crosses a tile instead of running along a tile edge.
+  // An edge is penalised when the mean grey levels of its first and last
+  // thirds differ by more than this fraction of its mean: it crosses a tile
+  // instead of running along a tile edge. Default 0.5 (the thesis's value);
+  // finite, > 0.
   double intensity_difference_fraction = 0.5;
-  // Weight = length x this factor for penalised edges (thesis: 3; above
-  // neighbor_weight_ratio so a penalised edge never joins normal ones).
+  // The weight of a penalised edge is its length times this factor. Default
+  // 3 (the thesis's value; above merge.neighbor_weight_ratio, so a penalised
+  // edge never joins normal ones); finite, >= 1.
   double penalty_factor = 3.0;
   // Refuse penalised edges instead of taking them up later at the higher
-  // weight. On the deltille fisheye photos 0.5 % of the true lattice edges
-  // tried by Kruskal are penalised (and other paths join their corners),
-  // while a penalised tile diagonal at the rim, where the true neighbours
-  // were not detected, could otherwise join and mislabel a corner.
+  // weight: where the true neighbours of a corner at the rim were not
+  // detected, a penalised tile diagonal could otherwise join and mislabel
+  // it, while the corners of the few penalised true lattice edges are
+  // joined by other paths. Default true.
   bool refuse_penalised_edges = true;
-  // With an image, an edge is refused when the tiles beside it change colour
-  // halfway (it spans two tiles through an undetected corner; lengths alone
-  // cannot tell when tile sizes vary by 3x along a fisheye line). Samples
-  // at this fraction of the edge length to either side of it...
+  // An edge is refused when the tiles beside it change colour halfway: it
+  // spans two tiles through an undetected corner (lengths alone cannot tell
+  // when tile sizes vary by 3x along a fisheye line). The sides are sampled
+  // at this fraction of the edge length to either side of it. Default 0.1
+  // (inside the tiles next to the edge); in (0, 0.5].
   double side_offset_fraction = 0.1;
-  // ... and both left-right differences above this fraction of their mean
-  // grey level. 0 turns the test off.
+  // ... and the edge is refused when both left-right differences exceed this
+  // fraction of their mean grey level. Default 0.2 (well above the noise of
+  // a uniform tile, well below the contrast of a tile edge); 0 turns the test
+  // off; finite, >= 0.
   double side_min_contrast = 0.2;
 
-  // Merge check at both ends of the joining edge: every tree edge already at
-  // that corner on the same lattice line has a weight within this factor of
-  // the joining edge's weight (thesis eq. 4.2: 2.9, there against all edges
-  // at the corner; steep views foreshorten one axis by more than that).
+  bool Check(std::string* why = nullptr) const;
+};
+
+// Kruskal's merges of two trees (thesis section 4.2) and the checks that
+// keep their labels consistent.
+struct GridMergeOptions {
+  // At both ends of the joining edge, every tree edge already at that corner
+  // on the same lattice line has a weight within this factor of the joining
+  // edge's weight. Default 2.9 (thesis eq. 4.2, there against all edges at
+  // the corner; here per line, since steep views foreshorten one axis by
+  // more than that); finite, > 1.
   double neighbor_weight_ratio = 2.9;
-  // Merge check: mean edge weight of the larger tree / mean edge weight of
-  // the smaller tree lies in (min, max) (thesis eq. 4.3: 0.3, 2.9), per
-  // lattice axis, where both trees have edges along it.
+  // Mean edge weight of the larger tree / mean edge weight of the smaller
+  // tree lies in (min, max), per lattice axis where both trees have edges
+  // along it. Default (0.3, 2.9) (thesis eq. 4.3); min in (0, 1), max finite
+  // and > 1.
   double tree_mean_weight_ratio_min = 0.3;
   double tree_mean_weight_ratio_max = 2.9;
-  // Collinearity of three consecutive corners on one lattice line: |sin| of
-  // the turning angle at most this (thesis: 0.342 = sin 20 degrees), and the
-  // turn less than 90 degrees.
+  // Three consecutive corners on one lattice line turn by less than 90
+  // degrees with |sin| of the turning angle at most this. Default 0.342 =
+  // sin 20 degrees (the thesis's value); in (0, 1].
   double max_collinearity_sin = 0.342;
-  // Three consecutive corners on a lattice line: the ratio of their two
-  // spacings lies within [1 / max, max] (perspective and fisheye change the
-  // spacing slowly).
+  // ... and the ratio of their two spacings lies within [1 / max, max]:
+  // perspective and fisheye change the spacing slowly. Default 2; finite,
+  // >= 1.
   double max_line_spacing_ratio = 2.0;
   // A lattice step must point within this angle (degrees) of the corner's
   // axis estimate (eigenvector +- 45 degrees); steps near 45 degrees are
-  // ambiguous between the two axes and are not used. The image directions of
-  // the two tile edges at a corner lie on either side of the eigenvectors
-  // (which bisect them), at 45 - theta/2 degrees from the estimate for tile
-  // edges theta degrees apart: theta = 20 (steep views under fisheye, tiles
-  // of aspect 5 and more at the rim) gives 35 degrees. Without an image
-  // this band also keeps out "knight" edges (1 tile along one axis, 2 along
-  // the other) of views steeper than 25 degrees, which pass the orientation
-  // filter and look like lattice steps; with an image they cross tiles and
-  // the intensity test refuses them, so the band can be narrower.
+  // ambiguous between the two axes and are not used. The image directions
+  // of the two tile edges at a corner lie on either side of the
+  // eigenvectors (which bisect them), at 45 - theta/2 degrees from the
+  // estimate for tile edges theta degrees apart: theta = 20 (steep views
+  // under fisheye, tiles of aspect 5 and more at the rim) gives 35. Without
+  // an image this band also keeps out "knight" edges (1 tile along one axis,
+  // 2 along the other) of views steeper than 25 degrees, which pass the
+  // orientation filter and look like lattice steps. Default 38; in (0, 45].
   double max_axis_deviation_deg = 38.0;
-  // The same with an image (and refuse_penalised_edges). On the deltille
-  // fisheye photos 44 instead of 38 joins 130 more corners to the largest
-  // components, with 0 wrong labels.
+  // The same with an image and image_tests.refuse_penalised_edges: knight edges
+  // cross tiles and the intensity test refuses them, so the band can be
+  // narrower and tile edges meeting at a narrower angle are accepted.
+  // Default 44; in (0, 45].
   double max_axis_deviation_with_image_deg = 44.0;
   // With an image, two corners that a merge makes lattice neighbours and
   // whose step is in that ambiguous band still agree when the step lies
-  // within this angle of the own direction each one's frame expects and the
+  // within this angle of the direction each one's frame expects and the
   // image shows a tile edge between them (one such pair along the seam of
-  // two large trees otherwise refuses the whole merge).
+  // two large trees would otherwise refuse the whole merge). Default 50
+  // (above 45: the band itself); in (0, 90).
   double max_adjacency_deviation_with_image_deg = 50.0;
-  // Two corners that a merge makes lattice neighbours must be at most this
+  // Two corners that a merge makes lattice neighbours are at most this
   // factor farther apart (or closer) than the tree edges on the same lattice
   // line at either corner (or, for a corner without any tree edge, the
-  // joining edge).
+  // joining edge). Default 2 (as max_line_spacing_ratio); finite, >= 1.
   double max_adjacency_length_ratio = 2.0;
   // ... and, when a corner has tree edges only across that line, at most
-  // this factor (the foreshortening of one axis against the other in steep
-  // views: 1 / sin(viewing angle) and more under perspective; rim tiles of
-  // the deltille fisheye photos reach 5-6).
+  // this factor: the foreshortening of one axis against the other in steep
+  // views (1 / sin(viewing angle) and more under perspective; tiles at the
+  // rim of a strong fisheye reach aspect 5-6). Default 8; finite, >= 1.
   double max_axis_aspect_ratio = 8.0;
-  // Kruskal passes over the sorted edges; a later pass retries edges between
-  // trees that an earlier pass refused (the trees have grown since).
+  // Kruskal passes over the sorted edges; a later pass retries the edges
+  // between trees that an earlier pass refused (the trees have grown
+  // since). Default 2; in [1, 10].
   int kruskal_passes = 2;
 
-  // Final pass, with an image: a corner stays only when the four tiles
-  // around it alternate dark/light (sampled at this fraction of the lattice
-  // diagonals from it): drops L-junctions at the board's border and clutter.
+  bool Check(std::string* why = nullptr) const;
+};
+
+// The final pass over the trees: corners their lattice does not predict are
+// removed, trees that fall apart are split.
+struct GridCleanupOptions {
+  // With an image, a corner stays only when the four tiles around it
+  // alternate dark/light: drops L-junctions at the board's border and
+  // clutter. Default true.
   bool check_saddle_pattern = true;
+  // The tiles are sampled at this fraction of the lattice diagonals from the
+  // corner. Default 0.3 (inside each tile, clear of its edges); in (0, 0.5].
   double saddle_sample_fraction = 0.3;
-  // Final pass: a corner is predicted from the next three corners on each of
-  // its lattice lines (quadratic extrapolation); the prediction holds when
-  // the error is at most this fraction of the spacing of the nearest two.
-  // With only two further corners the merge's collinearity test is used.
+  // A corner is predicted from the next three corners on each of its
+  // lattice lines (quadratic extrapolation); the prediction holds when the
+  // error is at most this fraction of the spacing of the nearest two (with
+  // only two further corners the merge's collinearity test is used).
   // Corners contradicted by more lines than support them are removed. The
   // extrapolation 3 p1 - 3 p2 + p3 multiplies the detector's position noise
-  // by sqrt(19) = 4.4: 1.5 px at the fisheye rim, where tiles are 15 px,
-  // is 0.44 of the spacing (0.35 removed true rim corners of 4 deltille
-  // photos; 0.5 keeps them and still removes clutter).
+  // by sqrt(19) = 4.4: 1.5 px at the rim of a strong fisheye, where tiles
+  // are 15 px, is 0.44 of the spacing. Default 0.5; finite, > 0.
   double line_prediction_tolerance = 0.5;
-  // Final pass, with an image: a corner outside every component joins one
-  // at a free label next to it when the component's lattice predicts it
-  // there and its four tiles alternate (see check_saddle_pattern); corners
-  // left out by refused merges of the large, quickly changing tiles next to
-  // a fisheye lens. Predictions: quadratic extrapolation along each lattice
-  // line through the label with three corners, and the parallelogram of
-  // each tile at the label with three corners. Each must land within
-  // attach_tolerance of the local spacing, and at least attach_min_support
-  // of them must exist. Rounds: while corners join, at most this many
-  // (0 turns the pass off).
-  int attach_rounds = 8;
-  double attach_tolerance = 0.45;
-  // A prediction contradicts only when it misses by more than this fraction
-  // of the spacing (between the two it counts neither way: true corners
-  // next to a fisheye lens miss by up to 0.55, a neighbouring lattice
-  // position by 1 and more).
-  double attach_contradiction_tolerance = 0.65;
-  int attach_min_support = 2;
-  // The tiles of an attached corner are sampled at saddle_sample_fraction or
-  // (when they do not alternate there) at this fraction of the lattice
-  // diagonals: tiles of 80-170 px next to a fisheye lens whose steps beyond
-  // the board's last corners (taken from the other side) overshoot the
-  // shrinking border tiles into the dark rim of the image circle.
-  double attach_saddle_sample_fraction = 0.15;
-  // Then (same pass) a component joins another when the other's lattice
-  // predicts one of its corners at a free label next to it as above, the
-  // image directions of both lattices at that corner agree within this
-  // angle (degrees) on both axes under exactly one lattice symmetry, no two
-  // corners meet on one label and the predictions at each corner along the
-  // seam hold more often than they fail (board halves split by refused
-  // merges near a fisheye lens; occluded boards). At most this many joins
-  // (0: none).
-  double max_join_direction_deviation_deg = 30.0;
-  int max_component_joins = 16;
-  // Components with fewer corners are dropped (not returned).
+  // Components with fewer corners are dropped (not returned). Default 4 (a
+  // single tile); >= 1.
   int min_component_size = 4;
 
-  // False with a reason when a field is out of range.
+  bool Check(std::string* why = nullptr) const;
+};
+
+// With an image, after the cleanup: corners outside every component join one
+// at a free label next to it, and components join one another, where the
+// lattice predicts them (corners and board halves left out by refused
+// merges of the large, quickly changing tiles next to a fisheye lens;
+// occluded boards).
+struct GridAttachOptions {
+  // Rounds of attaching corners, while corners join (a joined corner
+  // predicts the next one). Default 8; 0 turns the pass off; in [0, 100].
+  int rounds = 8;
+  // Predictions of a corner at a free label: quadratic extrapolation along
+  // each lattice line through the label with three corners, and the
+  // parallelogram of each tile at the label with three corners. A
+  // prediction supports when it lands within this fraction of the local
+  // spacing. Default 0.45 (below half a step: a corner one label off misses
+  // by 1); in (0, 1).
+  double tolerance = 0.45;
+  // ... and contradicts only when it misses by more than this fraction
+  // (between the two it counts neither way: true corners next to a fisheye
+  // lens miss by up to 0.55, a neighbouring lattice position by 1 and more).
+  // Default 0.65; in [tolerance, 1).
+  double contradiction_tolerance = 0.65;
+  // A corner joins when at least this many predictions support it and none
+  // contradicts. Default 2 (two independent predictions agree); in [1, 8].
+  int min_support = 2;
+  // The tiles of a joining corner are sampled at
+  // cleanup.saddle_sample_fraction or (when they do not alternate there) at
+  // this fraction of the lattice diagonals: tiles of 80-170 px next to a
+  // fisheye lens whose steps beyond the board's last corners (taken from the
+  // other side) overshoot the shrinking border tiles into the dark rim of
+  // the image circle. Default 0.15; in (0, 0.5].
+  double saddle_sample_fraction = 0.15;
+  // A component joins another when the other's lattice predicts one of its
+  // corners at a free label next to it (as above), the image directions of
+  // both lattices at that corner agree within this angle (degrees) on both
+  // axes under exactly one lattice symmetry, no two corners meet on one
+  // label and the predictions at each corner along the seam hold more often
+  // than they fail. Default 30 (a third of the 90 degrees between the
+  // axes); in (0, 90).
+  double max_join_direction_deviation_deg = 30.0;
+  // At most this many component joins. Default 16; 0: none; in [0, 1000].
+  int max_component_joins = 16;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+// After the attach pass, every labelled corner must lie where the lattice
+// of its neighbours puts it: a false corner (clutter, a blob or a junction
+// next to a lattice position whose corner was not detected) can pass the
+// merge and line checks where only a few short lines reach it (at the rim
+// of a fisheye view, next to occluders). Predictions of a corner from its
+// neighbours (itself not used): per lattice line, interpolation between the
+// neighbours on both sides and quadratic extrapolation from each side with
+// three corners; per tile at the corner, the parallelogram of its three
+// other corners.
+struct GridOffLatticeOptions {
+  // Run the check. Default true.
+  bool enabled = true;
+  // A corner is removed when it lies farther than this fraction of the
+  // local spacing from the mean of the agreeing predictions (below).
+  // Default 0.3: a third of the way to the next lattice position, above the
+  // spread of true corners (detector noise amplified 1-4 times by the
+  // predictions, perspective and fisheye curvature the quadratic terms
+  // leave); in (0, 1).
+  double tolerance = 0.3;
+  // The agreeing predictions: those within this fraction of their spacing
+  // of one of them, the largest such group (the neighbours agree with each
+  // other, so the corner and not a neighbour is off). Default 0.15; in
+  // (0, tolerance].
+  double agreement = 0.15;
+  // The corner is judged only when at least this many predictions agree and
+  // they are more than half of all its predictions. Default 2 (two
+  // independent predictions); in [2, 10].
+  int min_agreeing = 2;
+  // Rounds of removal (a removal changes its neighbours' predictions).
+  // Default 3; in [1, 10].
+  int max_rounds = 3;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+// The options of BuildGrid, one group per stage in the order they run.
+struct GridOptions {
+  GridCandidateOptions candidates;    // k-NN candidate edges and their filters
+  GridEdgeImageOptions image_tests;   // intensity penalty, sides test (image)
+  GridMergeOptions merge;             // Kruskal's merge checks
+  GridCleanupOptions cleanup;         // removal of unpredicted corners, split
+  GridAttachOptions attach;           // late joins of corners and components
+  GridOffLatticeOptions off_lattice;  // final check of every labelled corner
+
+  // False with a reason (naming the group and field) when a field is out of
+  // range.
   bool Check(std::string* why = nullptr) const;
 };
 
@@ -205,8 +303,9 @@ struct GridSummary {
   int num_removed_not_saddle = 0;     // tiles around it do not alternate
   int num_removed_by_prediction = 0;  // corners their lines did not predict
   int num_attached = 0;               // joined by the attach pass
+  int num_removed_off_lattice = 0;    // off the lattice of its neighbours
   int num_components_joined = 0;      // joined by the attach pass
-  int num_components_dropped = 0;     // below min_component_size
+  int num_components_dropped = 0;     // below cleanup.min_component_size
   int num_components = 0;             // returned
   int num_labelled_corners = 0;       // corners in returned components
   int largest_component = 0;
@@ -230,7 +329,7 @@ enum class GridEdgeDecision {
   kNeighborContradiction,  // direction/length mismatch of new neighbours
   kCollinearity,           // lines bend or jump
   kSidesFlip,              // runs through an undetected corner (image)
-  kPenalised,              // crosses a tile, refused_penalised_edges
+  kPenalised,              // crosses a tile, image_tests.refuse_penalised_edges
 };
 
 // "merged", "same tree", ...

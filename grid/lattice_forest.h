@@ -45,17 +45,17 @@ struct LatticeForest {
   LabelTable table{0};                 // (tree, label) -> corner
 };
 
-// Runs options.kruskal_passes passes of Kruskal over `sorted_edges` (sorted by
-// GridEdgeLess, weight = length), merging trees by the lattice symmetry that
-// the corners' axes at the joining edge imply, and only when the merge checks
-// pass. `crosses_tile` (may be empty) says whether an edge gets the intensity
-// penalty (weight x options.penalty_factor); it is asked only for edges that
-// join two trees when their turn comes, and penalised edges are taken up
-// again at their new weight. `sides_flip` (may be empty) refuses an edge
-// when its turn comes (it spans two tiles). The second and later passes retry
-// the edges refused before. Counts go to `summary` (merge rejections are
-// counted per attempt); `trace` (optional) gets every edge with its last
-// decision.
+// Runs options.merge.kruskal_passes passes of Kruskal over `sorted_edges`
+// (sorted by GridEdgeLess, weight = length), merging trees by the lattice
+// symmetry that the corners' axes at the joining edge imply, and only when the
+// merge checks pass. `crosses_tile` (may be empty) says whether an edge gets
+// the intensity penalty (weight x options.image_tests.penalty_factor); it is
+// asked only for edges that join two trees when their turn comes, and penalised
+// edges are taken up again at their new weight. `sides_flip` (may be empty)
+// refuses an edge when its turn comes (it spans two tiles). The second and
+// later passes retry the edges refused before. Counts go to `summary` (merge
+// rejections are counted per attempt); `trace` (optional) gets every edge with
+// its last decision.
 void BuildLatticeForest(
     const LatticeNodes& nodes, const std::vector<GridEdge>& sorted_edges,
     const std::function<bool(const GridEdge&)>& crosses_tile,

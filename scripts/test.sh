@@ -1,13 +1,25 @@
 #!/usr/bin/env bash
-# Builds puzzlecal and runs the whole test suite three ways:
-#  1. Release build (build/), ctest;
-#  2. AddressSanitizer + UBSan build (build-asan/), ctest: any finding fails;
-#  3. the libFuzzer targets (build-fuzz/, clang), each for a bounded time from
-#     its seed corpus (scripts/fuzz.sh; PUZZLECAL_FUZZ_SECONDS per target,
-#     default 20, so CI stays well inside its time; 0 skips fuzzing).
+# Builds puzzlecal and runs the test suite.
+#
+#   scripts/test.sh          install the dependencies, Release build (build/),
+#                            every ctest test. A few minutes on 2 cores.
+#   scripts/test.sh --full   the above, then an AddressSanitizer + UBSan build
+#                            (build-asan/) with every ctest test (any finding
+#                            fails), then the libFuzzer targets (build-fuzz/,
+#                            clang), each for a bounded time from its seed
+#                            corpus (scripts/fuzz.sh; PUZZLECAL_FUZZ_SECONDS per
+#                            target, default 20; 0 skips fuzzing). About half
+#                            an hour on 2 cores.
 # Prints the time of each phase at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+full=0
+case "${1:-}" in
+  "") ;;
+  --full) full=1 ;;
+  -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+  *) echo "test.sh: unknown argument '$1' (use --full or nothing)" >&2; exit 2 ;;
+esac
 fuzz_seconds="${PUZZLECAL_FUZZ_SECONDS:-20}"
 timings=()
 phase_start=$SECONDS
@@ -24,24 +36,26 @@ phase_done "build (Release)"
 (cd build && ctest --output-on-failure --parallel "$(nproc)")
 phase_done "ctest (Release)"
 
-scripts/build.sh build-asan Asan -DPUZZLECAL_BUILD_BENCH=OFF
-phase_done "build (Asan)"
-# Every sanitizer finding is fatal. LeakSanitizer needs ptrace; some
-# containers forbid it, then leaks are not checked (said below).
-export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:print_stacktrace=1"
-if build-asan/apps/puzzlecal version 2>&1 >/dev/null |
-    grep -q "LeakSanitizer has encountered a fatal error"; then
-  echo "test.sh: LeakSanitizer does not work here; leaks are not checked"
-  export ASAN_OPTIONS="halt_on_error=1:detect_leaks=0:print_stacktrace=1"
-fi
-(cd build-asan && ctest --output-on-failure --parallel "$(nproc)" --timeout 600)
-phase_done "ctest (Asan)"
+if [ "$full" = 1 ]; then
+  scripts/build.sh build-asan Asan -DPUZZLECAL_BUILD_BENCH=OFF
+  phase_done "build (Asan)"
+  # Every sanitizer finding is fatal. LeakSanitizer needs ptrace; some
+  # containers forbid it, then leaks are not checked (said below).
+  export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+  export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:print_stacktrace=1"
+  if build-asan/apps/puzzlecal version 2>&1 >/dev/null |
+      grep -q "LeakSanitizer has encountered a fatal error"; then
+    echo "test.sh: LeakSanitizer does not work here; leaks are not checked"
+    export ASAN_OPTIONS="halt_on_error=1:detect_leaks=0:print_stacktrace=1"
+  fi
+  (cd build-asan && ctest --output-on-failure --parallel "$(nproc)" --timeout 600)
+  phase_done "ctest (Asan)"
 
-if [ "$fuzz_seconds" != "0" ]; then
-  scripts/fuzz.sh "$fuzz_seconds"
-  phase_done "fuzz (${fuzz_seconds} s/target)"
+  if [ "$fuzz_seconds" != "0" ]; then
+    scripts/fuzz.sh "$fuzz_seconds"
+    phase_done "fuzz (${fuzz_seconds} s/target)"
+  fi
 fi
 
-echo "test.sh: all passed. Time per phase:"
+echo "test.sh: all passed$([ "$full" = 1 ] || echo " (Release; --full adds the sanitizer and fuzz runs)"). Time per phase:"
 printf '  %s\n' "${timings[@]}"

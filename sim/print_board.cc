@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <sstream>
 #include <vector>
@@ -74,36 +75,134 @@ std::string Number(double value) {
   return text;
 }
 
-std::string Svg(const Board& board) {
-  double page_w, page_h;
-  PrintedPageSizeMm(board, &page_w, &page_h);
+std::string XmlEscaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '&') {
+      out += "&amp;";
+    } else if (c == '<') {
+      out += "&lt;";
+    } else if (c == '>') {
+      out += "&gt;";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+// Label band below the pattern (millimetres): gap, label line, gap, scale
+// bar with its text.
+constexpr double kBandGapMm = 5.0;
+constexpr double kLabelFontMm = 3.5;
+constexpr double kBarGapMm = 3.0;
+constexpr double kBarHeightMm = 1.5;
+constexpr double kTickHeightMm = 4.0;
+constexpr double kTickWidthMm = 0.3;
+constexpr double kBandHeightMm =
+    kBandGapMm + kLabelFontMm + kBarGapMm + kTickHeightMm + kLabelFontMm;
+// The label band needs this width (the bar and its text).
+constexpr double kBandWidthMm = kScaleBarMm + 25.0;
+
+// The scale bar's black shapes: the bar and ticks every 10 mm (tall at 0,
+// 50 and 100 mm).
+std::vector<Rect> ScaleBar(const PageLayout& layout) {
+  std::vector<Rect> shapes;
+  const double x = layout.scale_bar_x_mm, y = layout.scale_bar_y_mm;
+  shapes.push_back(
+      {x, y + kTickHeightMm - kBarHeightMm, kScaleBarMm, kBarHeightMm});
+  for (int k = 0; k <= 10; ++k) {
+    const double h = k % 5 == 0 ? kTickHeightMm : 0.5 * kTickHeightMm;
+    shapes.push_back({x + k * 10.0 - 0.5 * kTickWidthMm, y + kTickHeightMm - h,
+                      kTickWidthMm, h});
+  }
+  return shapes;
+}
+
+std::string Svg(const Board& board, const PageLayout& layout) {
   std::vector<Rect> tiles;
   std::vector<Disc> discs;
   Layout(board, &tiles, &discs);
+  const double ox = layout.pattern_x_mm, oy = layout.pattern_y_mm;
   std::ostringstream out;
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<!-- " << BoardTypeName(board.type) << " " << board.cols << " x "
       << board.rows << " corners from (" << board.origin.x() << ", "
       << board.origin.y() << "), tile " << Number(board.tile_size_m * 1000)
       << " mm; user units are millimetres. Print at 100 %. -->\n"
-      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Number(page_w)
-      << "mm\" height=\"" << Number(page_h) << "mm\" viewBox=\"0 0 "
-      << Number(page_w) << " " << Number(page_h) << "\">\n"
-      << "<rect x=\"0\" y=\"0\" width=\"" << Number(page_w) << "\" height=\""
-      << Number(page_h) << "\" fill=\"#ffffff\"/>\n<g fill=\"#000000\">\n";
+      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\""
+      << Number(layout.width_mm) << "mm\" height=\"" << Number(layout.height_mm)
+      << "mm\" viewBox=\"0 0 " << Number(layout.width_mm) << " "
+      << Number(layout.height_mm) << "\">\n"
+      << "<rect x=\"0\" y=\"0\" width=\"" << Number(layout.width_mm)
+      << "\" height=\"" << Number(layout.height_mm)
+      << "\" fill=\"#ffffff\"/>\n<g fill=\"#000000\">\n";
   for (const Rect& t : tiles) {
-    out << "<rect x=\"" << Number(t.x) << "\" y=\"" << Number(t.y)
+    out << "<rect x=\"" << Number(ox + t.x) << "\" y=\"" << Number(oy + t.y)
         << "\" width=\"" << Number(t.w) << "\" height=\"" << Number(t.h)
         << "\"/>\n";
   }
   out << "</g>\n";
   for (const Disc& d : discs) {
-    out << "<circle cx=\"" << Number(d.cx) << "\" cy=\"" << Number(d.cy)
-        << "\" r=\"" << Number(d.r) << "\" fill=\""
+    out << "<circle cx=\"" << Number(ox + d.cx) << "\" cy=\""
+        << Number(oy + d.cy) << "\" r=\"" << Number(d.r) << "\" fill=\""
         << (d.white ? "#ffffff" : "#000000") << "\"/>\n";
+  }
+  if (layout.has_label) {
+    out << "<g fill=\"#000000\">\n";
+    for (const Rect& r : ScaleBar(layout)) {
+      out << "<rect x=\"" << Number(r.x) << "\" y=\"" << Number(r.y)
+          << "\" width=\"" << Number(r.w) << "\" height=\"" << Number(r.h)
+          << "\"/>\n";
+    }
+    out << "</g>\n<g font-family=\"sans-serif\" font-size=\""
+        << Number(kLabelFontMm) << "\" fill=\"#000000\">\n"
+        << "<text x=\"" << Number(layout.pattern_x_mm) << "\" y=\""
+        << Number(layout.label_y_mm) << "\">" << XmlEscaped(layout.label)
+        << "</text>\n"
+        << "<text x=\"" << Number(layout.scale_bar_x_mm + kScaleBarMm + 2)
+        << "\" y=\"" << Number(layout.scale_bar_y_mm + kTickHeightMm)
+        << "\">100 mm</text>\n</g>\n";
   }
   out << "</svg>\n";
   return out.str();
+}
+
+// The PNG with a pHYs chunk (pixels per metre, from `dpi`) after IHDR, so
+// viewers and print dialogs know its physical size.
+uint32_t Crc32(const std::string& bytes) {
+  uint32_t crc = 0xffffffffu;
+  for (unsigned char c : bytes) {
+    crc ^= c;
+    for (int k = 0; k < 8; ++k)
+      crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return crc ^ 0xffffffffu;
+}
+
+void AppendBigEndian(uint32_t value, std::string* out) {
+  for (int shift = 24; shift >= 0; shift -= 8) {
+    out->push_back(static_cast<char>((value >> shift) & 0xff));
+  }
+}
+
+bool InsertPhys(double dpi, std::string* png) {
+  // Signature (8) + IHDR (4 length + 4 type + 13 data + 4 CRC).
+  constexpr size_t kAfterIhdr = 8 + 25;
+  if (png->size() < kAfterIhdr || png->compare(12, 4, "IHDR") != 0) {
+    return false;
+  }
+  const uint32_t per_metre = static_cast<uint32_t>(std::lround(dpi / 0.0254));
+  std::string body = "pHYs";
+  AppendBigEndian(per_metre, &body);
+  AppendBigEndian(per_metre, &body);
+  body.push_back(1);  // unit: metre
+  std::string chunk;
+  AppendBigEndian(9, &chunk);
+  chunk += body;
+  AppendBigEndian(Crc32(body), &chunk);
+  png->insert(kAfterIhdr, chunk);
+  return true;
 }
 
 cairo_status_t AppendBytes(void* closure, const unsigned char* data,
@@ -114,16 +213,17 @@ cairo_status_t AppendBytes(void* closure, const unsigned char* data,
 }
 
 // Draws the page with user units of millimetres scaled by `scale`.
-void Draw(cairo_t* cr, const Board& board, double scale) {
-  double page_w, page_h;
-  PrintedPageSizeMm(board, &page_w, &page_h);
+void Draw(cairo_t* cr, const Board& board, const PageLayout& layout,
+          double scale) {
   std::vector<Rect> tiles;
   std::vector<Disc> discs;
   Layout(board, &tiles, &discs);
   cairo_scale(cr, scale, scale);
   cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_rectangle(cr, 0, 0, page_w, page_h);
+  cairo_rectangle(cr, 0, 0, layout.width_mm, layout.height_mm);
   cairo_fill(cr);
+  cairo_save(cr);
+  cairo_translate(cr, layout.pattern_x_mm, layout.pattern_y_mm);
   cairo_set_source_rgb(cr, 0, 0, 0);
   for (const Rect& t : tiles) cairo_rectangle(cr, t.x, t.y, t.w, t.h);
   cairo_fill(cr);
@@ -137,6 +237,55 @@ void Draw(cairo_t* cr, const Board& board, double scale) {
     }
     cairo_fill(cr);
   }
+  cairo_restore(cr);
+  if (!layout.has_label) return;
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  for (const Rect& r : ScaleBar(layout))
+    cairo_rectangle(cr, r.x, r.y, r.w, r.h);
+  cairo_fill(cr);
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
+                         CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, kLabelFontMm);
+  cairo_move_to(cr, layout.pattern_x_mm, layout.label_y_mm);
+  cairo_show_text(cr, layout.label.c_str());
+  cairo_move_to(cr, layout.scale_bar_x_mm + kScaleBarMm + 2,
+                layout.scale_bar_y_mm + kTickHeightMm);
+  cairo_show_text(cr, "100 mm");
+}
+
+// Sheet sizes in millimetres, portrait.
+void SheetMm(PageSize page, double* w, double* h) {
+  switch (page) {
+    case PageSize::kA4:
+      *w = 210;
+      *h = 297;
+      return;
+    case PageSize::kA3:
+      *w = 297;
+      *h = 420;
+      return;
+    case PageSize::kLetter:
+      *w = 215.9;
+      *h = 279.4;
+      return;
+    case PageSize::kPatternOnly:
+    case PageSize::kFit:
+      break;
+  }
+  *w = *h = 0;
+}
+
+std::string Label(const Board& board, const PrintOptions& options) {
+  std::ostringstream out;
+  if (!options.board_name.empty()) out << options.board_name << ": ";
+  out << BoardTypeName(board.type) << ", " << board.cols << " x " << board.rows
+      << " corners (cols x rows), tile " << Number(board.tile_size_m * 1000)
+      << " mm";
+  if (board.type == BoardType::kPuzzleBoard) {
+    out << ", origin [" << board.origin.x() << ", " << board.origin.y() << "]";
+  }
+  out << "; print at 100 %";
+  return out.str();
 }
 
 }  // namespace
@@ -158,6 +307,86 @@ bool PrintFormatFromPath(const std::string& path, PrintFormat* format) {
   return true;
 }
 
+const char* PageSizeName(PageSize page) {
+  switch (page) {
+    case PageSize::kPatternOnly:
+      return "pattern";
+    case PageSize::kFit:
+      return "fit";
+    case PageSize::kA4:
+      return "a4";
+    case PageSize::kA3:
+      return "a3";
+    case PageSize::kLetter:
+      return "letter";
+  }
+  return "pattern";
+}
+
+bool PageSizeFromName(const std::string& name, PageSize* page) {
+  for (PageSize candidate : {PageSize::kPatternOnly, PageSize::kFit,
+                             PageSize::kA4, PageSize::kA3, PageSize::kLetter}) {
+    if (name == PageSizeName(candidate)) {
+      *page = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool LayOutPage(const Board& board, const PrintOptions& options,
+                PageLayout* layout, std::string* why) {
+  *layout = PageLayout();
+  PrintedPageSizeMm(board, &layout->pattern_w_mm, &layout->pattern_h_mm);
+  const double pw = layout->pattern_w_mm, ph = layout->pattern_h_mm;
+  if (options.page == PageSize::kPatternOnly) {
+    layout->width_mm = pw;
+    layout->height_mm = ph;
+    return true;
+  }
+  const double m = options.margin_mm;
+  // Room the pattern and the label band need.
+  const double need_w = std::max(pw, kBandWidthMm);
+  const double need_h = ph + kBandHeightMm;
+  if (options.page == PageSize::kFit) {
+    layout->width_mm = need_w + 2 * m;
+    layout->height_mm = need_h + 2 * m;
+  } else {
+    double w, h;
+    SheetMm(options.page, &w, &h);
+    const bool portrait_fits = need_w <= w - 2 * m && need_h <= h - 2 * m;
+    const bool landscape_fits = need_w <= h - 2 * m && need_h <= w - 2 * m;
+    if (!portrait_fits && !landscape_fits) {
+      if (why != nullptr) {
+        std::string sheet = PageSizeName(options.page);
+        for (char& c : sheet) c = static_cast<char>(std::toupper(c));
+        if (options.page == PageSize::kLetter) sheet = "Letter";
+        *why = "the board is " + Number(pw) + " x " + Number(ph) + " mm; " +
+               (sheet[0] == 'A' ? "an " : "a ") + sheet + " sheet (" +
+               Number(w) + " x " + Number(h) + " mm) holds " +
+               Number(w - 2 * m) + " x " + Number(h - 2 * m - kBandHeightMm) +
+               " mm inside its margins and label, or " + Number(h - 2 * m) +
+               " x " + Number(w - 2 * m - kBandHeightMm) +
+               " mm in landscape: choose a larger page, --page fit, or a "
+               "board with fewer or smaller tiles";
+      }
+      return false;
+    }
+    // Landscape when only it fits, or when both do and the pattern is wide.
+    const bool landscape = !portrait_fits || (landscape_fits && pw > ph);
+    layout->width_mm = landscape ? h : w;
+    layout->height_mm = landscape ? w : h;
+  }
+  layout->pattern_x_mm = 0.5 * (layout->width_mm - pw);
+  layout->pattern_y_mm = 0.5 * (layout->height_mm - need_h);
+  layout->has_label = true;
+  layout->label_y_mm = layout->pattern_y_mm + ph + kBandGapMm + kLabelFontMm;
+  layout->scale_bar_x_mm = layout->pattern_x_mm;
+  layout->scale_bar_y_mm = layout->label_y_mm + kBarGapMm;
+  layout->label = Label(board, options);
+  return true;
+}
+
 bool PrintOptions::Check(std::string* why) const {
   if (!(std::isfinite(dpi) && dpi >= 10 && dpi <= 2400)) {
     if (why != nullptr) *why = "dpi must be in [10, 2400]";
@@ -165,6 +394,10 @@ bool PrintOptions::Check(std::string* why) const {
   }
   if (max_png_side_px < 16) {
     if (why != nullptr) *why = "max_png_side_px must be >= 16";
+    return false;
+  }
+  if (!(margin_mm >= 0 && margin_mm <= 50)) {
+    if (why != nullptr) *why = "margin_mm must be in [0, 50]";
     return false;
   }
   return true;
@@ -196,13 +429,14 @@ bool RenderPrintableBoard(const Board& board, PrintFormat format,
   std::string reason;
   if (!board.Check(&reason)) return fail("board: " + reason);
   if (!options.Check(&reason)) return fail("print options: " + reason);
+  PageLayout layout;
+  if (!LayOutPage(board, options, &layout, &reason)) return fail(reason);
   bytes->clear();
   if (format == PrintFormat::kSvg) {
-    *bytes = Svg(board);
+    *bytes = Svg(board, layout);
     return true;
   }
-  double page_w, page_h;
-  PrintedPageSizeMm(board, &page_w, &page_h);
+  const double page_w = layout.width_mm, page_h = layout.height_mm;
   cairo_surface_t* surface = nullptr;
   double scale = 1.0;
   if (format == PrintFormat::kPdf) {
@@ -227,13 +461,16 @@ bool RenderPrintableBoard(const Board& board, PrintFormat format,
     return fail("cairo: " + message);
   }
   cairo_t* cr = cairo_create(surface);
-  Draw(cr, board, scale);
+  Draw(cr, board, layout, scale);
   cairo_status_t status = cairo_status(cr);
   cairo_destroy(cr);
   if (status == CAIRO_STATUS_SUCCESS) {
     if (format == PrintFormat::kPng) {
       cairo_surface_flush(surface);
       status = cairo_surface_write_to_png_stream(surface, &AppendBytes, bytes);
+      if (status == CAIRO_STATUS_SUCCESS && !InsertPhys(options.dpi, bytes)) {
+        status = CAIRO_STATUS_WRITE_ERROR;
+      }
     } else {
       cairo_surface_finish(surface);  // writes the PDF
       status = cairo_surface_status(surface);

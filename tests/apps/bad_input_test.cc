@@ -6,6 +6,7 @@
 // The images are rendered here (sim/render.h) into a temporary folder; the
 // program is the one built beside this test (<build>/apps/puzzlecal).
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -13,7 +14,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -152,6 +156,32 @@ const std::vector<Eigen::Isometry3d>& GoodPoses() {
     };
   }();
   return poses;
+}
+
+// How often `needle` occurs in `text`.
+int CountOf(const std::string& text, const std::string& needle) {
+  int count = 0;
+  for (size_t at = text.find(needle); at != std::string::npos;
+       at = text.find(needle, at + needle.size())) {
+    ++count;
+  }
+  return count;
+}
+
+// True when a line starts like a glog line ("W20261201 19:38:04.99 123
+// f.cc:1]").
+bool HasLogPrefix(const std::string& text) {
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.size() > 9 &&
+        std::string("IWEF").find(line[0]) != std::string::npos &&
+        std::all_of(line.begin() + 1, line.begin() + 9,
+                    [](char c) { return std::isdigit(c) != 0; })) {
+      return true;
+    }
+  }
+  return false;
 }
 
 // ---------------------------------------------------------------- fixture --
@@ -490,8 +520,10 @@ TEST_F(BadInputTest, BrokenFilesAmongGoodViews) {
   const std::string all = calibrate.all();
   for (const char* name : {"truncated.png", "truncated.jpg", "zero.png",
                            "one_pixel.png", "noise.png"}) {
-    EXPECT_NE(all.find(name), std::string::npos) << name << "\n" << all;
+    // Named on one line, with its reason.
+    EXPECT_EQ(CountOf(all, std::string(name) + ": "), 1) << name << "\n" << all;
   }
+  EXPECT_FALSE(HasLogPrefix(all)) << all;
   EXPECT_TRUE(fs::exists(camera)) << all;
 }
 
@@ -648,6 +680,223 @@ TEST_F(BadInputTest, UnknownModelName) {
   EXPECT_EQ(run.exit_code, kExitUsage) << run.all();
   EXPECT_NE(run.err.find("fisheye-magic"), std::string::npos) << run.err;
   EXPECT_FALSE(fs::exists(camera));
+}
+
+// --format kalibr: pinhole-radtan calibrates Kalibr's 4-coefficient radtan
+// (k3 held at 0) and writes a camchain with the rostopic Kalibr's reader
+// requires; pinhole-rational, which the camchain cannot hold, is refused
+// before any image is read.
+TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  const fs::path camchain = case_dir_ / "camchain.yaml";
+  const RunResult run =
+      Calibrate(folder, camchain, "--format kalibr --rostopic /left/image_raw");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  const YAML::Node cam0 = YAML::LoadFile(camchain.string())["cam0"];
+  EXPECT_EQ(cam0["rostopic"].as<std::string>(), "/left/image_raw");
+  EXPECT_EQ(cam0["distortion_model"].as<std::string>(), "radtan");
+  const auto coeffs = cam0["distortion_coeffs"].as<std::vector<double>>();
+  ASSERT_EQ(coeffs.size(), 4u);
+  // The render's k1 = -0.08, k2 = 0.03: a 4-coefficient fit recovers them.
+  EXPECT_NEAR(coeffs[0], -0.08, 0.02);
+  const auto intrinsics = cam0["intrinsics"].as<std::vector<double>>();
+  EXPECT_NEAR(intrinsics[0], 560.0, 5.0);
+
+  const fs::path rational = case_dir_ / "rational.yaml";
+  const RunResult refused = Run("calibrate --images " + Quote(folder.string()) +
+                                " --board " + Quote(BoardFile().string()) +
+                                " --model pinhole-rational --format "
+                                "kalibr --verbose --out " +
+                                Quote(rational.string()));
+  EXPECT_EQ(refused.exit_code, kExitUsage) << refused.all();
+  EXPECT_NE(refused.err.find("kalibr"), std::string::npos) << refused.err;
+  EXPECT_EQ(refused.all().find("view0"), std::string::npos)
+      << "images were read before the refusal:\n"
+      << refused.all();
+  EXPECT_FALSE(fs::exists(rational));
+}
+
+// A board file that does not fit the photos (another board, another origin,
+// cols and rows swapped) ends with a message about the board file, not with
+// one about image sizes or the number of views.
+TEST_F(BadInputTest, WrongBoardFileNamesTheBoard) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  struct Case {
+    const char* name;
+    const char* yaml;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"other_board.yaml",
+            "type: puzzleboard\ncols: 23\nrows: 16\norigin: [50, 100]\n"
+            "tile_size_m: 0.030\n"},
+           {"other_origin.yaml",
+            "type: puzzleboard\ncols: 11\nrows: 8\norigin: [40, 40]\n"
+            "tile_size_m: 0.060\n"},
+           {"swapped.yaml",
+            "type: puzzleboard\ncols: 8\nrows: 11\norigin: [0, 0]\n"
+            "tile_size_m: 0.060\n"},
+       }) {
+    const fs::path board = case_dir_ / c.name;
+    WriteFile(board, c.yaml);
+    const fs::path camera = case_dir_ / "camera.yaml";
+    const RunResult run =
+        Run("calibrate --images " + Quote(folder.string()) + " --board " +
+            Quote(board.string()) + " --out " + Quote(camera.string()) +
+            " --report " + Quote((case_dir_ / "report").string()));
+    EXPECT_EQ(run.exit_code, kExitNoResult) << c.name << "\n" << run.all();
+    EXPECT_NE(run.err.find("5 of 5 images show many corners but none matches "
+                           "the code of " +
+                           board.string() +
+                           " at any position: check cols, rows and origin"),
+              std::string::npos)
+        << c.name << "\n"
+        << run.err;
+    EXPECT_EQ(run.all().find("must be positive"), std::string::npos)
+        << run.all();
+    EXPECT_EQ(run.all().find("add more views"), std::string::npos) << run.all();
+    EXPECT_FALSE(fs::exists(camera));
+  }
+}
+
+// Images of two sizes: the size most images have is used; the others are
+// named with theirs.
+TEST_F(BadInputTest, ImagesOfAnotherSizeAreNamed) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("sizes", 5);
+  // Sorted first, so "the first image's size" would be the wrong choice.
+  cv::Mat wider;
+  cv::copyMakeBorder(Render(GoodPoses()[1]), wider, 0, 20, 0, 60,
+                     cv::BORDER_REPLICATE);
+  WriteFile(folder / "a_wider.png", EncodeImage(wider, ".png"));
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const RunResult run = Calibrate(folder, camera);
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_NE(run.err.find("a_wider.png"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("700x500 differs from the 640x480 most images have"),
+            std::string::npos)
+      << run.err;
+  const YAML::Node file = YAML::LoadFile(camera.string());
+  EXPECT_EQ(file["image_width"].as<int>(), 640);
+  EXPECT_EQ(file["views"].size(), 5u);
+}
+
+// The camera file is written before the report; the report folder is
+// replaced as a whole (old overlays go); a report folder holding other files
+// and an unwritable camera path are refused before any image is read.
+TEST_F(BadInputTest, OutputsCheckedFirstAndReportReplaced) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const fs::path report = case_dir_ / "report";
+  fs::create_directories(report);
+  WriteFile(report / "overlay_from_an_old_run.png", "old");
+  WriteFile(report / "summary.md", "old summary");
+  RunResult run =
+      Calibrate(folder, camera, "--report " + Quote(report.string()));
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_TRUE(fs::exists(camera));
+  EXPECT_FALSE(fs::exists(report / "overlay_from_an_old_run.png"));
+  EXPECT_NE(ReadFile(report / "summary.md"), "old summary");
+  for (const auto& entry : fs::directory_iterator(case_dir_)) {
+    EXPECT_EQ(entry.path().filename().string().find(".report"),
+              std::string::npos)
+        << entry.path();
+  }
+
+  const fs::path notes = case_dir_ / "notes";
+  fs::create_directories(notes);
+  WriteFile(notes / "my_notes.txt", "keep me");
+  const fs::path camera2 = case_dir_ / "camera2.yaml";
+  run =
+      Calibrate(folder, camera2, "--verbose --report " + Quote(notes.string()));
+  EXPECT_EQ(run.exit_code, kExitOutputError) << run.all();
+  EXPECT_NE(run.err.find("my_notes.txt"), std::string::npos) << run.err;
+  EXPECT_EQ(run.all().find("view0.png"), std::string::npos)
+      << "images were read before the refusal:\n"
+      << run.all();
+  EXPECT_EQ(ReadFile(notes / "my_notes.txt"), "keep me");
+  EXPECT_FALSE(fs::exists(camera2));
+}
+
+// Ctrl-C while the images are processed: "interrupted", exit 130, nothing
+// half-written.
+TEST_F(BadInputTest, InterruptSaysSoAndLeavesNothingHalfWritten) {
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  const fs::path camera = case_dir_ / "camera.yaml";
+  int err_pipe[2];
+  ASSERT_EQ(pipe(err_pipe), 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    dup2(err_pipe[1], STDERR_FILENO);
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, STDOUT_FILENO);
+    close(err_pipe[0]);
+    const std::string program = program_.string();
+    const std::string images = folder.string(), out = camera.string(),
+                      board = BoardFile().string();
+    execl(program.c_str(), program.c_str(), "calibrate", "--images",
+          images.c_str(), "--board", board.c_str(), "--out", out.c_str(),
+          "--threads", "1", "--verbose", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(err_pipe[1]);
+  // The first image line: the run is under way, four images and the
+  // calibration still to go.
+  std::string err;
+  char buffer[256];
+  while (err.find("[1/") == std::string::npos) {
+    const ssize_t n = read(err_pipe[0], buffer, sizeof(buffer));
+    if (n <= 0) break;
+    err.append(buffer, n);
+  }
+  kill(child, SIGINT);
+  for (ssize_t n; (n = read(err_pipe[0], buffer, sizeof(buffer))) > 0;) {
+    err.append(buffer, n);
+  }
+  close(err_pipe[0]);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
+  EXPECT_NE(err.find("interrupted"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(camera));
+  for (const std::string& file : FilesUnder(case_dir_)) {
+    EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+  }
+}
+
+// The console: --version, `help SUBCOMMAND`, required flags marked, --quiet.
+TEST_F(BadInputTest, ConsoleVersionHelpAndQuiet) {
+  RunResult run = Run("--version");
+  EXPECT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_EQ(run.out.rfind("puzzlecal ", 0), 0u) << run.out;
+  run = Run("help calibrate");
+  EXPECT_EQ(run.exit_code, kExitOk) << run.all();
+  for (const char* line :
+       {"--images (required)", "--board (required)", "--out (required)",
+        "--format (default: puzzlecal)",
+        "--rostopic (default: /cam0/image_raw)",
+        "--camera-name (default: camera)", "--quiet", "--verbose"}) {
+    EXPECT_NE(run.out.find(line), std::string::npos) << line << "\n" << run.out;
+  }
+  EXPECT_NE(run.out.find("the camera file"), std::string::npos) << run.out;
+  EXPECT_EQ(Run("help calibrate").out, Run("calibrate --help").out);
+  EXPECT_EQ(Run("help no-such-thing").exit_code, kExitUsage);
+
+  SKIP_WITHOUT_CALIBRATE();
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  WriteFile(folder / "zero.png", "");
+  const fs::path camera = case_dir_ / "camera.yaml";
+  run = Calibrate(folder, camera, "--quiet --camera-name left");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_EQ(run.err, "");
+  EXPECT_EQ(run.out, "wrote " + camera.string() + "\n");
+  run = Calibrate(folder, camera, "--quiet --verbose");
+  EXPECT_EQ(run.exit_code, kExitUsage) << run.all();
 }
 
 // Command-line mistakes: exit 2 with a message naming the flag or argument,

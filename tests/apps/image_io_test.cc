@@ -1,6 +1,7 @@
 #include "apps/image_io.h"
 
 #include <gtest/gtest.h>
+#include <libdeflate.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -166,6 +167,37 @@ TEST_F(ImageIoTest, JpegWithThumbnailAndTrailer) {
   EXPECT_NE(error.find("truncated JPEG"), std::string::npos) << error;
 }
 
+// A JPEG whose EXIF orientation tag says "rotate 90 degrees" (6) loads in
+// the sensor's frame, as stored: calibration needs that frame.
+TEST_F(ImageIoTest, JpegExifOrientationIsNotApplied) {
+  cv::Mat colour;
+  cv::cvtColor(ramp_, colour, cv::COLOR_GRAY2BGR);
+  cv::imwrite(Path("plain.jpg"), colour, {cv::IMWRITE_JPEG_QUALITY, 100});
+  const std::string jpg = ReadBytes("plain.jpg");
+  // APP1: "Exif\0\0", big-endian TIFF header, one IFD entry 0x0112
+  // (orientation), SHORT, count 1, value 6; no next IFD.
+  const std::string tiff =
+      std::string("MM\0*\0\0\0\x08", 8) + std::string("\0\x01", 2) +
+      std::string("\x01\x12\0\x03\0\0\0\x01\0\x06\0\0", 12) +
+      std::string("\0\0\0\0", 4);
+  const std::string payload = std::string("Exif\0\0", 6) + tiff;
+  const size_t length = payload.size() + 2;
+  const std::string app1 = std::string("\xFF\xE1") +
+                           static_cast<char>(length >> 8) +
+                           static_cast<char>(length & 0xFF) + payload;
+  WriteBytes("rotated.jpg", jpg.substr(0, 2) + app1 + jpg.substr(2));
+  // The tag is real: OpenCV's default reading turns the image.
+  ASSERT_EQ(cv::imread(Path("rotated.jpg"), cv::IMREAD_GRAYSCALE).size(),
+            cv::Size(ramp_.rows, ramp_.cols));
+  cv::Mat grey;
+  std::string error;
+  ASSERT_TRUE(LoadGreyImage(Path("rotated.jpg"), {}, &grey, &error)) << error;
+  ASSERT_EQ(grey.size(), ramp_.size());
+  cv::Mat difference;
+  cv::absdiff(grey, ramp_, difference);
+  EXPECT_LE(cv::norm(difference, cv::NORM_INF), 3.0);
+}
+
 // A PNG whose header claims 20000 x 20000 pixels is refused from the header,
 // before any decoding (the file holds no image data at all).
 TEST_F(ImageIoTest, RefusesAHugePngFromItsHeader) {
@@ -183,6 +215,81 @@ TEST_F(ImageIoTest, RefusesAHugePngFromItsHeader) {
   EXPECT_FALSE(LoadGreyImage(Path("bomb.png"), {}, &grey, &error));
   EXPECT_NE(error.find("20000x20000"), std::string::npos) << error;
   EXPECT_NE(error.find("exceeds"), std::string::npos) << error;
+}
+
+// A PNG of `image` (8-bit grey) written here, row y filtered with
+// filter(y) (0 None, 1 Sub, 2 Up, 3 Average, 4 Paeth), the data split over
+// two IDAT chunks.
+std::string GreyPng(const cv::Mat& image, int (*filter)(int)) {
+  auto big_endian = [](uint32_t v) {
+    return std::string{static_cast<char>(v >> 24), static_cast<char>(v >> 16),
+                       static_cast<char>(v >> 8), static_cast<char>(v)};
+  };
+  auto chunk = [&](const std::string& type, const std::string& data) {
+    const std::string body = type + data;
+    return big_endian(static_cast<uint32_t>(data.size())) + body +
+           big_endian(libdeflate_crc32(0, body.data(), body.size()));
+  };
+  std::string raw;
+  for (int y = 0; y < image.rows; ++y) {
+    const int f = filter(y);
+    raw += static_cast<char>(f);
+    for (int x = 0; x < image.cols; ++x) {
+      const int a = x > 0 ? image.at<uint8_t>(y, x - 1) : 0;
+      const int b = y > 0 ? image.at<uint8_t>(y - 1, x) : 0;
+      const int c = x > 0 && y > 0 ? image.at<uint8_t>(y - 1, x - 1) : 0;
+      const int pa = std::abs(b - c), pb = std::abs(a - c),
+                pc = std::abs(a + b - 2 * c);
+      const int predictor[5] = {0, a, b, (a + b) / 2,
+                                pa <= pb && pa <= pc ? a : (pb <= pc ? b : c)};
+      raw += static_cast<char>(image.at<uint8_t>(y, x) - predictor[f]);
+    }
+  }
+  libdeflate_compressor* compressor = libdeflate_alloc_compressor(6);
+  std::string packed(libdeflate_zlib_compress_bound(compressor, raw.size()),
+                     '\0');
+  packed.resize(libdeflate_zlib_compress(compressor, raw.data(), raw.size(),
+                                         packed.data(), packed.size()));
+  libdeflate_free_compressor(compressor);
+  const std::string header = big_endian(image.cols) + big_endian(image.rows) +
+                             std::string("\x08\0\0\0\0", 5);
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", header) +
+         chunk("IDAT", packed.substr(0, packed.size() / 2)) +
+         chunk("IDAT", packed.substr(packed.size() / 2)) + chunk("IEND", "");
+}
+
+// Grey PNGs with every filter type load exactly, and as libpng (behind
+// cv::imdecode) reads them; a corrupt one is refused with the file's name.
+TEST_F(ImageIoTest, GreyPngsWithEveryFilterLoadExactly) {
+  cv::Mat image(23, 37, CV_8UC1);
+  cv::randu(image, 0, 256);
+  image.rowRange(0, 8) = ramp_(cv::Rect(0, 0, 37, 8)) * 1.0;
+  int (*filters[])(int) = {[](int) { return 0; }, [](int) { return 1; },
+                           [](int) { return 2; }, [](int) { return 3; },
+                           [](int) { return 4; }, [](int y) { return y % 5; }};
+  for (int k = 0; k < 6; ++k) {
+    const std::string name = "filter" + std::to_string(k) + ".png";
+    const std::string png = GreyPng(image, filters[k]);
+    WriteBytes(name, png);
+    cv::Mat grey;
+    std::string error;
+    ASSERT_TRUE(LoadGreyImage(Path(name), {}, &grey, &error)) << error;
+    ASSERT_EQ(grey.size(), image.size()) << name;
+    EXPECT_EQ(cv::norm(grey, image, cv::NORM_INF), 0.0) << name;
+    const cv::Mat by_libpng =
+        cv::imdecode(std::vector<unsigned char>(png.begin(), png.end()),
+                     cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(by_libpng.size(), image.size()) << name;
+    EXPECT_EQ(cv::norm(by_libpng, image, cv::NORM_INF), 0.0) << name;
+  }
+  std::string corrupt = GreyPng(image, filters[5]);
+  corrupt[corrupt.size() - 40] ^= 0x5A;  // inside the second IDAT
+  WriteBytes("corrupt.png", corrupt);
+  cv::Mat grey;
+  std::string error;
+  EXPECT_FALSE(LoadGreyImage(Path("corrupt.png"), {}, &grey, &error));
+  EXPECT_NE(error.find("corrupt.png"), std::string::npos) << error;
+  EXPECT_TRUE(grey.empty());
 }
 
 TEST_F(ImageIoTest, RefusesImagesAboveThePixelLimit) {

@@ -174,5 +174,40 @@ TEST_F(PipelineTest, CheckerboardViewKeepsOneConsistentComponent) {
   EXPECT_EQ(consistent_transforms, 1);
 }
 
+// Views come from the image size most usable images have, whichever comes
+// first; the others are marked with both sizes.
+TEST(MakeCalibrationViewsTest, UsesTheSizeMostImagesHave) {
+  const Board board =
+      MakeBoard(BoardType::kPuzzleBoard, 11, 8, Eigen::Vector2i(0, 0), 0.02);
+  std::vector<ImageResult> images(5);
+  const int sizes[5][2] = {
+      {800, 600}, {640, 480}, {640, 480}, {1024, 768}, {640, 480}};
+  for (int i = 0; i < 5; ++i) {
+    images[i].file = "view" + std::to_string(i) + ".png";
+    images[i].outcome = ImageOutcome::kUsable;
+    images[i].width = sizes[i][0];
+    images[i].height = sizes[i][1];
+    for (int k = 0; k < 6; ++k) {
+      images[i].decode.observation.id.emplace_back(k, 0);
+      images[i].decode.observation.xy.emplace_back(10.0 * k, 5.0);
+    }
+  }
+  images[3].outcome = ImageOutcome::kNoGrid;  // not usable: not counted
+  std::vector<int> view_of_image;
+  int width = 0, height = 0;
+  const std::vector<CalibrationView> views =
+      MakeCalibrationViews(board, &images, &view_of_image, &width, &height);
+  EXPECT_EQ(width, 640);
+  EXPECT_EQ(height, 480);
+  ASSERT_EQ(views.size(), 3u);
+  EXPECT_EQ(view_of_image, (std::vector<int>{-1, 0, 1, -1, 2}));
+  EXPECT_EQ(images[0].outcome, ImageOutcome::kSizeMismatch);
+  EXPECT_NE(images[0].reason.find("800x600 differs from the 640x480"),
+            std::string::npos)
+      << images[0].reason;
+  EXPECT_EQ(images[3].outcome, ImageOutcome::kNoGrid);
+  EXPECT_EQ(views[0].board_points[2], board.Point(Eigen::Vector2i(2, 0)));
+}
+
 }  // namespace
 }  // namespace puzzlecal

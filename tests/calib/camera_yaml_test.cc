@@ -4,12 +4,15 @@
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "calib/atomic_file.h"
+#include "tests/calib/synthetic_views.h"
+#include "util/atomic_file.h"
 
 namespace puzzlecal {
 namespace {
@@ -233,6 +236,152 @@ TEST_F(CameraYamlTest, KalibrRefusesLossyWritesAndKeepsTheOldFile) {
   }
 }
 
+TEST_F(CameraYamlTest, FormatsSayBeforehandWhichParametersMustBeFixed) {
+  std::vector<std::string> fixed;
+  std::string error;
+  ASSERT_TRUE(CameraFormatFixedParams(CameraFileFormat::kKalibr,
+                                      CameraModelId::kPinholeRadtan, &fixed,
+                                      &error));
+  EXPECT_EQ(fixed, std::vector<std::string>{"k3"});
+  ASSERT_TRUE(CameraFormatFixedParams(CameraFileFormat::kKalibr,
+                                      CameraModelId::kKannalaBrandt, &fixed,
+                                      &error));
+  EXPECT_TRUE(fixed.empty());
+  EXPECT_FALSE(CameraFormatFixedParams(CameraFileFormat::kKalibr,
+                                       CameraModelId::kPinholeRational, &fixed,
+                                       &error));
+  EXPECT_NE(error.find("pinhole-rational"), std::string::npos) << error;
+  for (CameraFileFormat format :
+       {CameraFileFormat::kPuzzlecal, CameraFileFormat::kOpenCv,
+        CameraFileFormat::kRos}) {
+    for (CameraModelId model :
+         {CameraModelId::kPinholeRadtan, CameraModelId::kPinholeRational,
+          CameraModelId::kKannalaBrandt}) {
+      EXPECT_TRUE(CameraFormatFixedParams(format, model, &fixed, &error));
+      EXPECT_TRUE(fixed.empty());
+    }
+  }
+}
+
+// Read as Kalibr's camchain reader does: cam0 with camera_model, intrinsics,
+// distortion_model, distortion_coeffs, resolution and the required rostopic;
+// ros camera_info with its camera_name.
+TEST_F(CameraYamlTest, KalibrAndRosFilesCarryTopicAndName) {
+  Camera camera = MakeCamera(CameraModelId::kPinholeRadtan);
+  camera.params[8] = 0;
+  CameraFileNames names;
+  std::string text, error;
+  ASSERT_TRUE(FormatCameraFile(camera, CameraFileStats(),
+                               CameraFileFormat::kKalibr, &text, &error));
+  YAML::Node cam0 = YAML::Load(text)["cam0"];
+  ASSERT_TRUE(cam0.IsMap()) << text;
+  EXPECT_EQ(cam0["rostopic"].as<std::string>(), "/cam0/image_raw");
+  EXPECT_EQ(cam0["camera_model"].as<std::string>(), "pinhole");
+  EXPECT_EQ(cam0["distortion_model"].as<std::string>(), "radtan");
+  const auto intrinsics = cam0["intrinsics"].as<std::vector<double>>();
+  const auto coeffs = cam0["distortion_coeffs"].as<std::vector<double>>();
+  const auto resolution = cam0["resolution"].as<std::vector<int>>();
+  ASSERT_EQ(intrinsics.size(), 4u);
+  ASSERT_EQ(coeffs.size(), 4u);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(intrinsics[k], camera.params[k]);
+    EXPECT_EQ(coeffs[k], camera.params[4 + k]);
+  }
+  EXPECT_EQ(resolution, (std::vector<int>{camera.width, camera.height}));
+
+  names.rostopic = "/left/image_mono";
+  names.camera_name = "left_camera";
+  ASSERT_TRUE(FormatCameraFile(camera, CameraFileStats(),
+                               CameraFileFormat::kKalibr, &text, &error,
+                               names));
+  EXPECT_EQ(YAML::Load(text)["cam0"]["rostopic"].as<std::string>(),
+            "/left/image_mono");
+  ASSERT_TRUE(FormatCameraFile(camera, CameraFileStats(),
+                               CameraFileFormat::kRos, &text, &error, names));
+  EXPECT_EQ(YAML::Load(text)["camera_name"].as<std::string>(), "left_camera");
+  ASSERT_TRUE(FormatCameraFile(camera, CameraFileStats(),
+                               CameraFileFormat::kRos, &text, &error));
+  EXPECT_EQ(YAML::Load(text)["camera_name"].as<std::string>(), "camera");
+}
+
+// The puzzlecal format's `views`: poses read back and used the way OpenCV
+// uses a pose (cv::projectPoints, cv::fisheye::projectPoints) put the board
+// corners, in the board file's frame, onto the observed corners.
+TEST_F(CameraYamlTest, ViewPosesReprojectTheBoardWithOpenCv) {
+  for (const Camera& truth :
+       {testing::TruthRadtan(), testing::TruthFisheye190()}) {
+    testing::SyntheticScene scene;
+    scene.camera = truth;
+    scene.num_views = 8;
+    scene.max_corner_angle_deg = 70;  // cv::fisheye's range
+    testing::SyntheticData data = testing::MakeSyntheticData(scene);
+    // The calibration's board frame has the first printed corner at
+    // `first_corner` (a PuzzleBoard with origin (7, 3)); the file's at 0.
+    const Eigen::Vector3d first_corner(7 * scene.tile, 3 * scene.tile, 0);
+    std::vector<std::vector<Eigen::Vector3d>> file_points;
+    std::vector<std::string> files;
+    for (CalibrationView& view : data.views) {
+      file_points.push_back(view.board_points);
+      for (Eigen::Vector3d& p : view.board_points) p += first_corner;
+      files.push_back("view" + std::to_string(files.size()) + ".png");
+    }
+    CalibrationResult result;
+    std::string error;
+    ASSERT_TRUE(Calibrate(data.views, truth.model, truth.width, truth.height,
+                          CalibrationOptions(), &result, &error))
+        << error;
+    const std::string path = Path("views.yaml");
+    ASSERT_TRUE(WriteCameraFile(
+        path, CameraFileFormat::kPuzzlecal, result.camera,
+        CameraFileStatsOfResult(result, files, first_corner), &error))
+        << error;
+    std::vector<CameraFileView> views;
+    ASSERT_TRUE(ReadCameraFileViews(path, &views, &error)) << error;
+    ASSERT_EQ(views.size(), data.views.size());
+    const auto& p = result.camera.params;
+    const cv::Matx33d k(p[0], 0, p[2], 0, p[1], p[3], 0, 0, 1);
+    for (size_t v = 0; v < views.size(); ++v) {
+      EXPECT_EQ(views[v].file, files[v]);
+      EXPECT_EQ(views[v].corners,
+                static_cast<int>(data.views[v].board_points.size()));
+      EXPECT_GT(views[v].rms_px, 0.0);
+      EXPECT_LT(views[v].rms_px, 0.3);
+      cv::Matx33d r;
+      cv::Vec3d t;
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j)
+          r(i, j) = views[v].cam_from_board.linear()(i, j);
+        t[i] = views[v].cam_from_board.translation()[i];
+      }
+      cv::Vec3d rvec;
+      cv::Rodrigues(r, rvec);
+      std::vector<cv::Point3d> object;
+      for (const Eigen::Vector3d& q : file_points[v]) {
+        object.emplace_back(q.x(), q.y(), q.z());
+      }
+      std::vector<cv::Point2d> projected;
+      if (truth.model == CameraModelId::kKannalaBrandt) {
+        cv::fisheye::projectPoints(object, projected, rvec, t, k,
+                                   cv::Vec4d(p[4], p[5], p[6], p[7]));
+      } else {
+        cv::projectPoints(object, rvec, t, k,
+                          std::vector<double>(p.begin() + 4, p.end()),
+                          projected);
+      }
+      double sum = 0;
+      for (size_t c = 0; c < object.size(); ++c) {
+        const Eigen::Vector2d& seen = data.views[v].image_points[c];
+        sum += std::pow(projected[c].x - seen.x(), 2) +
+               std::pow(projected[c].y - seen.y(), 2);
+      }
+      const double rms = std::sqrt(sum / (2.0 * object.size()));
+      // The noise is 0.1 px per coordinate; the view's RMS is that of its fit.
+      EXPECT_LT(rms, 0.2) << CameraModelName(truth.model) << " view " << v;
+      EXPECT_NEAR(rms, views[v].rms_px, 0.02);
+    }
+  }
+}
+
 TEST_F(CameraYamlTest, BadFilesGiveMessagesNamingFileAndField) {
   struct Case {
     const char* text;
@@ -291,24 +440,6 @@ TEST_F(CameraYamlTest, FormatNames) {
   }
   CameraFileFormat parsed;
   EXPECT_FALSE(CameraFileFormatFromName("json", &parsed));
-}
-
-TEST_F(CameraYamlTest, AtomicWriteReplacesAndReportsFailures) {
-  const std::string path = Path("atomic.txt");
-  std::string error;
-  ASSERT_TRUE(WriteFileAtomically(path, "first", &error)) << error;
-  ASSERT_TRUE(WriteFileAtomically(path, "second", &error)) << error;
-  std::ifstream in(path);
-  std::string contents((std::istreambuf_iterator<char>(in)),
-                       std::istreambuf_iterator<char>());
-  EXPECT_EQ(contents, "second");
-  const std::string bad = dir_ + "/no_such_folder/file.txt";
-  EXPECT_FALSE(WriteFileAtomically(bad, "x", &error));
-  EXPECT_NE(error.find(bad), std::string::npos) << error;
-  EXPECT_NE(error.find("No such file"), std::string::npos) << error;
-  EXPECT_FALSE(WriteFileAtomically(dir_, "x", &error));
-  EXPECT_NE(error.find("folder"), std::string::npos) << error;
-  EXPECT_FALSE(WriteFileAtomically("", "x", &error));
 }
 
 }  // namespace

@@ -692,6 +692,51 @@ TEST(DetectorTest, DeterministicAndSortedByYThenX) {
   }
 }
 
+// A detector kept across images (its buffers reused) finds exactly what a
+// fresh one finds, whatever it saw before: a larger image, another size,
+// three pyramid levels, and each refinement that keeps whole blurred levels.
+TEST(DetectorTest, ReusedDetectorMatchesAFreshOneAcrossSizes) {
+  const Board board = MakeBoard(BoardType::kPuzzleBoard, 11, 8);
+  RenderOptions render;
+  render.noise_sigma = 0.02;
+  const cv::Mat large = RenderBoard(board, Pinhole(900, 700, 900.0),
+                                    CentredPose(board, 900.0, 40.0, 0.2, 0.4),
+                                    render);
+  const cv::Mat small = RenderBoard(board, Pinhole(500, 380, 500.0),
+                                    CentredPose(board, 500.0, 22.0, -0.3, 0.2),
+                                    render);
+  for (SubpixelMethod method :
+       {SubpixelMethod::kSaddleFit, SubpixelMethod::kGradientOrthogonality,
+        SubpixelMethod::kCentroid}) {
+    DetectorOptions options;
+    options.num_levels = 3;
+    options.subpixel = method;
+    CornerDetector reused(options);
+    for (const cv::Mat* image : {&large, &small, &large, &small}) {
+      DetectorSummary fresh_summary, reused_summary;
+      const std::vector<Corner> fresh =
+          DetectCorners(*image, options, &fresh_summary);
+      const std::vector<Corner> again = reused.Detect(*image, &reused_summary);
+      ASSERT_GT(fresh.size(), 40u);
+      EXPECT_EQ(reused_summary.levels_used, fresh_summary.levels_used);
+      ASSERT_EQ(again.size(), fresh.size());
+      for (size_t i = 0; i < fresh.size(); ++i) {
+        EXPECT_EQ(again[i].xy, fresh[i].xy);
+        EXPECT_EQ(again[i].orientation, fresh[i].orientation);
+        EXPECT_EQ(again[i].response, fresh[i].response);
+      }
+    }
+    // A strip whose first coarse level is already below the minimum side
+    // (16 px): two levels, however large the images before it were.
+    const cv::Mat strip = large(cv::Rect(0, 0, 40, 30)).clone();
+    DetectorSummary fresh_summary, reused_summary;
+    DetectCorners(strip, options, &fresh_summary);
+    reused.Detect(strip, &reused_summary);
+    EXPECT_EQ(fresh_summary.levels_used, 2);
+    EXPECT_EQ(reused_summary.levels_used, 2);
+  }
+}
+
 TEST(DetectorTest, BadInputGivesNoCornersAndAReason) {
   DetectorSummary summary;
   EXPECT_TRUE(DetectCorners(cv::Mat(), {}, &summary).empty());

@@ -369,7 +369,7 @@ TEST(GridTest, DegenerateInputsDoNotCrash) {
 TEST(GridTest, BadOptionsAndImagesAreRefusedWithAReason) {
   std::vector<Corner> corners(4);
   GridOptions options;
-  options.num_neighbors = 0;
+  options.candidates.num_neighbors = 0;
   std::string why;
   EXPECT_FALSE(options.Check(&why));
   EXPECT_NE(why.find("num_neighbors"), std::string::npos);
@@ -383,6 +383,45 @@ TEST(GridTest, BadOptionsAndImagesAreRefusedWithAReason) {
   EXPECT_FALSE(summary.ok);
   EXPECT_NE(summary.message.find("image type"), std::string::npos);
   EXPECT_TRUE(GridOptions().Check(&why));
+}
+
+// Every option group refuses an out-of-range field and names it with its
+// group; the defaults pass.
+TEST(GridTest, EachOptionGroupChecksItsFields) {
+  std::string why;
+  EXPECT_TRUE(GridCandidateOptions().Check(&why)) << why;
+  EXPECT_TRUE(GridEdgeImageOptions().Check(&why)) << why;
+  EXPECT_TRUE(GridMergeOptions().Check(&why)) << why;
+  EXPECT_TRUE(GridCleanupOptions().Check(&why)) << why;
+  EXPECT_TRUE(GridAttachOptions().Check(&why)) << why;
+  EXPECT_TRUE(GridOffLatticeOptions().Check(&why)) << why;
+  struct Case {
+    void (*spoil)(GridOptions*);
+    const char* name;
+  };
+  const Case cases[] = {
+      {[](GridOptions* o) {
+         o->candidates.min_orientation_difference_deg = 90;
+       },
+       "candidates.min_orientation_difference_deg"},
+      {[](GridOptions* o) { o->image_tests.penalty_factor = 0.5; },
+       "image_tests.penalty_factor"},
+      {[](GridOptions* o) { o->merge.kruskal_passes = 0; },
+       "merge.kruskal_passes"},
+      {[](GridOptions* o) { o->cleanup.min_component_size = 0; },
+       "cleanup.min_component_size"},
+      {[](GridOptions* o) { o->attach.contradiction_tolerance = 0.2; },
+       "attach.contradiction_tolerance"},
+      {[](GridOptions* o) { o->off_lattice.agreement = 0.5; },
+       "off_lattice.agreement"},
+  };
+  for (const Case& c : cases) {
+    GridOptions options;
+    c.spoil(&options);
+    why.clear();
+    EXPECT_FALSE(options.Check(&why)) << c.name;
+    EXPECT_NE(why.find(c.name), std::string::npos) << why;
+  }
 }
 
 }  // namespace

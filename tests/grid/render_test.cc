@@ -232,9 +232,9 @@ TEST(GridRenderTest, AttachPassJoinsLeftOutCornersAndComponents) {
   const Camera& camera = setup.camera;
   const RenderOptions& options = setup.options;
   GridOptions strict;
-  strict.neighbor_weight_ratio = 1.2;
-  strict.tree_mean_weight_ratio_min = 1 / 1.2;
-  strict.tree_mean_weight_ratio_max = 1.2;
+  strict.merge.neighbor_weight_ratio = 1.2;
+  strict.merge.tree_mean_weight_ratio_min = 1 / 1.2;
+  strict.merge.tree_mean_weight_ratio_max = 1.2;
   std::printf(
       "angle  min_size  attach  detected  labelled  largest  components  "
       "wrong  attached  joined\n");
@@ -243,10 +243,10 @@ TEST(GridRenderTest, AttachPassJoinsLeftOutCornersAndComponents) {
     const Eigen::Isometry3d cam_from_board = grid_test::LookAtBoard(
         Geometry(board), 0.1, angle, 30, 20, Eigen::Vector3d(0.05, 0.03, 0));
     for (int min_size : {4, 20}) {
-      strict.min_component_size = min_size;
+      strict.cleanup.min_component_size = min_size;
       LabelCheck checks[2];
       for (int attach : {0, 1}) {
-        strict.attach_rounds = attach ? 8 : 0;
+        strict.attach.rounds = attach ? 8 : 0;
         GridSummary summary;
         const RenderOutcome outcome = DetectAndLabel(
             board, camera, cam_from_board, options, 12.0, strict, &summary);

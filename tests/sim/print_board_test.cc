@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
+#include "apps/config_io.h"
+#include "apps/pipeline.h"
 #include "decode/puzzleboard.h"
 
 namespace puzzlecal {
@@ -155,6 +159,147 @@ TEST(PrintBoardTest, BadInputSaysWhy) {
   EXPECT_FALSE(PrintFormatFromPath("board.jpg", &format));
   EXPECT_TRUE(PrintFormatFromPath("BOARD.PDF", &format));
   EXPECT_EQ(format, PrintFormat::kPdf);
+}
+
+// The pHYs chunk of a PNG: pixels per metre in x and y (0 when absent).
+void ReadPhys(const std::string& png, uint32_t* x, uint32_t* y) {
+  *x = *y = 0;
+  auto be32 = [&](size_t at) {
+    return (static_cast<uint32_t>(static_cast<unsigned char>(png[at])) << 24) |
+           (static_cast<uint32_t>(static_cast<unsigned char>(png[at + 1]))
+            << 16) |
+           (static_cast<uint32_t>(static_cast<unsigned char>(png[at + 2]))
+            << 8) |
+           static_cast<uint32_t>(static_cast<unsigned char>(png[at + 3]));
+  };
+  for (size_t at = 8; at + 12 <= png.size();) {
+    const uint32_t length = be32(at);
+    if (png.compare(at + 4, 4, "pHYs") == 0 && length == 9 &&
+        png[at + 16] == 1) {
+      *x = be32(at + 8);
+      *y = be32(at + 12);
+      return;
+    }
+    at += 12 + length;
+  }
+}
+
+// An A4 page: the sheet in landscape at the exact size, the pattern centred
+// where LayOutPage says (decoded corners land at their page positions), a
+// 100 mm scale bar 100 mm long, the dpi stored in pHYs.
+TEST(PrintBoardTest, A4PageHoldsThePatternLabelAndScaleBar) {
+  const Board board = MakeBoard(BoardType::kPuzzleBoard, 13, 8,
+                                Eigen::Vector2i(100, 200), 0.02);
+  PrintOptions options;
+  options.page = PageSize::kA4;
+  options.dpi = 150;
+  options.board_name = "puzzleboard_a4.yaml";
+  PageLayout layout;
+  std::string why;
+  ASSERT_TRUE(LayOutPage(board, options, &layout, &why)) << why;
+  EXPECT_EQ(layout.width_mm, 297);
+  EXPECT_EQ(layout.height_mm, 210);
+  EXPECT_NEAR(2 * layout.pattern_x_mm + layout.pattern_w_mm, 297, 1e-9);
+  EXPECT_GE(layout.pattern_y_mm, options.margin_mm);
+  EXPECT_LE(layout.scale_bar_y_mm + 8, 210 - options.margin_mm);
+
+  std::string bytes;
+  ASSERT_TRUE(
+      RenderPrintableBoard(board, PrintFormat::kPng, options, &bytes, &why))
+      << why;
+  uint32_t ppm_x, ppm_y;
+  ReadPhys(bytes, &ppm_x, &ppm_y);
+  EXPECT_EQ(ppm_x, static_cast<uint32_t>(std::lround(150 / 0.0254)));
+  EXPECT_EQ(ppm_y, ppm_x);
+  const cv::Mat page = cv::imdecode(
+      std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_GRAYSCALE);
+  const double px_per_mm = 150 / 25.4;
+  ASSERT_EQ(page.cols, std::lround(297 * px_per_mm));
+  ASSERT_EQ(page.rows, std::lround(210 * px_per_mm));
+
+  // The printed corners, found and decoded by the calibration's own
+  // pipeline, sit at the page positions of the layout.
+  ImageResult found;
+  ProcessGreyImage(page, board, PipelineOptions(), &found);
+  ASSERT_EQ(found.outcome, ImageOutcome::kUsable) << found.reason;
+  EXPECT_GE(found.decode.observation.id.size(), 13u * 8u - 4);
+  for (size_t k = 0; k < found.decode.observation.id.size(); ++k) {
+    const Eigen::Vector2i id = found.decode.observation.id[k];
+    double x_mm, y_mm;
+    PrintedCornerMm(board, id.x(), id.y(), &x_mm, &y_mm);
+    const Eigen::Vector2d expected(
+        (layout.pattern_x_mm + x_mm) * px_per_mm - 0.5,
+        (layout.pattern_y_mm + y_mm) * px_per_mm - 0.5);
+    EXPECT_LT((found.decode.observation.xy[k] - expected).norm(), 0.3)
+        << id.transpose();
+  }
+
+  // The scale bar: the longest black run on the bar's middle row.
+  const int row =
+      static_cast<int>((layout.scale_bar_y_mm + 4.0 - 0.75) * px_per_mm);
+  int longest = 0, run = 0;
+  for (int x = 0; x < page.cols; ++x) {
+    run = page.at<uchar>(row, x) < 128 ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  // 100 mm between the centres of the end ticks; the ticks (well under a
+  // millimetre wide) add their width.
+  EXPECT_GE(longest, kScaleBarMm * px_per_mm - 1.0);
+  EXPECT_LE(longest, (kScaleBarMm + 0.6) * px_per_mm + 1.0);
+
+  // The label (SVG text).
+  ASSERT_TRUE(
+      RenderPrintableBoard(board, PrintFormat::kSvg, options, &bytes, &why));
+  for (const char* part :
+       {"puzzleboard_a4.yaml", "puzzleboard", "13 x 8 corners", "tile 20 mm",
+        "origin [100, 200]", "print at 100 %", "100 mm", "width=\"297mm\"",
+        "height=\"210mm\""}) {
+    EXPECT_NE(bytes.find(part), std::string::npos) << part;
+  }
+}
+
+TEST(PrintBoardTest, BoardsThatDoNotFitAreRefusedWithTheirSize) {
+  PrintOptions options;
+  options.page = PageSize::kA4;
+  PageLayout layout;
+  std::string why;
+  EXPECT_FALSE(LayOutPage(MediumPuzzleBoard(), options, &layout, &why));
+  EXPECT_NE(why.find("690 x 480 mm"), std::string::npos) << why;
+  std::string bytes;
+  EXPECT_FALSE(RenderPrintableBoard(MediumPuzzleBoard(), PrintFormat::kPdf,
+                                    options, &bytes, &why));
+  // fit: the pattern plus the margins and the label band.
+  options.page = PageSize::kFit;
+  ASSERT_TRUE(LayOutPage(MediumPuzzleBoard(), options, &layout, &why)) << why;
+  EXPECT_NEAR(layout.width_mm, 690 + 2 * options.margin_mm, 1e-9);
+  EXPECT_GT(layout.height_mm, 480 + 2 * options.margin_mm);
+  EXPECT_NEAR(layout.pattern_x_mm, options.margin_mm, 1e-9);
+}
+
+// The presets in configs/boards/: each `a4` / `letter` board fits its sheet.
+TEST(PrintBoardTest, SheetPresetsFitTheirSheets) {
+  int presets = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator("configs/boards")) {
+    const std::string name = entry.path().filename().string();
+    PrintOptions options;
+    if (name.find("a4") != std::string::npos) {
+      options.page = PageSize::kA4;
+    } else if (name.find("letter") != std::string::npos) {
+      options.page = PageSize::kLetter;
+    } else {
+      continue;
+    }
+    Board board;
+    std::string why;
+    ASSERT_TRUE(LoadBoardFile(entry.path().string(), &board, &why)) << why;
+    PageLayout layout;
+    EXPECT_TRUE(LayOutPage(board, options, &layout, &why))
+        << name << ": " << why;
+    EXPECT_EQ(board.type, BoardType::kPuzzleBoard) << name;
+    ++presets;
+  }
+  EXPECT_GE(presets, 2);
 }
 
 }  // namespace

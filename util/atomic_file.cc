@@ -1,4 +1,4 @@
-#include "calib/atomic_file.h"
+#include "util/atomic_file.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -9,13 +9,10 @@
 #include <cstring>
 #include <vector>
 
+#include "util/failure.h"
+
 namespace puzzlecal {
 namespace {
-
-bool Fail(const std::string& message, std::string* error) {
-  if (error != nullptr) *error = message;
-  return false;
-}
 
 std::string ErrnoText(int err) { return std::strerror(err); }
 

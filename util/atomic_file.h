@@ -1,5 +1,5 @@
-#ifndef PUZZLECAL_CALIB_ATOMIC_FILE_H_
-#define PUZZLECAL_CALIB_ATOMIC_FILE_H_
+#ifndef PUZZLECAL_UTIL_ATOMIC_FILE_H_
+#define PUZZLECAL_UTIL_ATOMIC_FILE_H_
 
 #include <string>
 
@@ -16,4 +16,4 @@ bool WriteFileAtomically(const std::string& path, const std::string& contents,
 
 }  // namespace puzzlecal
 
-#endif  // PUZZLECAL_CALIB_ATOMIC_FILE_H_
+#endif  // PUZZLECAL_UTIL_ATOMIC_FILE_H_

@@ -1,0 +1,37 @@
+#include "util/statistics.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace puzzlecal {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
+double Quantile(std::vector<double> values, double fraction) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const double position =
+      std::clamp(fraction, 0.0, 1.0) * static_cast<double>(values.size() - 1);
+  const size_t below = static_cast<size_t>(std::floor(position));
+  const size_t above = std::min(below + 1, values.size() - 1);
+  const double weight = position - static_cast<double>(below);
+  return values[below] + weight * (values[above] - values[below]);
+}
+
+double MedianAbsoluteDeviationSigma(const std::vector<double>& values) {
+  if (values.empty()) return 0;
+  const double center = Median(values);
+  std::vector<double> deviations(values.size());
+  for (size_t i = 0; i < values.size(); ++i) {
+    deviations[i] = std::abs(values[i] - center);
+  }
+  // 1.4826 = 1 / Phi^-1(3/4): for Gaussian values the MAD times this is sigma.
+  return 1.4826 * Median(deviations);
+}
+
+}  // namespace puzzlecal

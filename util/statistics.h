@@ -1,0 +1,23 @@
+#ifndef PUZZLECAL_UTIL_STATISTICS_H_
+#define PUZZLECAL_UTIL_STATISTICS_H_
+
+// Small order statistics shared by the libraries and the benches.
+
+#include <vector>
+
+namespace puzzlecal {
+
+// The upper median (element n/2 of the sorted values); 0 for no values.
+double Median(std::vector<double> values);
+
+// The value below which `fraction` (in [0, 1]) of the values lie, by linear
+// interpolation between order statistics; 0 for no values.
+double Quantile(std::vector<double> values, double fraction);
+
+// 1.4826 * median(|v - median(v)|): the standard deviation of Gaussian values,
+// estimated robustly; 0 for no values.
+double MedianAbsoluteDeviationSigma(const std::vector<double>& values);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_UTIL_STATISTICS_H_
