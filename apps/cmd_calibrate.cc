@@ -362,6 +362,7 @@ int RunCalibrate() {
   }
 
   const auto calib_start = std::chrono::steady_clock::now();
+  calibration_options.num_threads = threads;  // same result for any count
   // --model auto: the candidate with the lowest held-out error
   // (calib/model_selection.h).
   ModelSelection selection;
@@ -473,7 +474,7 @@ int RunCalibrate() {
 
   const double seconds_total = SecondsSince(run_start);
   if (verbosity != Verbosity::kQuiet) {
-    std::cout << result.report << "\n";
+    std::cout << CalibrationReport(result) << "\n";
     std::cout << "views used: " << result.num_views_used << " of "
               << images.size()
               << " images; corners: " << result.num_corners_used << "; RMS "

@@ -3,16 +3,16 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
-#include <sstream>
 
+#include "calib/marginal_covariance.h"
+#include "calib/parallel_reprojection.h"
 #include "calib/reprojection_error.h"
 
 namespace puzzlecal {
@@ -57,103 +57,532 @@ std::string Format(const char* format, double value) {
   return buffer;
 }
 
-// The state the solves share.
-struct Problem {
-  const std::vector<CalibrationView>* views = nullptr;
-  CameraModelId model = CameraModelId::kPinholeRadtan;
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                       start)
+      .count();
+}
+
+// Everything one Calibrate() call works on: its inputs, the current
+// estimate, the correspondences in play and the last solve.
+struct CalibrationState {
+  CalibrationState(const std::vector<CalibrationView>& views_in,
+                   CameraModelId model_in, int width_in, int height_in,
+                   const CalibrationOptions& options_in,
+                   CalibrationResult* result_in, std::string* error_in)
+      : views(views_in),
+        model(model_in),
+        width(width_in),
+        height(height_in),
+        options(options_in),
+        result(result_in),
+        error(error_in),
+        names(CameraModelParamNames(model_in)) {}
+
+  // Inputs.
+  const std::vector<CalibrationView>& views;
+  const CameraModelId model;
+  const int width, height;
+  const CalibrationOptions& options;
+  CalibrationResult* const result;
+  std::string* const error;
+  const std::vector<std::string> names;  // parameter names of the model
+  const std::chrono::steady_clock::time_point start =
+      std::chrono::steady_clock::now();
+
+  // The estimate: intrinsics (model order), one pose per view, which
+  // intrinsics are held.
   std::vector<double> params;
   std::vector<Pose> poses;
+  std::vector<bool> fixed;
+  // Views and correspondences in play.
   std::vector<bool> view_used;
   std::vector<std::vector<bool>> valid;   // finite input, usable at all
   std::vector<std::vector<bool>> inlier;  // currently in the problem
+  // Residuals at the estimate (views in use only) and whether each corner
+  // projects.
+  std::vector<std::vector<Eigen::Vector2d>> residuals;
+  std::vector<std::vector<bool>> projects;
+
+  // The last solve; its problem is kept for the covariance and refers to
+  // `loss`.
+  std::unique_ptr<ceres::LossFunction> loss;
+  std::unique_ptr<ceres::EvaluationCallback> evaluation;  // multi-threaded
+  std::unique_ptr<ceres::Problem> problem;
+  ceres::Solver::Summary summary;
+  int iterations = 0;  // all solves
+  int rounds = 0;      // outlier rejection rounds
+
+  // Filled by FillResult: the inlier sum of squares and free parameters.
+  double sum2 = 0;
+  int free_params = 0;
 };
 
-// Pixel error of one correspondence with the current state; false when the
-// point cannot be projected.
-bool Residual(const Problem& problem, size_t v, size_t i,
+int CountUsed(const std::vector<bool>& used) {
+  return static_cast<int>(std::count(used.begin(), used.end(), true));
+}
+
+void SetViewOutcome(CalibrationState* s, size_t v, ViewOutcome outcome,
+                    const std::string& reason) {
+  s->view_used[v] = false;
+  s->result->view_outcome[v] = outcome;
+  s->result->view_reason[v] = reason;
+}
+
+bool FailTooFewViews(const CalibrationState& s, int count) {
+  return Fail("only " + std::to_string(count) + " usable view" +
+                  (count == 1 ? "" : "s") + " (need at least " +
+                  std::to_string(s.options.min_views) +
+                  "): add views of the board at different positions and "
+                  "tilted by 30 degrees or more",
+              s.error);
+}
+
+bool FailParallelViews(const CalibrationState& s, double spread_deg) {
+  return Fail(
+      "all views show the board at nearly the same orientation "
+      "(largest angle between board normals " +
+          Format("%.1f", spread_deg) + " degrees, need " +
+          Format("%.1f", s.options.min_orientation_spread_deg) +
+          "), so the focal length is undetermined: add views with "
+          "the board tilted by 30 degrees or more",
+      s.error);
+}
+
+// Pixel error of one correspondence with the current estimate; false when
+// the point cannot be projected.
+bool Residual(const CalibrationState& s, size_t v, size_t i,
               Eigen::Vector2d* residual) {
-  const CalibrationView& view = (*problem.views)[v];
-  const Eigen::Isometry3d pose = IsometryFromPose(problem.poses[v]);
+  const CalibrationView& view = s.views[v];
+  const Eigen::Isometry3d pose = IsometryFromPose(s.poses[v]);
   Eigen::Vector2d pixel;
-  if (!ProjectPoint(problem.model, problem.params.data(),
-                    pose * view.board_points[i], &pixel)) {
+  if (!ProjectPoint(s.model, s.params.data(), pose * view.board_points[i],
+                    &pixel)) {
     return false;
   }
   *residual = pixel - view.image_points[i];
   return residual->allFinite();
 }
 
-struct SolveOutcome {
-  ceres::Solver::Summary summary;
-  std::unique_ptr<ceres::Problem> problem;  // kept for the covariance
-};
+// ---------------------------------------------------------------------------
+// Stage 1: check the views.
 
-// One Levenberg-Marquardt solve over the current inliers; `fixed[k]` holds
-// parameter k.
-template <typename Model>
-void Solve(Problem* state, const std::vector<bool>& fixed,
-           const CalibrationOptions& options,
-           std::unique_ptr<ceres::LossFunction>* loss, SolveOutcome* outcome) {
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  outcome->problem = std::make_unique<ceres::Problem>(problem_options);
-  ceres::Problem& problem = *outcome->problem;
+// Marks the finite correspondences of view v; true when the view can be used.
+bool CheckView(CalibrationState* s, size_t v) {
+  const CalibrationView& view = s->views[v];
+  const size_t n = view.board_points.size();
+  s->valid[v].assign(n, false);
+  if (view.image_points.size() != n) {
+    SetViewOutcome(s, v, ViewOutcome::kMismatchedPoints,
+                   std::to_string(n) + " board points but " +
+                       std::to_string(view.image_points.size()) +
+                       " image points");
+    s->valid[v].assign(std::max(n, view.image_points.size()), false);
+    return false;
+  }
+  double extent = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (view.board_points[i].allFinite()) {
+      extent = std::max(extent, view.board_points[i].head<2>().norm());
+    }
+  }
+  bool planar = true;
+  int good = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const bool finite =
+        view.board_points[i].allFinite() && view.image_points[i].allFinite();
+    if (finite && std::abs(view.board_points[i].z()) > 1e-9 * (1 + extent)) {
+      planar = false;
+    }
+    s->valid[v][i] = finite;
+    good += finite ? 1 : 0;
+  }
+  if (!planar) {
+    SetViewOutcome(s, v, ViewOutcome::kNotPlanar,
+                   "board points are not on the plane z = 0");
+    return false;
+  }
+  if (good < s->options.min_corners_per_view) {
+    SetViewOutcome(s, v, ViewOutcome::kTooFewCorners,
+                   "only " + std::to_string(good) + " corners (need " +
+                       std::to_string(s->options.min_corners_per_view) + ")");
+    return false;
+  }
+  return true;
+}
+
+// Fraction of coverage-grid cells that hold at least one corner.
+double Coverage(const CalibrationState& s) {
+  const int grid = s.options.coverage_grid;
+  std::vector<bool> cell(grid * grid, false);
+  for (size_t v = 0; v < s.views.size(); ++v) {
+    if (!s.view_used[v]) continue;
+    for (size_t i = 0; i < s.views[v].image_points.size(); ++i) {
+      if (!s.valid[v][i]) continue;
+      const Eigen::Vector2d& p = s.views[v].image_points[i];
+      const int cx = static_cast<int>((p.x() + 0.5) * grid / s.width);
+      const int cy = static_cast<int>((p.y() + 0.5) * grid / s.height);
+      if (cx >= 0 && cx < grid && cy >= 0 && cy < grid) {
+        cell[cy * grid + cx] = true;
+      }
+    }
+  }
+  return static_cast<double>(std::count(cell.begin(), cell.end(), true)) /
+         (grid * grid);
+}
+
+// Every view checked; enough usable ones that cover the image.
+bool CheckViews(CalibrationState* s) {
+  const size_t num_views = s->views.size();
+  s->view_used.assign(num_views, false);
+  s->valid.resize(num_views);
+  for (size_t v = 0; v < num_views; ++v) s->view_used[v] = CheckView(s, v);
+  const int usable = CountUsed(s->view_used);
+  if (usable < s->options.min_views) return FailTooFewViews(*s, usable);
+  s->result->coverage = Coverage(*s);
+  if (s->result->coverage < s->options.min_coverage) {
+    return Fail("the corners cover only " +
+                    Format("%.0f", 100 * s->result->coverage) +
+                    " % of the image (need " +
+                    Format("%.0f", 100 * s->options.min_coverage) +
+                    " %): the views are all at one spot; move the board "
+                    "towards the corners and borders of the image",
+                s->error);
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Stage 2: initialise.
+
+// Intrinsics and poses from calib/initialization.h on the finite
+// correspondences only; views without an initial pose drop out.
+bool Initialise(CalibrationState* s) {
+  const size_t num_views = s->views.size();
+  std::vector<CalibrationView> clean(num_views);
+  for (size_t v = 0; v < num_views; ++v) {
+    if (!s->view_used[v]) continue;
+    clean[v].name = s->views[v].name;
+    for (size_t i = 0; i < s->views[v].board_points.size(); ++i) {
+      if (s->valid[v][i]) {
+        clean[v].board_points.push_back(s->views[v].board_points[i]);
+        clean[v].image_points.push_back(s->views[v].image_points[i]);
+      }
+    }
+  }
+  InitializationResult init;
+  std::string why;
+  if (!InitializeCalibration(clean, s->view_used, s->model, s->width,
+                             s->height, s->options.initial_params,
+                             s->options.initialization, &init, &why)) {
+    return Fail("initialisation failed: " + why, s->error);
+  }
+  s->result->initialization_method = init.method;
+  s->result->orientation_spread_deg = init.orientation_spread_deg;
+  s->result->initialization_seconds = SecondsSince(s->start);
+  s->params = init.camera.params;
+  s->poses.assign(num_views, Pose{});
+  for (size_t v = 0; v < num_views; ++v) {
+    if (!s->view_used[v]) continue;
+    if (!init.view_ok[v]) {
+      SetViewOutcome(s, v, ViewOutcome::kNoInitialPose,
+                     "no initial pose: " + init.view_reason[v]);
+      continue;
+    }
+    s->poses[v] = PoseFromIsometry(init.cam_from_board[v]);
+  }
+  const int usable = CountUsed(s->view_used);
+  if (usable < s->options.min_views) return FailTooFewViews(*s, usable);
+  if (s->result->orientation_spread_deg <
+      s->options.min_orientation_spread_deg) {
+    return FailParallelViews(*s, s->result->orientation_spread_deg);
+  }
+  return true;
+}
+
+// The intrinsics held at their initial values, from the options.
+std::vector<bool> FixedParams(const CalibrationState& s) {
+  const int num_params = static_cast<int>(s.names.size());
+  std::vector<bool> fixed(num_params, false);
+  for (int k = 0; k < num_params; ++k) {
+    if (k < kPrincipalPointBegin)
+      fixed[k] = s.options.fix_focal_length;
+    else if (k < kDistortionBegin)
+      fixed[k] = s.options.fix_principal_point;
+    else
+      fixed[k] = s.options.fix_distortion;
+    const auto& named = s.options.fixed_params;
+    if (std::find(named.begin(), named.end(), s.names[k]) != named.end()) {
+      fixed[k] = true;
+    }
+  }
+  return fixed;
+}
+
+// The correspondences that project through the initial camera start as
+// inliers; a view with too few of them drops out.
+bool SelectInitialInliers(CalibrationState* s) {
+  s->inlier = s->valid;
+  for (size_t v = 0; v < s->views.size(); ++v) {
+    if (!s->view_used[v]) {
+      std::fill(s->inlier[v].begin(), s->inlier[v].end(), false);
+      continue;
+    }
+    int projecting = 0;
+    for (size_t i = 0; i < s->inlier[v].size(); ++i) {
+      Eigen::Vector2d r;
+      if (s->inlier[v][i] && !Residual(*s, v, i, &r)) s->inlier[v][i] = false;
+      projecting += s->inlier[v][i] ? 1 : 0;
+    }
+    if (projecting < s->options.min_corners_per_view) {
+      SetViewOutcome(
+          s, v, ViewOutcome::kTooFewProjecting,
+          "only " + std::to_string(projecting) +
+              " corners project through the initial camera (need " +
+              std::to_string(s->options.min_corners_per_view) + ")");
+      std::fill(s->inlier[v].begin(), s->inlier[v].end(), false);
+    }
+  }
+  const int usable = CountUsed(s->view_used);
+  if (usable < s->options.min_views) return FailTooFewViews(*s, usable);
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Stage 3: build the problem.
+
+void ResetLoss(const CalibrationOptions& options,
+               std::unique_ptr<ceres::LossFunction>* loss) {
   loss->reset();
   if (options.loss == RobustLoss::kHuber) {
     loss->reset(new ceres::HuberLoss(options.loss_scale_px));
   } else if (options.loss == RobustLoss::kCauchy) {
     loss->reset(new ceres::CauchyLoss(options.loss_scale_px));
   }
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+}
+
+// A Ceres problem over the current inliers, with the poses in the first
+// elimination group; `fixed[k]` holds intrinsic k. Returns the number of
+// residual blocks (0: nothing to fit, and no intrinsics block added).
+template <typename Model>
+int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
+                 ceres::ParameterBlockOrdering* ordering) {
+  // The old problem refers to the old loss and evaluation: release it
+  // first.
+  s->problem.reset();
+  s->evaluation.reset();
+  ResetLoss(s->options, &s->loss);
+  ParallelReprojection<Model>* parallel = nullptr;
+  if (s->options.deterministic && s->options.num_threads > 1) {
+    parallel = new ParallelReprojection<Model>(s->params.data(),
+                                               s->options.num_threads);
+    s->evaluation.reset(parallel);
+  }
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.evaluation_callback = s->evaluation.get();
+  s->problem = std::make_unique<ceres::Problem>(problem_options);
   int num_residuals = 0;
-  for (size_t v = 0; v < state->views->size(); ++v) {
-    if (!state->view_used[v]) continue;
-    const CalibrationView& view = (*state->views)[v];
+  for (size_t v = 0; v < s->views.size(); ++v) {
+    if (!s->view_used[v]) continue;
+    const CalibrationView& view = s->views[v];
     int view_residuals = 0;
     for (size_t i = 0; i < view.board_points.size(); ++i) {
-      if (!state->inlier[v][i]) continue;
-      problem.AddResidualBlock(ReprojectionError<Model>::Create(
-                                   view.board_points[i], view.image_points[i]),
-                               loss->get(), state->params.data(),
-                               state->poses[v].data());
+      if (!s->inlier[v][i]) continue;
+      ceres::CostFunction* cost =
+          parallel != nullptr
+              ? parallel->Add(view.board_points[i], view.image_points[i],
+                              s->poses[v].data())
+              : ReprojectionError<Model>::Create(view.board_points[i],
+                                                 view.image_points[i]);
+      s->problem->AddResidualBlock(cost, s->loss.get(), s->params.data(),
+                                   s->poses[v].data());
       ++view_residuals;
     }
     // Only blocks the problem holds may be named in the ordering.
-    if (view_residuals > 0) {
-      ordering->AddElementToGroup(state->poses[v].data(), 0);
-    }
+    if (view_residuals > 0) ordering->AddElementToGroup(s->poses[v].data(), 0);
     num_residuals += view_residuals;
   }
-  if (num_residuals == 0) {
-    // Nothing to fit (and no intrinsics block to hold fixed): report a
-    // failed solve instead of handing Ceres an empty problem.
-    outcome->summary = ceres::Solver::Summary();
-    outcome->summary.message = "no corners left to fit";
-    return;
-  }
-  ordering->AddElementToGroup(state->params.data(), 1);
+  if (num_residuals == 0) return 0;
+  ordering->AddElementToGroup(s->params.data(), 1);
   std::vector<int> fixed_indices;
   for (int k = 0; k < Model::kNumParams; ++k) {
     if (fixed[k]) fixed_indices.push_back(k);
   }
   if (static_cast<int>(fixed_indices.size()) == Model::kNumParams) {
-    problem.SetParameterBlockConstant(state->params.data());
+    s->problem->SetParameterBlockConstant(s->params.data());
   } else if (!fixed_indices.empty()) {
-    problem.SetManifold(
-        state->params.data(),
+    s->problem->SetManifold(
+        s->params.data(),
         new ceres::SubsetManifold(Model::kNumParams, fixed_indices));
   }
+  return num_residuals;
+}
+
+// ---------------------------------------------------------------------------
+// Stage 4: solve.
+
+ceres::Solver::Options SolverOptions(
+    const CalibrationOptions& options,
+    std::shared_ptr<ceres::ParameterBlockOrdering> ordering) {
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.linear_solver_ordering = ordering;
+  solver_options.linear_solver_ordering = std::move(ordering);
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.gradient_tolerance = options.gradient_tolerance;
   solver_options.parameter_tolerance = options.parameter_tolerance;
   solver_options.num_threads = options.deterministic ? 1 : options.num_threads;
   solver_options.logging_type = ceres::SILENT;
-  ceres::Solve(solver_options, &problem, &outcome->summary);
+  return solver_options;
 }
+
+// One Levenberg-Marquardt solve over the current inliers, starting from the
+// current estimate; `fixed[k]` holds intrinsic k.
+template <typename Model>
+void Solve(CalibrationState* s, const std::vector<bool>& fixed) {
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  if (BuildProblem<Model>(s, fixed, ordering.get()) == 0) {
+    // Nothing to fit: report a failed solve instead of handing Ceres an
+    // empty problem.
+    s->summary = ceres::Solver::Summary();
+    s->summary.message = "no corners left to fit";
+    return;
+  }
+  ceres::Solve(SolverOptions(s->options, ordering), s->problem.get(),
+               &s->summary);
+  s->iterations += static_cast<int>(s->summary.iterations.size());
+}
+
+// The first solve, after one with the distortion held at zero when
+// options.staged_distortion says so.
+template <typename Model>
+bool SolveFromInitialisation(CalibrationState* s) {
+  if (s->options.staged_distortion && !s->options.fix_distortion) {
+    std::vector<bool> staged = s->fixed;
+    for (int k = kDistortionBegin; k < Model::kNumParams; ++k) staged[k] = true;
+    Solve<Model>(s, staged);
+    if (!s->summary.IsSolutionUsable()) {
+      return Fail("the first solve (distortion held at zero) failed: " +
+                      s->summary.message,
+                  s->error);
+    }
+  }
+  if (s->options.coarse_stride > 1) {
+    // The walk from the initialisation on every coarse_stride-th corner of
+    // each view: the same path at a fraction of the cost per iteration.
+    const std::vector<std::vector<bool>> all = s->inlier;
+    for (auto& view : s->inlier) {
+      for (size_t i = 0; i < view.size(); ++i) {
+        view[i] = view[i] && i % s->options.coarse_stride == 0;
+      }
+    }
+    Solve<Model>(s, s->fixed);
+    s->inlier = all;
+  }
+  Solve<Model>(s, s->fixed);
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Stage 5: reject outliers.
+
+// Residuals of every valid corner of the views in use at the estimate.
+void ComputeResiduals(CalibrationState* s) {
+  const size_t num_views = s->views.size();
+  s->residuals.resize(num_views);
+  s->projects.resize(num_views);
+  for (size_t v = 0; v < num_views; ++v) {
+    const size_t n = s->view_used[v] ? s->views[v].board_points.size() : 0;
+    s->residuals[v].assign(n, Eigen::Vector2d::Zero());
+    s->projects[v].assign(n, false);
+    for (size_t i = 0; i < n; ++i) {
+      if (!s->valid[v][i]) continue;
+      Eigen::Vector2d r;
+      if (Residual(*s, v, i, &r)) {
+        s->residuals[v][i] = r;
+        s->projects[v][i] = true;
+      } else {
+        s->residuals[v][i].setConstant(
+            std::numeric_limits<double>::quiet_NaN());
+      }
+    }
+  }
+}
+
+// max(outlier_k * sigma, floor), sigma = 1.4826 * the median absolute
+// deviation of the residual coordinates over every corner of the views in
+// use (not only the current inliers: the median is robust to the outliers
+// already, and a sigma of the inliers alone shrinks with every round and
+// trims good corners).
+double RejectionThreshold(CalibrationState* s) {
+  std::vector<double> coordinates;
+  for (size_t v = 0; v < s->views.size(); ++v) {
+    if (!s->view_used[v]) continue;
+    for (size_t i = 0; i < s->residuals[v].size(); ++i) {
+      if (s->projects[v][i]) {
+        coordinates.push_back(s->residuals[v][i].x());
+        coordinates.push_back(s->residuals[v][i].y());
+      }
+    }
+  }
+  const double median = Median(coordinates);
+  for (double& c : coordinates) c = std::abs(c - median);
+  const double sigma = 1.4826 * Median(coordinates);
+  s->result->noise_sigma_px = sigma;
+  s->result->outlier_threshold_px = std::max(
+      s->options.outlier_k * sigma, s->options.min_outlier_threshold_px);
+  return s->result->outlier_threshold_px;
+}
+
+// Inliers: the corners that project within `threshold`. False when nothing
+// changes.
+bool SelectInliers(CalibrationState* s, double threshold) {
+  bool changed = false;
+  for (size_t v = 0; v < s->views.size(); ++v) {
+    if (!s->view_used[v]) continue;
+    for (size_t i = 0; i < s->residuals[v].size(); ++i) {
+      const bool keep =
+          s->projects[v][i] && s->residuals[v][i].norm() <= threshold;
+      changed |= keep != s->inlier[v][i];
+      s->inlier[v][i] = keep;
+    }
+  }
+  return changed;
+}
+
+// A view left with too few corners has no trustworthy pose: it drops out.
+void DropDepletedViews(CalibrationState* s) {
+  for (size_t v = 0; v < s->views.size(); ++v) {
+    if (!s->view_used[v]) continue;
+    const int kept = CountUsed(s->inlier[v]);
+    if (kept < s->options.min_corners_per_view) {
+      SetViewOutcome(s, v, ViewOutcome::kTooFewAfterRejection,
+                     "only " + std::to_string(kept) +
+                         " corners left after outlier rejection");
+      std::fill(s->inlier[v].begin(), s->inlier[v].end(), false);
+    }
+  }
+}
+
+// Rounds of k-sigma rejection, each followed by a solve from the last
+// estimate, until the inliers stop changing.
+template <typename Model>
+void RejectOutliers(CalibrationState* s) {
+  ComputeResiduals(s);
+  while (s->options.outlier_k > 0 &&
+         s->rounds < s->options.outlier_iterations &&
+         s->summary.IsSolutionUsable()) {
+    if (!SelectInliers(s, RejectionThreshold(s))) break;
+    DropDepletedViews(s);
+    ++s->rounds;
+    Solve<Model>(s, s->fixed);
+    ComputeResiduals(s);
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Stage 6: fill the result.
 
 // Largest angle between the board normals of two used views, degrees.
 double OrientationSpreadDeg(const std::vector<Eigen::Isometry3d>& poses,
@@ -171,529 +600,207 @@ double OrientationSpreadDeg(const std::vector<Eigen::Isometry3d>& poses,
   return spread * 180.0 / M_PI;
 }
 
-// Covariance of the intrinsics with the poses marginalised out, from the
-// Jacobian at the solution: inverse of the Schur complement
-// S = A - sum_v B_v C_v^-1 B_v' of J'J (A: intrinsics, C_v: pose v). Summed
-// in a fixed order, so the result does not depend on threads. Fixed
-// parameters get zero rows and columns. False when S is singular.
-template <int kNumParams>
-bool MarginalCovariance(ceres::Problem* problem, const Problem* state,
-                        const std::vector<bool>& fixed,
-                        double min_eigenvalue_ratio,
-                        Eigen::Matrix<double, kNumParams, kNumParams>* cov) {
-  std::vector<int> free_index;
-  for (int k = 0; k < kNumParams; ++k) {
-    if (!fixed[k]) free_index.push_back(k);
-  }
-  const int n = static_cast<int>(free_index.size());
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks.push_back(
-      const_cast<double*>(state->params.data()));
-  for (size_t v = 0; v < state->poses.size(); ++v) {
-    if (!state->view_used[v]) continue;
-    evaluate.parameter_blocks.push_back(
-        const_cast<double*>(state->poses[v].data()));
-  }
-  evaluate.num_threads = 1;
-  ceres::CRSMatrix jacobian;
-  if (!problem->Evaluate(evaluate, nullptr, nullptr, nullptr, &jacobian)) {
-    return false;
-  }
-  const int num_poses = static_cast<int>(evaluate.parameter_blocks.size()) - 1;
-  if (jacobian.num_cols != n + kPoseBlockSize * num_poses) return false;
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
-  std::vector<Eigen::MatrixXd> b(num_poses, Eigen::MatrixXd::Zero(n, 6));
-  std::vector<Eigen::Matrix<double, 6, 6>> c(
-      num_poses, Eigen::Matrix<double, 6, 6>::Zero());
-  Eigen::VectorXd j_int(n);
-  Eigen::Matrix<double, 6, 1> j_pose;
-  for (int row = 0; row < jacobian.num_rows; ++row) {
-    j_int.setZero();
-    j_pose.setZero();
-    int pose = -1;
-    for (int e = jacobian.rows[row]; e < jacobian.rows[row + 1]; ++e) {
-      const int col = jacobian.cols[e];
-      if (col < n) {
-        j_int(col) = jacobian.values[e];
-      } else {
-        pose = (col - n) / kPoseBlockSize;
-        j_pose((col - n) % kPoseBlockSize) = jacobian.values[e];
-      }
-    }
-    a.noalias() += j_int * j_int.transpose();
-    if (pose >= 0) {
-      b[pose].noalias() += j_int * j_pose.transpose();
-      c[pose].noalias() += j_pose * j_pose.transpose();
-    }
-  }
-  for (int v = 0; v < num_poses; ++v) {
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(c[v]);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
-      return false;
-    }
-    a.noalias() -= b[v] * ldlt.solve(b[v].transpose());
-  }
-  // S is symmetric positive definite unless the intrinsics are
-  // undetermined; refuse to invert a (numerically) singular S.
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
-  if (eig.info() != Eigen::Success) return false;
-  const Eigen::VectorXd values = eig.eigenvalues();
-  if (!(values(0) > min_eigenvalue_ratio * values(n - 1))) return false;
-  const Eigen::MatrixXd inverse = eig.eigenvectors() *
-                                  values.cwiseInverse().asDiagonal() *
-                                  eig.eigenvectors().transpose();
-  cov->setZero();
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      (*cov)(free_index[i], free_index[j]) = inverse(i, j);
-    }
-  }
-  return true;
-}
-
-// Fraction of coverage-grid cells that hold at least one corner.
-double Coverage(const std::vector<CalibrationView>& views,
-                const std::vector<bool>& view_used,
-                const std::vector<std::vector<bool>>& valid, int width,
-                int height, int grid) {
-  std::vector<bool> cell(grid * grid, false);
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (!view_used[v]) continue;
-    for (size_t i = 0; i < views[v].image_points.size(); ++i) {
-      if (!valid[v][i]) continue;
-      const Eigen::Vector2d& p = views[v].image_points[i];
-      const int cx = static_cast<int>((p.x() + 0.5) * grid / width);
-      const int cy = static_cast<int>((p.y() + 0.5) * grid / height);
-      if (cx >= 0 && cx < grid && cy >= 0 && cy < grid) {
-        cell[cy * grid + cx] = true;
-      }
-    }
-  }
-  return static_cast<double>(std::count(cell.begin(), cell.end(), true)) /
-         (grid * grid);
-}
-
-template <typename Model>
-bool CalibrateModel(const std::vector<CalibrationView>& views, int width,
-                    int height, const CalibrationOptions& options,
-                    CalibrationResult* result, std::string* error) {
-  constexpr int kNumParams = Model::kNumParams;
-  const CameraModelId model = Model::kId;
-  const auto start = std::chrono::steady_clock::now();
-  Problem state;
-  state.views = &views;
-  state.model = model;
-  state.view_used.assign(views.size(), false);
-  state.valid.resize(views.size());
-  result->view_reason.assign(views.size(), "");
-
-  // Input checks, per view.
-  int usable = 0;
-  for (size_t v = 0; v < views.size(); ++v) {
-    const CalibrationView& view = views[v];
-    const size_t n = view.board_points.size();
-    state.valid[v].assign(n, false);
-    if (view.image_points.size() != n) {
-      result->view_reason[v] = std::to_string(n) + " board points but " +
-                               std::to_string(view.image_points.size()) +
-                               " image points";
-      state.valid[v].assign(std::max(n, view.image_points.size()), false);
-      continue;
-    }
-    double extent = 0;
-    bool planar = true;
-    for (size_t i = 0; i < n; ++i) {
-      if (view.board_points[i].allFinite()) {
-        extent = std::max(extent, view.board_points[i].head<2>().norm());
-      }
-    }
-    int good = 0;
-    for (size_t i = 0; i < n; ++i) {
-      const bool finite =
-          view.board_points[i].allFinite() && view.image_points[i].allFinite();
-      if (finite && std::abs(view.board_points[i].z()) > 1e-9 * (1 + extent)) {
-        planar = false;
-      }
-      state.valid[v][i] = finite;
-      good += finite ? 1 : 0;
-    }
-    if (!planar) {
-      result->view_reason[v] = "board points are not on the plane z = 0";
-      continue;
-    }
-    if (good < options.min_corners_per_view) {
-      result->view_reason[v] =
-          "only " + std::to_string(good) + " corners (need " +
-          std::to_string(options.min_corners_per_view) + ")";
-      continue;
-    }
-    state.view_used[v] = true;
-    ++usable;
-  }
-  auto too_few_views = [&](int count) {
-    return Fail("only " + std::to_string(count) + " usable view" +
-                    (count == 1 ? "" : "s") + " (need at least " +
-                    std::to_string(options.min_views) +
-                    "): add views of the board at different positions and "
-                    "tilted by 30 degrees or more",
-                error);
-  };
-  if (usable < options.min_views) return too_few_views(usable);
-
-  result->coverage = Coverage(views, state.view_used, state.valid, width,
-                              height, options.coverage_grid);
-  if (result->coverage < options.min_coverage) {
-    return Fail("the corners cover only " +
-                    Format("%.0f", 100 * result->coverage) +
-                    " % of the image (need " +
-                    Format("%.0f", 100 * options.min_coverage) +
-                    " %): the views are all at one spot; move the board "
-                    "towards the corners and borders of the image",
-                error);
-  }
-
-  // Initialisation on the finite correspondences only.
-  std::vector<CalibrationView> clean(views.size());
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (!state.view_used[v]) continue;
-    clean[v].name = views[v].name;
-    for (size_t i = 0; i < views[v].board_points.size(); ++i) {
-      if (state.valid[v][i]) {
-        clean[v].board_points.push_back(views[v].board_points[i]);
-        clean[v].image_points.push_back(views[v].image_points[i]);
-      }
-    }
-  }
-  InitializationResult init;
-  std::string why;
-  if (!InitializeCalibration(clean, state.view_used, model, width, height,
-                             options.initial_params, options.initialization,
-                             &init, &why)) {
-    return Fail("initialisation failed: " + why, error);
-  }
-  result->initialization_method = init.method;
-  result->orientation_spread_deg = init.orientation_spread_deg;
-  result->initialization_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
-  state.params = init.camera.params;
-  state.poses.assign(views.size(), Pose{});
-  usable = 0;
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (!state.view_used[v]) continue;
-    if (!init.view_ok[v]) {
-      state.view_used[v] = false;
-      result->view_reason[v] = "no initial pose: " + init.view_reason[v];
-      continue;
-    }
-    state.poses[v] = PoseFromIsometry(init.cam_from_board[v]);
-    ++usable;
-  }
-  if (usable < options.min_views) return too_few_views(usable);
-  auto parallel_views = [&](double spread_deg) {
-    return Fail(
-        "all views show the board at nearly the same orientation "
-        "(largest angle between board normals " +
-            Format("%.1f", spread_deg) + " degrees, need " +
-            Format("%.1f", options.min_orientation_spread_deg) +
-            "), so the focal length is undetermined: add views with "
-            "the board tilted by 30 degrees or more",
-        error);
-  };
-  if (result->orientation_spread_deg < options.min_orientation_spread_deg) {
-    return parallel_views(result->orientation_spread_deg);
-  }
-
-  // Fixed parameters.
-  std::vector<bool> fixed(kNumParams, false);
-  const std::vector<std::string> names = CameraModelParamNames(model);
-  for (int k = 0; k < kNumParams; ++k) {
-    if (k < kPrincipalPointBegin)
-      fixed[k] = options.fix_focal_length;
-    else if (k < kDistortionBegin)
-      fixed[k] = options.fix_principal_point;
-    else
-      fixed[k] = options.fix_distortion;
-    if (std::find(options.fixed_params.begin(), options.fixed_params.end(),
-                  names[k]) != options.fixed_params.end()) {
-      fixed[k] = true;
-    }
-  }
-
-  // Correspondences that project at all start as inliers.
-  state.inlier = state.valid;
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (!state.view_used[v]) {
-      std::fill(state.inlier[v].begin(), state.inlier[v].end(), false);
-      continue;
-    }
-    int projecting = 0;
-    for (size_t i = 0; i < state.inlier[v].size(); ++i) {
-      Eigen::Vector2d r;
-      if (state.inlier[v][i] && !Residual(state, v, i, &r)) {
-        state.inlier[v][i] = false;
-      }
-      projecting += state.inlier[v][i] ? 1 : 0;
-    }
-    if (projecting < options.min_corners_per_view) {
-      state.view_used[v] = false;
-      std::fill(state.inlier[v].begin(), state.inlier[v].end(), false);
-      result->view_reason[v] =
-          "only " + std::to_string(projecting) +
-          " corners project through the initial camera (need " +
-          std::to_string(options.min_corners_per_view) + ")";
-      --usable;
-    }
-  }
-  if (usable < options.min_views) return too_few_views(usable);
-
-  std::unique_ptr<ceres::LossFunction> loss;
-  SolveOutcome outcome;
-  int iterations = 0;
-  if (options.staged_distortion && !options.fix_distortion) {
-    std::vector<bool> staged = fixed;
-    for (int k = kDistortionBegin; k < kNumParams; ++k) staged[k] = true;
-    Solve<Model>(&state, staged, options, &loss, &outcome);
-    iterations += outcome.summary.iterations.size();
-    if (!outcome.summary.IsSolutionUsable()) {
-      return Fail("the first solve (distortion held at zero) failed: " +
-                      outcome.summary.message,
-                  error);
-    }
-  }
-  Solve<Model>(&state, fixed, options, &loss, &outcome);
-  iterations += outcome.summary.iterations.size();
-
-  // k-sigma outlier rejection.
-  int rounds = 0;
-  std::vector<std::vector<Eigen::Vector2d>> residuals(views.size());
-  auto compute_residuals = [&](std::vector<std::vector<bool>>* projects) {
-    projects->resize(views.size());
-    for (size_t v = 0; v < views.size(); ++v) {
-      residuals[v].assign(state.view_used[v] ? views[v].board_points.size() : 0,
-                          Eigen::Vector2d::Zero());
-      (*projects)[v].assign(residuals[v].size(), false);
-      for (size_t i = 0; i < residuals[v].size(); ++i) {
-        if (!state.valid[v][i]) continue;
-        Eigen::Vector2d r;
-        if (Residual(state, v, i, &r)) {
-          residuals[v][i] = r;
-          (*projects)[v][i] = true;
-        } else {
-          residuals[v][i].setConstant(std::numeric_limits<double>::quiet_NaN());
-        }
-      }
-    }
-  };
-  std::vector<std::vector<bool>> projects;
-  compute_residuals(&projects);
-  while (options.outlier_k > 0 && rounds < options.outlier_iterations &&
-         outcome.summary.IsSolutionUsable()) {
-    // sigma from every corner of the used views, not only the current
-    // inliers: the median is robust to the outliers already, and a sigma of
-    // the inliers alone shrinks with every round and trims good corners.
-    std::vector<double> magnitudes;
-    for (size_t v = 0; v < views.size(); ++v) {
-      if (!state.view_used[v]) continue;
-      for (size_t i = 0; i < residuals[v].size(); ++i) {
-        if (projects[v][i]) {
-          magnitudes.push_back(std::abs(residuals[v][i].x()));
-          magnitudes.push_back(std::abs(residuals[v][i].y()));
-        }
-      }
-    }
-    const double sigma = 1.4826 * Median(magnitudes);
-    const double threshold =
-        std::max(options.outlier_k * sigma, options.min_outlier_threshold_px);
-    std::vector<std::vector<bool>> next = state.inlier;
-    bool changed = false;
-    for (size_t v = 0; v < views.size(); ++v) {
-      if (!state.view_used[v]) continue;
-      for (size_t i = 0; i < residuals[v].size(); ++i) {
-        next[v][i] = projects[v][i] && residuals[v][i].norm() <= threshold;
-        changed |= next[v][i] != state.inlier[v][i];
-      }
-    }
-    if (!changed) break;
-    state.inlier = next;
-    // A view left with too few corners has no trustworthy pose.
-    for (size_t v = 0; v < views.size(); ++v) {
-      if (!state.view_used[v]) continue;
-      const int kept =
-          std::count(state.inlier[v].begin(), state.inlier[v].end(), true);
-      if (kept < options.min_corners_per_view) {
-        state.view_used[v] = false;
-        std::fill(state.inlier[v].begin(), state.inlier[v].end(), false);
-        result->view_reason[v] = "only " + std::to_string(kept) +
-                                 " corners left after outlier rejection";
-      }
-    }
-    ++rounds;
-    Solve<Model>(&state, fixed, options, &loss, &outcome);
-    iterations += outcome.summary.iterations.size();
-    compute_residuals(&projects);
-  }
-
-  // Fill the result.
-  result->camera.model = model;
-  result->camera.width = width;
-  result->camera.height = height;
-  result->camera.params = state.params;
-  result->view_used = state.view_used;
-  result->cam_from_board.assign(views.size(), Eigen::Isometry3d::Identity());
-  result->residuals = residuals;
-  result->inlier = state.inlier;
-  result->view_rms_px.assign(views.size(), 0.0);
-  result->param_fixed = fixed;
-  result->outlier_rounds = rounds;
-  result->iterations = iterations;
-  result->termination = outcome.summary.message;
-  double sum2 = 0;
-  int corners = 0, outliers = 0, used = 0;
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (!state.view_used[v]) continue;
-    ++used;
-    result->cam_from_board[v] = IsometryFromPose(state.poses[v]);
+// Per-view poses and RMS, the totals, and what the solve did.
+void FillResult(CalibrationState* s) {
+  CalibrationResult* r = s->result;
+  const size_t num_views = s->views.size();
+  r->camera.params = s->params;
+  r->view_used = s->view_used;
+  r->residuals = s->residuals;
+  r->inlier = s->inlier;
+  r->param_fixed = s->fixed;
+  r->outlier_rounds = s->rounds;
+  r->iterations = s->iterations;
+  r->termination = s->summary.message;
+  s->sum2 = 0;
+  int corners = 0, outliers = 0;
+  for (size_t v = 0; v < num_views; ++v) {
+    if (!s->view_used[v]) continue;
+    r->view_outcome[v] = ViewOutcome::kUsed;
+    r->cam_from_board[v] = IsometryFromPose(s->poses[v]);
     double view_sum2 = 0;
     int view_corners = 0;
-    for (size_t i = 0; i < residuals[v].size(); ++i) {
-      if (state.inlier[v][i]) {
-        view_sum2 += residuals[v][i].squaredNorm();
+    for (size_t i = 0; i < s->residuals[v].size(); ++i) {
+      if (s->inlier[v][i]) {
+        view_sum2 += s->residuals[v][i].squaredNorm();
         ++view_corners;
-      } else if (state.valid[v][i]) {
+      } else if (s->valid[v][i]) {
         ++outliers;
       }
     }
-    sum2 += view_sum2;
+    s->sum2 += view_sum2;
     corners += view_corners;
-    result->view_rms_px[v] =
+    const int valid = CountUsed(s->valid[v]);
+    r->view_rejected_fraction[v] =
+        valid > 0 ? static_cast<double>(valid - view_corners) / valid : 0.0;
+    r->view_rms_px[v] =
         view_corners > 0 ? std::sqrt(view_sum2 / (2.0 * view_corners)) : 0.0;
   }
-  result->num_views_used = used;
-  result->num_corners_used = corners;
+  r->num_views_used = CountUsed(s->view_used);
+  r->num_corners_used = corners;
   // The initial poses come from rough intrinsics; judge the orientations
   // again with the final ones.
-  result->orientation_spread_deg =
-      OrientationSpreadDeg(result->cam_from_board, state.view_used);
-  result->num_outliers = outliers;
-  result->rms_px = corners > 0 ? std::sqrt(sum2 / (2.0 * corners)) : 0.0;
-  result->rms_point_px = corners > 0 ? std::sqrt(sum2 / corners) : 0.0;
+  r->orientation_spread_deg =
+      OrientationSpreadDeg(r->cam_from_board, s->view_used);
+  r->num_outliers = outliers;
+  r->rejected_fraction =
+      corners + outliers > 0
+          ? static_cast<double>(outliers) / (corners + outliers)
+          : 0.0;
+  r->rms_px = corners > 0 ? std::sqrt(s->sum2 / (2.0 * corners)) : 0.0;
+  r->rms_point_px = corners > 0 ? std::sqrt(s->sum2 / corners) : 0.0;
+  s->free_params = kPoseBlockSize * r->num_views_used;
+  for (bool held : s->fixed) s->free_params += held ? 0 : 1;
+}
 
-  // Covariance of the intrinsics, scaled by the residual variance.
-  int free_params = kPoseBlockSize * used;
-  for (int k = 0; k < kNumParams; ++k) free_params += fixed[k] ? 0 : 1;
-  result->param_stddev.assign(kNumParams, 0.0);
-  result->covariance = Eigen::MatrixXd::Zero(kNumParams, kNumParams);
-  const bool any_free =
-      std::find(fixed.begin(), fixed.end(), false) != fixed.end();
-  if (options.compute_covariance && any_free && outcome.problem &&
-      2 * corners > free_params && outcome.summary.IsSolutionUsable()) {
-    Eigen::Matrix<double, kNumParams, kNumParams> block;
-    bool ok;
-    if (options.deterministic) {
-      ok = MarginalCovariance(outcome.problem.get(), &state, fixed,
-                              options.covariance_min_eigenvalue_ratio, &block);
-    } else {
-      // ceres::Covariance (SuiteSparseQR) may thread internally, which
-      // changes the last bits from run to run.
-      ceres::Covariance::Options covariance_options;
-      covariance_options.num_threads = options.num_threads;
-      ceres::Covariance covariance(covariance_options);
-      std::vector<std::pair<const double*, const double*>> blocks = {
-          {state.params.data(), state.params.data()}};
-      Eigen::Matrix<double, kNumParams, kNumParams, Eigen::RowMajor> row_major;
-      ok = covariance.Compute(blocks, outcome.problem.get()) &&
-           covariance.GetCovarianceBlock(state.params.data(),
-                                         state.params.data(), row_major.data());
-      block = row_major;
-    }
-    if (ok) {
-      const double variance = sum2 / (2.0 * corners - free_params);
-      result->covariance = block * variance;
-      for (int k = 0; k < kNumParams; ++k) {
-        result->param_stddev[k] =
-            std::sqrt(std::max(0.0, result->covariance(k, k)));
-      }
-      result->covariance_ok = true;
-    }
-  }
-  result->solve_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
+// ---------------------------------------------------------------------------
+// Stage 7: covariance.
 
-  // Report.
-  std::ostringstream report;
-  report << "model: " << CameraModelName(model) << ", image " << width << "x"
-         << height << "\n";
-  report << "initialisation: " << result->initialization_method << "\n";
-  for (int k = 0; k < kNumParams; ++k) {
-    report << "  " << names[k] << " = " << Format("%.10g", state.params[k]);
-    if (fixed[k]) {
-      report << " (fixed)";
-    } else if (result->covariance_ok) {
-      report << " +- " << Format("%.3g", result->param_stddev[k]);
-    }
-    report << "\n";
+// ceres::Covariance (SuiteSparseQR) of the intrinsics block; it may thread
+// internally, which changes the last bits from run to run.
+template <typename Model>
+bool CeresCovariance(CalibrationState* s, Eigen::MatrixXd* cov) {
+  constexpr int kNumParams = Model::kNumParams;
+  ceres::Covariance::Options covariance_options;
+  covariance_options.num_threads = s->options.num_threads;
+  ceres::Covariance covariance(covariance_options);
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {s->params.data(), s->params.data()}};
+  Eigen::Matrix<double, kNumParams, kNumParams, Eigen::RowMajor> row_major;
+  if (!covariance.Compute(blocks, s->problem.get()) ||
+      !covariance.GetCovarianceBlock(s->params.data(), s->params.data(),
+                                     row_major.data())) {
+    return false;
   }
-  if (options.compute_covariance && any_free && !result->covariance_ok) {
-    report << "covariance: not available (the problem is rank deficient; "
-              "some parameters are not determined by these views)\n";
-  }
-  report << "rms: " << Format("%.4f", result->rms_px) << " px per coordinate ("
-         << Format("%.4f", result->rms_point_px) << " px per corner)\n";
-  report << "views used: " << used << " of " << views.size()
-         << ", corners used: " << corners << ", outliers rejected: " << outliers
-         << " (" << rounds << " rejection rounds)\n";
-  report << "coverage: " << Format("%.0f", 100 * result->coverage)
-         << " % of the image, board orientation spread "
-         << Format("%.1f", result->orientation_spread_deg) << " degrees\n";
-  report << "solver: " << iterations << " iterations, "
-         << Format("%.3f", result->solve_seconds) << " s, "
-         << outcome.summary.message << "\n";
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (!result->view_reason[v].empty()) {
-      report << "view " << v << " (" << views[v].name
-             << ") not used: " << result->view_reason[v] << "\n";
-    }
-  }
-  result->report = report.str();
+  *cov = row_major;
+  return true;
+}
 
-  if (!outcome.summary.IsSolutionUsable()) {
-    return Fail("the bundle adjustment failed: " + outcome.summary.message,
-                error);
+// The intrinsics' covariance, scaled by the residual variance, and their
+// standard deviations.
+template <typename Model>
+void ComputeCovariance(CalibrationState* s) {
+  CalibrationResult* r = s->result;
+  r->param_stddev.assign(Model::kNumParams, 0.0);
+  r->covariance = Eigen::MatrixXd::Zero(Model::kNumParams, Model::kNumParams);
+  r->covariance_requested =
+      s->options.compute_covariance &&
+      std::find(s->fixed.begin(), s->fixed.end(), false) != s->fixed.end();
+  const int corners = r->num_corners_used;
+  if (!r->covariance_requested || !s->problem ||
+      !(2 * corners > s->free_params) || !s->summary.IsSolutionUsable()) {
+    return;
   }
-  if (outcome.summary.termination_type == ceres::NO_CONVERGENCE) {
+  Eigen::MatrixXd block;
+  bool ok;
+  if (s->options.deterministic) {
+    std::vector<double*> poses;
+    for (size_t v = 0; v < s->poses.size(); ++v) {
+      if (s->view_used[v]) poses.push_back(s->poses[v].data());
+    }
+    ok = MarginalCovariance(s->problem.get(), s->params.data(), poses,
+                            s->fixed, s->options.covariance_min_eigenvalue_ratio,
+                            &block);
+  } else {
+    ok = CeresCovariance<Model>(s, &block);
+  }
+  if (!ok) return;
+  const double variance = s->sum2 / (2.0 * corners - s->free_params);
+  r->covariance = block * variance;
+  for (int k = 0; k < Model::kNumParams; ++k) {
+    r->param_stddev[k] = std::sqrt(std::max(0.0, r->covariance(k, k)));
+  }
+  r->covariance_ok = true;
+}
+
+// ---------------------------------------------------------------------------
+// Stage 8: judge.
+
+// The failure checks on the final result.
+bool Judge(const CalibrationState& s) {
+  const CalibrationResult& r = *s.result;
+  const CalibrationOptions& options = s.options;
+  if (!s.summary.IsSolutionUsable()) {
+    return Fail("the bundle adjustment failed: " + s.summary.message, s.error);
+  }
+  if (s.summary.termination_type == ceres::NO_CONVERGENCE) {
     return Fail("the bundle adjustment did not converge within " +
                     std::to_string(options.max_iterations) +
                     " iterations: raise the iteration limit or check the "
                     "correspondences (RMS " +
-                    Format("%.3f", result->rms_px) + " px)",
-                error);
+                    Format("%.3f", r.rms_px) + " px)",
+                s.error);
   }
-  if (used < options.min_views) return too_few_views(used);
-  if (result->orientation_spread_deg < options.min_orientation_spread_deg) {
-    return parallel_views(result->orientation_spread_deg);
+  if (r.num_views_used < options.min_views) {
+    return FailTooFewViews(s, r.num_views_used);
+  }
+  if (r.orientation_spread_deg < options.min_orientation_spread_deg) {
+    return FailParallelViews(s, r.orientation_spread_deg);
   }
   // Both focal lengths (indices 0 and 1: fx, fy in every model) must be
   // determined unless held fixed.
   for (int k = 0; k < 2; ++k) {
-    if (result->covariance_ok && !fixed[k] &&
-        !(result->param_stddev[k] <=
-          options.max_focal_relative_stddev * std::abs(state.params[k]))) {
-      return Fail("the views do not determine the focal length (" + names[k] +
-                      " = " + Format("%.1f", state.params[k]) + " +- " +
-                      Format("%.3g", result->param_stddev[k]) +
+    if (r.covariance_ok && !s.fixed[k] &&
+        !(r.param_stddev[k] <=
+          options.max_focal_relative_stddev * std::abs(s.params[k]))) {
+      return Fail("the views do not determine the focal length (" +
+                      s.names[k] + " = " + Format("%.1f", s.params[k]) +
+                      " +- " + Format("%.3g", r.param_stddev[k]) +
                       " px): add views with the board tilted by 30 degrees "
                       "or more, near the image borders too",
+                  s.error);
+    }
+  }
+  if (!(r.rms_px <= options.max_rms_px)) {
+    return Fail("the reprojection RMS is " + Format("%.2f", r.rms_px) +
+                    " px (limit " + Format("%.2f", options.max_rms_px) +
+                    " px): the correspondences do not fit the " +
+                    CameraModelName(s.model) +
+                    " model; check the board definition and the model",
+                s.error);
+  }
+  return true;
+}
+
+template <typename Model>
+bool CalibrateModel(CalibrationState* s) {
+  if (!CheckViews(s) || !Initialise(s)) return false;
+  s->fixed = FixedParams(*s);
+  if (!SelectInitialInliers(s) || !SolveFromInitialisation<Model>(s)) {
+    return false;
+  }
+  RejectOutliers<Model>(s);
+  FillResult(s);
+  ComputeCovariance<Model>(s);
+  s->result->solve_seconds = SecondsSince(s->start);
+  return Judge(*s);
+}
+
+// Checks on the arguments that need no view: options, image size, fixed
+// parameter names and the length of initial_params.
+bool CheckArguments(CameraModelId model, int width, int height,
+                    const CalibrationOptions& options, std::string* error) {
+  std::string why;
+  if (!options.Check(&why)) return Fail("calibration options: " + why, error);
+  if (width <= 0 || height <= 0) {
+    return Fail("the image size must be positive (got " +
+                    std::to_string(width) + "x" + std::to_string(height) + ")",
+                error);
+  }
+  const std::vector<std::string> names = CameraModelParamNames(model);
+  for (const std::string& name : options.fixed_params) {
+    if (std::find(names.begin(), names.end(), name) == names.end()) {
+      return Fail("calibration options: fixed parameter '" + name +
+                      "' is not a parameter of " + CameraModelName(model),
                   error);
     }
   }
-  if (!(result->rms_px <= options.max_rms_px)) {
-    return Fail("the reprojection RMS is " + Format("%.2f", result->rms_px) +
-                    " px (limit " + Format("%.2f", options.max_rms_px) +
-                    " px): the correspondences do not fit the " +
-                    CameraModelName(model) +
-                    " model; check the board definition and the model",
+  if (!options.initial_params.empty() &&
+      options.initial_params.size() != names.size()) {
+    return Fail("calibration options: initial_params has " +
+                    std::to_string(options.initial_params.size()) +
+                    " values, " + CameraModelName(model) + " needs " +
+                    std::to_string(names.size()),
                 error);
   }
   return true;
@@ -741,6 +848,30 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
   return true;
 }
 
+// Per-view fields sized to the input, so that a failure at any step still
+// returns a result a report can describe (every view unused, with its
+// outcome).
+void ResetResult(const std::vector<CalibrationView>& views,
+                 CameraModelId model, int width, int height,
+                 CalibrationResult* result) {
+  *result = CalibrationResult();
+  result->camera.model = model;
+  result->camera.width = width;
+  result->camera.height = height;
+  result->view_name.resize(views.size());
+  for (size_t v = 0; v < views.size(); ++v) {
+    result->view_name[v] = views[v].name;
+  }
+  result->view_used.assign(views.size(), false);
+  result->view_outcome.assign(views.size(), ViewOutcome::kNotReached);
+  result->view_reason.assign(views.size(), "");
+  result->cam_from_board.assign(views.size(), Eigen::Isometry3d::Identity());
+  result->view_rms_px.assign(views.size(), 0.0);
+  result->view_rejected_fraction.assign(views.size(), 0.0);
+  result->residuals.resize(views.size());  // empty: no view used yet
+  result->inlier.resize(views.size());
+}
+
 }  // namespace
 
 const char* RobustLossName(RobustLoss loss) {
@@ -766,6 +897,28 @@ bool RobustLossFromName(const std::string& name, RobustLoss* loss) {
   return false;
 }
 
+const char* ViewOutcomeName(ViewOutcome outcome) {
+  switch (outcome) {
+    case ViewOutcome::kUsed:
+      return "used";
+    case ViewOutcome::kNotReached:
+      return "not reached";
+    case ViewOutcome::kMismatchedPoints:
+      return "mismatched points";
+    case ViewOutcome::kNotPlanar:
+      return "board points not planar";
+    case ViewOutcome::kTooFewCorners:
+      return "too few corners";
+    case ViewOutcome::kNoInitialPose:
+      return "no initial pose";
+    case ViewOutcome::kTooFewProjecting:
+      return "too few corners project";
+    case ViewOutcome::kTooFewAfterRejection:
+      return "too few corners after outlier rejection";
+  }
+  return "not reached";
+}
+
 bool CalibrationOptions::Check(std::string* why) const {
   if (!(loss_scale_px > 0)) return Fail("loss_scale_px must be > 0", why);
   if (!(outlier_k >= 0)) return Fail("outlier_k must be >= 0", why);
@@ -773,6 +926,7 @@ bool CalibrationOptions::Check(std::string* why) const {
     return Fail("outlier_iterations must be >= 0", why);
   }
   if (max_iterations < 1) return Fail("max_iterations must be >= 1", why);
+  if (coarse_stride < 1) return Fail("coarse_stride must be >= 1", why);
   if (!(function_tolerance > 0)) {
     return Fail("function_tolerance must be > 0", why);
   }
@@ -810,61 +964,21 @@ bool CalibrationOptions::Check(std::string* why) const {
 bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
                int width, int height, const CalibrationOptions& options,
                CalibrationResult* result, std::string* error) {
-  // Per-view fields are sized to the input from the start, so that a
-  // failure at any step still returns a result a report can describe (every
-  // view unused, with its reason where one is known).
-  *result = CalibrationResult();
-  result->camera.model = model;
-  result->camera.width = width;
-  result->camera.height = height;
-  result->view_used.assign(views.size(), false);
-  result->view_reason.assign(views.size(), "");
-  result->cam_from_board.assign(views.size(), Eigen::Isometry3d::Identity());
-  result->view_rms_px.assign(views.size(), 0.0);
-  result->residuals.resize(views.size());  // empty: no view used yet
-  result->inlier.resize(views.size());
-  std::string why;
-  if (!options.Check(&why)) return Fail("calibration options: " + why, error);
-  if (width <= 0 || height <= 0) {
-    return Fail("the image size must be positive (got " +
-                    std::to_string(width) + "x" + std::to_string(height) + ")",
-                error);
-  }
-  const std::vector<std::string> names = CameraModelParamNames(model);
-  for (const std::string& name : options.fixed_params) {
-    if (std::find(names.begin(), names.end(), name) == names.end()) {
-      return Fail("calibration options: fixed parameter '" + name +
-                      "' is not a parameter of " + CameraModelName(model),
-                  error);
-    }
-  }
-  if (!options.initial_params.empty() &&
-      options.initial_params.size() != names.size()) {
-    return Fail("calibration options: initial_params has " +
-                    std::to_string(options.initial_params.size()) +
-                    " values, " + CameraModelName(model) + " needs " +
-                    std::to_string(names.size()),
-                error);
-  }
+  ResetResult(views, model, width, height, result);
+  if (!CheckArguments(model, width, height, options, error)) return false;
   CalibrationOptions start = options;
   std::string start_method;
   if (!StartFromFarFieldModel(views, model, width, height, &start,
                               &start_method, error)) {
     return false;
   }
+  CalibrationState state(views, model, width, height, start, result, error);
   const bool ok = DispatchCameraModel(model, [&](auto model_struct) {
-    return CalibrateModel<decltype(model_struct)>(views, width, height, start,
-                                                  result, error);
+    return CalibrateModel<decltype(model_struct)>(&state);
   });
-  if (!start_method.empty()) {
-    const std::string line = "initialisation: " + result->initialization_method;
-    const size_t at = result->report.find(line);
-    if (at != std::string::npos) {
-      result->report.replace(at, line.size(),
-                             "initialisation: " + start_method);
-    }
-    result->initialization_method = start_method;
-  }
+  // The report names the real start: the central fit, not "given by the
+  // caller".
+  if (!start_method.empty()) result->initialization_method = start_method;
   return ok;
 }
 

@@ -78,10 +78,10 @@ TEST_F(DeltilleCalibrationTest, UsesAlmostEveryPhotoAndAgreesWithOpenCv) {
   DeltilleRun run = CalibrateFiles(files_);
   ASSERT_TRUE(run.ok) << run.error;
   // The 64-photo subset: every photo shows the whole board.
-  EXPECT_GE(run.result.num_views_used, 60) << run.result.report;
+  EXPECT_GE(run.result.num_views_used, 60) << CalibrationReport(run.result);
   // The board's rim corners at 100-114 degrees are the hardest to locate;
   // 0.41 px per coordinate was measured, the bound is 1.5x that.
-  EXPECT_LT(run.result.rms_px, 0.6) << run.result.report;
+  EXPECT_LT(run.result.rms_px, 0.6) << CalibrationReport(run.result);
 
   constexpr double kCentralRadiusPx = 380.0;
   const Eigen::Vector2d centre(800, 600);
