@@ -78,8 +78,9 @@ struct CalibrationOptions {
   // the start. >= 1.
   int coarse_stride = 1;
 
-  // Levenberg-Marquardt iterations per solve. Default 100.
-  int max_iterations = 100;
+  // Levenberg-Marquardt iterations per solve. Default 200 (the first solve
+  // from a rough start can take more than 100 on wide-angle cameras).
+  int max_iterations = 200;
   // Relative cost change that ends a solve. Default 1e-9: the parameters
   // then move by about 1e-4 of their standard deviations per iteration
   // (measured on the sample set: the result agrees with 1e-12 to 1e-5 px in
