@@ -42,12 +42,27 @@ double Quantile(std::vector<double> values, double q) {
   return values[k];
 }
 
+// Every map and figure here is of the far field: a ray's direction, as
+// Unproject gives it. Camera::Project takes a point, and a unit ray as a
+// point is one metre away, where a non-central lens still shows its pupil
+// shift (a 4 mm shift at 90 degrees moves such a point by about 1 px on a
+// 300 px fisheye). So directions are projected as points this far along
+// them (metres), where the shift moves them by about 1e-6 px; central models
+// give the same pixel at any distance.
+constexpr double kFarDistanceM = 1e6;
+
+bool ProjectDirection(const Camera& camera, const Eigen::Vector3d& ray,
+                      Eigen::Vector2d* pixel) {
+  return camera.Project(kFarDistanceM * ray, pixel);
+}
+
 double FieldAngleDeg(const Eigen::Vector3d& ray) {
   return std::atan2(ray.head<2>().norm(), ray.z()) / kDeg;
 }
 
 // d pixel / d intrinsics (jacobian, 2 x n) and d pixel / d point (point, 2 x
-// 3) of Model::Project at `ray`, by automatic differentiation.
+// 3, by the ray) of Model::Project of the far point along `ray`, by
+// automatic differentiation.
 template <typename Model>
 bool ProjectionJacobians(const double* params, const Eigen::Vector3d& ray,
                          Eigen::MatrixXd* jacobian,
@@ -56,8 +71,11 @@ bool ProjectionJacobians(const double* params, const Eigen::Vector3d& ray,
   using JetT = ceres::Jet<double, kN + 3>;
   JetT p[kN];
   for (int k = 0; k < kN; ++k) p[k] = JetT(params[k], k);
-  const JetT x[3] = {JetT(ray.x(), kN), JetT(ray.y(), kN + 1),
-                     JetT(ray.z(), kN + 2)};
+  // The far point along the ray (see kFarDistanceM), differentiated by the
+  // ray itself.
+  const JetT x[3] = {kFarDistanceM * JetT(ray.x(), kN),
+                     kFarDistanceM * JetT(ray.y(), kN + 1),
+                     kFarDistanceM * JetT(ray.z(), kN + 2)};
   JetT pixel[2];
   if (!Model::Project(p, x, pixel)) return false;
   jacobian->resize(2, kN);
@@ -394,8 +412,9 @@ ProjectionUncertainty ComputeProjectionUncertainty(
                                 std::sin(angle * kDeg) * std::sin(phi),
                                 std::cos(angle * kDeg));
       Eigen::Vector2d pixel;
-      if (!camera.Project(ray, &pixel) || pixel.x() < 0 || pixel.y() < 0 ||
-          pixel.x() > camera.width - 1 || pixel.y() > camera.height - 1) {
+      if (!ProjectDirection(camera, ray, &pixel) || pixel.x() < 0 ||
+          pixel.y() < 0 || pixel.x() > camera.width - 1 ||
+          pixel.y() > camera.height - 1) {
         continue;
       }
       double sigma, fixed_frame;
@@ -506,7 +525,8 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
         const int k = j * map.cols + i;
         Eigen::Vector2d projected;
         if (!valid[k] ||
-            !out.camera_b.Project(out.b_from_a * rays_a[k], &projected)) {
+            !ProjectDirection(out.camera_b, out.b_from_a * rays_a[k],
+                              &projected)) {
           continue;
         }
         gtg += g[k].transpose() * g[k];
@@ -527,7 +547,8 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
       const int k = j * map.cols + i;
       if (!valid[k]) continue;
       Eigen::Vector2d projected;
-      if (out.camera_b.Project(out.b_from_a * rays_a[k], &projected)) {
+      if (ProjectDirection(out.camera_b, out.b_from_a * rays_a[k],
+                           &projected)) {
         map.values[k] = (projected - MapPixel(map, camera, i, j)).norm();
       }
     }

@@ -40,6 +40,16 @@ struct VerdictOptions {
   // 0.1 px.
   double halves_factor = 2.5;
   double halves_floor_px = 0.1;
+  // The covariance assumes independent corner errors; errors shared by the
+  // corners of a view (its pose, the print, blur, a slightly bent board) do
+  // not average out over a view's corners, so real halves differ by more
+  // than it predicts, by about the same factor in every band. A model error
+  // instead leaves bands where the model fits. So, with at least
+  // halves_min_bands judged bands, the prediction is first scaled by the
+  // smallest ratio (difference / prediction) of any judged band, when that
+  // exceeds 1, and the halves_factor test applies to the scaled
+  // prediction. 0 turns the scaling off. Default 3.
+  int halves_min_bands = 3;
   // A residual bin (min_bin_count corners or more) is systematic when its
   // mean radial or tangential component is more than residual_se_factor
   // standard errors and more than residual_floor_px from zero. The standard

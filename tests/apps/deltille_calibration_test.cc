@@ -16,6 +16,8 @@
 #include "apps/pipeline.h"
 #include "calib/calibrate.h"
 #include "calib/camera_yaml.h"
+#include "calib/evidence.h"
+#include "calib/verdict.h"
 #include "tests/support/deltille_data.h"
 
 namespace puzzlecal {
@@ -31,7 +33,9 @@ struct DeltilleRun {
   CalibrationResult result;
 };
 
-DeltilleRun CalibrateFiles(const std::vector<std::string>& files) {
+DeltilleRun CalibrateFiles(
+    const std::vector<std::string>& files,
+    CameraModelId model = CameraModelId::kKannalaBrandt) {
   DeltilleRun run;
   Board board;
   EXPECT_TRUE(
@@ -45,8 +49,8 @@ DeltilleRun CalibrateFiles(const std::vector<std::string>& files) {
   int width = 0, height = 0;
   run.views =
       MakeCalibrationViews(board, &images, &view_of_image, &width, &height);
-  run.ok = Calibrate(run.views, CameraModelId::kKannalaBrandt, width, height,
-                     CalibrationOptions(), &run.result, &run.error);
+  run.ok = Calibrate(run.views, model, width, height, CalibrationOptions(),
+                     &run.result, &run.error);
   return run;
 }
 
@@ -177,6 +181,80 @@ TEST_F(DeltilleCalibrationTest, DisjointHalvesAgree) {
     EXPECT_NEAR(a.result.camera.params[p], b.result.camera.params[p], bound)
         << CameraModelParamNames(a.result.camera.model)[p];
   }
+}
+
+// The evidence and verdict of a run, as `puzzlecal calibrate` makes them.
+struct Judged {
+  Evidence evidence;
+  Verdict verdict;
+};
+
+Judged Judge(const DeltilleRun& run) {
+  Judged judged;
+  const EvidenceOptions evidence_options;
+  judged.evidence = ComputeEvidence(run.views, run.result, CalibrationOptions(),
+                                    evidence_options);
+  judged.verdict = MakeVerdict(run.result, judged.evidence, evidence_options,
+                               VerdictOptions());
+  return judged;
+}
+
+// The lens is non-central: its entrance pupil moves along the axis with the
+// field angle, by millimetres at 90 degrees, and the board was 2.5-24 cm
+// away. The central model leaves errors that grow as the board comes closer
+// (12 % of the corners rejected, RMS 0.49 px when this was written); the
+// verdict says so and names the non-central model.
+TEST_F(DeltilleCalibrationTest, CentralModelVerdictNamesNoncentral) {
+  const DeltilleRun run = CalibrateFiles(files_, CameraModelId::kKannalaBrandt);
+  ASSERT_TRUE(run.ok) << run.error;
+  const Judged judged = Judge(run);
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kModelError)
+      << judged.verdict.Line();
+  EXPECT_EQ(judged.verdict.suggested_model, "kannala-brandt-noncentral")
+      << judged.verdict.Line();
+  std::printf("%s\n", judged.verdict.Line().c_str());
+}
+
+// The non-central model on the same photos: the noise level of the corners
+// with nothing left over. Measured when this was written: RMS 0.153 px per
+// coordinate, 3 of 5471 corners (0.05 %) rejected, 64 of 64 photos used,
+// halves' far-field difference (median per 10-degree band) at most 0.081 px
+// below 90 degrees and 0.110 px at 90-100 degrees, verdict good.
+TEST_F(DeltilleCalibrationTest, NoncentralModelFitsToTheNoiseAndIsGood) {
+  const DeltilleRun run =
+      CalibrateFiles(files_, CameraModelId::kKannalaBrandtNoncentral);
+  ASSERT_TRUE(run.ok) << run.error;
+  const CalibrationResult& result = run.result;
+  EXPECT_EQ(result.num_views_used, run.images) << CalibrationReport(result);
+  EXPECT_EQ(run.images, static_cast<int>(files_.size()));
+  EXPECT_LE(result.rms_px, 0.17) << CalibrationReport(result);
+  const int corners = result.num_corners_used + result.num_outliers;
+  ASSERT_GT(corners, 0);
+  EXPECT_LE(result.num_outliers, 0.01 * corners) << CalibrationReport(result);
+
+  const Judged judged = Judge(run);
+  const CrossValidation& cv = judged.evidence.cross_validation;
+  ASSERT_TRUE(cv.ok) << cv.error;
+  int judged_bands = 0;
+  for (const AngleBand& band : cv.difference_bands) {
+    if (band.hi_deg > 100.0 + 1e-9) continue;
+    ++judged_bands;
+    // 0.1 px is the aim within 100 degrees; the 90-100 band measured
+    // 0.110 px, so it is held to 0.12 px (the bands below to 0.1 px).
+    const double bound = band.lo_deg >= 90.0 - 1e-9 ? 0.12 : 0.1;
+    EXPECT_LE(band.median, bound)
+        << band.lo_deg << "-" << band.hi_deg << " deg\n"
+        << EvidenceText(judged.evidence);
+    std::printf("halves %3.0f-%3.0f deg: median %.3f px, p95 %.3f px\n",
+                band.lo_deg, band.hi_deg, band.median, band.p95);
+  }
+  EXPECT_EQ(judged_bands, 10);
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kGood)
+      << judged.verdict.Line() << "\n"
+      << EvidenceText(judged.evidence);
+  std::printf("rms %.4f px, %d of %d corners rejected, %d of %d views\n%s\n",
+              result.rms_px, result.num_outliers, corners,
+              result.num_views_used, run.images, judged.verdict.Line().c_str());
 }
 
 }  // namespace
