@@ -137,6 +137,17 @@ int RunCalibrateRig() {
     return kExitUsage;
   }
   models.resize(folders.size(), models[0]);
+  // The format decides each camera's free parameters (Kalibr's radtan has
+  // no k3), so it is settled before any image is read.
+  std::vector<std::vector<std::string>> format_fixed(folders.size());
+  for (size_t c = 0; c < folders.size(); ++c) {
+    if (!CameraFormatFixedParams(format, models[c], &format_fixed[c],
+                                 &error)) {
+      std::cerr << kName << ": --format " << FLAGS_format << ", camera '"
+                << folders[c].filename().string() << "': " << error << ".\n";
+      return kExitUsage;
+    }
+  }
 
   // Every camera's images; the frames are the file names of all folders.
   std::vector<ImageListing> listings(folders.size());
@@ -171,6 +182,7 @@ int RunCalibrateRig() {
     RigCameraInput& input = inputs[c];
     input.name = folders[c].filename().string();
     input.model = models[c];
+    input.fixed_params = format_fixed[c];
     input.frames.resize(num_frames);
     std::vector<ImageResult> images =
         ProcessImageFiles(listings[c].images, board, pipeline_options, threads);

@@ -1153,13 +1153,15 @@ bool ReportOptions::Check(std::string* why) const {
   return true;
 }
 
-bool DistortionShift(const Camera& camera, const Eigen::Vector2d& pixel,
+bool DistortionShift(const Camera& lens, const Eigen::Vector2d& pixel,
                      double* shift_px, double* ray_angle_deg) {
-  if (static_cast<int>(camera.params.size()) !=
-          CameraModelNumParams(camera.model) ||
+  if (static_cast<int>(lens.params.size()) !=
+          CameraModelNumParams(lens.model) ||
       !pixel.allFinite()) {
     return false;
   }
+  // Directions: a non-central camera's far-field part.
+  const Camera camera = FarFieldCamera(lens);
   // Reference: the same camera without distortion, i.e. the pinhole
   // (pinhole models) or the equidistant fisheye r = f * theta (KB).
   double reference[16] = {};

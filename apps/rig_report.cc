@@ -28,9 +28,12 @@ bool RigReportOptions::Check(std::string* why) const {
   return true;
 }
 
-cv::Mat RectifyImage(const cv::Mat& image, const Camera& camera,
+cv::Mat RectifyImage(const cv::Mat& image, const Camera& lens,
                      const Eigen::Matrix3d& rectified_from_camera,
                      const Eigen::Matrix3d& projection, int width, int height) {
+  // The scene is far away compared to the lens: a non-central camera acts
+  // as its far-field part (the same camera for central models).
+  const Camera camera = FarFieldCamera(lens);
   cv::Mat map_x(height, width, CV_32FC1), map_y(height, width, CV_32FC1);
   const Eigen::Matrix3d camera_from_pixel =
       rectified_from_camera.transpose() * projection.inverse();

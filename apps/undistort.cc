@@ -140,8 +140,11 @@ bool UndistortOptions::Check(std::string* why) const {
   return true;
 }
 
-UndistortResult ChooseUndistortTarget(const Camera& source,
+UndistortResult ChooseUndistortTarget(const Camera& source_camera,
                                       const UndistortOptions& options) {
+  // The scene is far away compared to the lens: a non-central camera acts
+  // as its far-field part (the same camera for central models).
+  const Camera source = FarFieldCamera(source_camera);
   UndistortResult result;
   const int w = source.width, h = source.height;
   // The source border, side by side: each sample as a normalised point,
@@ -229,9 +232,12 @@ UndistortResult ChooseUndistortTarget(const Camera& source,
   return result;
 }
 
-void MakeUndistortMaps(const Camera& source, const Camera& target,
+void MakeUndistortMaps(const Camera& source_camera, const Camera& target,
                        const UndistortOptions& options, cv::Mat* map_x,
                        cv::Mat* map_y) {
+  // The scene is far away compared to the lens: a non-central camera acts
+  // as its far-field part (the same camera for central models).
+  const Camera source = FarFieldCamera(source_camera);
   map_x->create(target.height, target.width, CV_32FC1);
   map_y->create(target.height, target.width, CV_32FC1);
   const auto& k = target.params;

@@ -21,19 +21,6 @@ bool Fail(const std::string& message, std::string* error) {
   return false;
 }
 
-// Distortion model names of the other formats, per puzzlecal model.
-const char* RosDistortionModel(CameraModelId id) {
-  switch (id) {
-    case CameraModelId::kPinholeRadtan:
-      return "plumb_bob";
-    case CameraModelId::kPinholeRational:
-      return "rational_polynomial";
-    case CameraModelId::kKannalaBrandt:
-    case CameraModelId::kKannalaBrandtNoncentral:  // its far-field part
-      return "equidistant";
-  }
-  return "plumb_bob";
-}
 
 YAML::Emitter& Flow(YAML::Emitter& out, const std::vector<double>& values) {
   out << YAML::Flow << YAML::BeginSeq;
@@ -599,6 +586,19 @@ bool ParseKalibr(const YAML::Node& root, Reader& r, Camera* camera) {
 }
 
 }  // namespace
+
+const char* RosDistortionModel(CameraModelId id) {
+  switch (id) {
+    case CameraModelId::kPinholeRadtan:
+      return "plumb_bob";
+    case CameraModelId::kPinholeRational:
+      return "rational_polynomial";
+    case CameraModelId::kKannalaBrandt:
+    case CameraModelId::kKannalaBrandtNoncentral:  // its far-field part
+      return "equidistant";
+  }
+  return "plumb_bob";
+}
 
 const char* CameraFileFormatName(CameraFileFormat format) {
   switch (format) {

@@ -106,6 +106,11 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
 double FarFieldErrorPx(const Camera& camera, double distance_m,
                        double max_field_angle_deg);
 
+// The ros camera_info distortion_model of a puzzlecal model: plumb_bob,
+// rational_polynomial, or equidistant (kannala-brandt; a non-central camera
+// is written as its far-field part).
+const char* RosDistortionModel(CameraModelId id);
+
 // Name written into the ros format's camera_name.
 inline constexpr const char* kDefaultCameraName = "camera";
 // Image topic written into the kalibr camchain's cam0/rostopic.

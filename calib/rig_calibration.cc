@@ -523,9 +523,14 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
     for (int t = 0; t < threads; ++t) {
       workers.emplace_back([&, t]() {
         for (size_t c = t; c < num_cameras; c += threads) {
-          single_ok[c] =
-              Calibrate(cameras[c].frames, cameras[c].model, cameras[c].width,
-                        cameras[c].height, copt, &single[c], &single_error[c]);
+          CalibrationOptions camera_options = copt;
+          camera_options.fixed_params.insert(
+              camera_options.fixed_params.end(),
+              cameras[c].fixed_params.begin(), cameras[c].fixed_params.end());
+          single_ok[c] = Calibrate(cameras[c].frames, cameras[c].model,
+                                   cameras[c].width, cameras[c].height,
+                                   camera_options, &single[c],
+                                   &single_error[c]);
         }
       });
     }

@@ -38,6 +38,10 @@ struct RigCameraInput {
   int width = 0;
   int height = 0;
   std::vector<CalibrationView> frames;
+  // Parameters held at their initial values for this camera (by name), on
+  // top of the options' fixed_params; e.g. {"k3"} for a pinhole-radtan
+  // camera written to Kalibr's 4-coefficient radtan. Default empty.
+  std::vector<std::string> fixed_params;
 };
 
 struct RigCalibrationOptions {

@@ -205,18 +205,6 @@ bool FormatOpenCv(const RigCalibrationResult& result, std::string* text,
   return true;
 }
 
-const char* RosDistortionModel(CameraModelId id) {
-  switch (id) {
-    case CameraModelId::kPinholeRadtan:
-      return "plumb_bob";
-    case CameraModelId::kPinholeRational:
-      return "rational_polynomial";
-    case CameraModelId::kKannalaBrandt:
-      return "equidistant";
-  }
-  return "plumb_bob";
-}
-
 std::string FormatRosCamera(const RigCameraResult& cam,
                             const Eigen::Matrix3d& rectification,
                             const Eigen::Matrix<double, 3, 4>& projection) {
@@ -395,6 +383,12 @@ bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
                     std::vector<RigFileText>* files, std::string* error) {
   files->clear();
   if (!CheckCameras(result, error)) return false;
+  // opencv, ros and kalibr have no non-central model: they get each
+  // camera's far-field part (the same camera for central models).
+  RigCalibrationResult far_field = result;
+  for (RigCameraResult& cam : far_field.cameras) {
+    cam.camera = FarFieldCamera(cam.camera);
+  }
   RigFileText file;
   file.path = out_path;
   switch (format) {
@@ -402,12 +396,12 @@ bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
       file.text = FormatPuzzlecal(result);
       break;
     case CameraFileFormat::kOpenCv:
-      if (!FormatOpenCv(result, &file.text, error)) return false;
+      if (!FormatOpenCv(far_field, &file.text, error)) return false;
       break;
     case CameraFileFormat::kRos:
-      return FormatRos(result, out_path, files, error);
+      return FormatRos(far_field, out_path, files, error);
     case CameraFileFormat::kKalibr:
-      if (!FormatKalibr(result, &file.text, error)) return false;
+      if (!FormatKalibr(far_field, &file.text, error)) return false;
       break;
   }
   files->push_back(file);

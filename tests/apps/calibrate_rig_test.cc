@@ -4,7 +4,9 @@
 // built beside this test (<build>/apps/puzzlecal).
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -45,8 +47,16 @@ struct RunResult {
   std::string output;  // stdout and stderr
 };
 
+// A folder of this test process's own: ctest runs the test cases as
+// separate processes at the same time.
+fs::path ScratchRoot() {
+  return fs::temp_directory_path() /
+         ("puzzlecal_rig_test_" + std::to_string(getpid()));
+}
+
 RunResult RunProgram(const std::string& arguments) {
-  const fs::path log = fs::temp_directory_path() / "puzzlecal_rig_run.log";
+  fs::create_directories(ScratchRoot());
+  const fs::path log = ScratchRoot() / "run.log";
   const std::string command =
       ProgramPath().string() + " " + arguments + " > " + log.string() + " 2>&1";
   const int status = std::system(command.c_str());
@@ -80,7 +90,7 @@ struct RenderedRig {
 RenderedRig Render(const RigSceneSpec& scene, const std::string& name) {
   RenderedRig rig;
   rig.scene = scene;
-  rig.root = fs::temp_directory_path() / ("puzzlecal_rig_test_" + name);
+  rig.root = ScratchRoot() / name;
   fs::remove_all(rig.root);
   rig.images = rig.root / "images";
   std::string why;
@@ -179,6 +189,37 @@ TEST(CalibrateRigTest, StereoPinholeRendersInOpenCvFormat) {
   }
 }
 
+// Kalibr's radtan has 4 coefficients: --format kalibr calibrates
+// pinhole-radtan cameras with k3 held at 0 (and says so by writing the
+// camchain), and refuses pinhole-rational before any image is read.
+TEST(CalibrateRigTest, KalibrFormatHoldsK3AtZeroAndRefusesRationalAtOnce) {
+  const RenderedRig rig = Render(StereoPinholeRig(), "kalibr");
+  const fs::path out = rig.root / "camchain.yaml";
+  const RunResult run =
+      RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
+                 rig.board + " --model pinhole-radtan --format kalibr --out " +
+                 out.string() + " --threads 2");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  const YAML::Node chain = YAML::LoadFile(out.string());
+  for (const char* cam : {"cam0", "cam1"}) {
+    ASSERT_TRUE(chain[cam]) << cam;
+    EXPECT_EQ(chain[cam]["distortion_model"].as<std::string>(), "radtan");
+    EXPECT_EQ(chain[cam]["distortion_coeffs"].size(), 4u);
+    EXPECT_TRUE(chain[cam]["rostopic"]) << cam;
+  }
+  EXPECT_TRUE(chain["cam1"]["T_cn_cnm1"]);
+
+  const fs::path refused = rig.root / "rational.yaml";
+  const RunResult rational = RunProgram(
+      "calibrate-rig --images " + rig.images.string() + " --board " +
+      rig.board + " --model pinhole-rational --format kalibr --out " +
+      refused.string());
+  EXPECT_EQ(rational.exit_code, kExitUsage) << rational.output;
+  EXPECT_NE(rational.output.find("kalibr"), std::string::npos)
+      << rational.output;
+  EXPECT_FALSE(fs::exists(refused));
+}
+
 TEST(CalibrateRigTest, CameraThatNeverSharesAFrameIsNamedAndNothingWritten) {
   const RenderedRig rig = Render(StereoPinholeRig(), "no_shared");
   // Odd frames only for cam0, even ones only for cam1.
@@ -197,7 +238,7 @@ TEST(CalibrateRigTest, CameraThatNeverSharesAFrameIsNamedAndNothingWritten) {
 }
 
 TEST(CalibrateRigTest, WrongNumberOfModelsIsAUsageError) {
-  const fs::path root = fs::temp_directory_path() / "puzzlecal_rig_models";
+  const fs::path root = ScratchRoot() / "models";
   fs::create_directories(root / "a");
   fs::create_directories(root / "b");
   fs::create_directories(root / "c");

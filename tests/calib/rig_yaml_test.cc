@@ -5,6 +5,7 @@
 #include "calib/rig_yaml.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
@@ -47,7 +48,8 @@ RigCalibrationResult ResultFromScene(const RigSceneSpec& scene) {
 }
 
 std::string TempPath(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "puzzlecal_rig_yaml_test";
+  const fs::path dir = fs::temp_directory_path() /
+                       ("puzzlecal_rig_yaml_test_" + std::to_string(getpid()));
   fs::create_directories(dir);
   return (dir / name).string();
 }

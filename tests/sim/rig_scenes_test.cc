@@ -7,6 +7,7 @@
 #include "sim/rig_scenes.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -158,7 +159,8 @@ TEST(RigScenesTest, RendersOneFolderPerCameraWithFrameNames) {
   RigSceneSpec scene = FisheyePinholeRig(320, 240);
   scene.random_frames.count = 8;
   scene.render.supersampling = 2;
-  const fs::path dir = fs::temp_directory_path() / "puzzlecal_rig_scenes_test";
+  const fs::path dir = fs::temp_directory_path() /
+                       ("puzzlecal_rig_scenes_test_" + std::to_string(getpid()));
   fs::remove_all(dir);
   RigRenderSummary summary;
   std::string why;
