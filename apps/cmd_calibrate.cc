@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -29,6 +28,7 @@
 #include "calib/evidence.h"
 #include "calib/model_selection.h"
 #include "calib/verdict.h"
+#include "util/timer.h"
 
 namespace puzzlecal {
 namespace {
@@ -52,11 +52,6 @@ constexpr char kUsage[] =
     "file.\n\nExit codes: 0 done, 2 bad command line, 3 bad input, 4 no "
     "trustworthy result,\n5 an output cannot be written (checked before the "
     "work starts), 130 interrupted.";
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 // A one-line progress bar on a terminal, a plain line per image otherwise.
 class Progress {
@@ -267,7 +262,7 @@ void PrintImageProblems(const std::vector<ReportImage>& lines) {
 
 int RunCalibrate() {
   std::signal(SIGINT, OnInterrupt);
-  const auto run_start = std::chrono::steady_clock::now();
+  const Timer run_timer;
   if (FLAGS_images.empty() || FLAGS_board.empty() || FLAGS_out.empty()) {
     std::cerr << "puzzlecal calibrate: --images, --board and --out are "
                  "required. Run `puzzlecal calibrate --help`.\n";
@@ -361,7 +356,7 @@ int RunCalibrate() {
     return kExitBadInput;
   }
 
-  const auto calib_start = std::chrono::steady_clock::now();
+  const Timer calib_timer;
   calibration_options.num_threads = threads;  // same result for any count
   // --model auto: the candidate with the lowest held-out error
   // (calib/model_selection.h).
@@ -394,15 +389,15 @@ int RunCalibrate() {
                            &result, &calibration_error);
   }
   if (!calibrated && !mismatch.empty()) calibration_error = mismatch;
-  const double seconds_calibrate = SecondsSince(calib_start);
+  const double seconds_calibrate = calib_timer.Seconds();
   // Evidence (halves, uncertainty, binned residuals) and the verdict made
   // from it (calib/evidence.h, calib/verdict.h).
   const EvidenceOptions evidence_options;
   Evidence evidence;
   Verdict verdict;
   if (calibrated) {
-    evidence = ComputeEvidence(views, result, calibration_options,
-                               evidence_options);
+    evidence =
+        ComputeEvidence(views, result, calibration_options, evidence_options);
     verdict = MakeVerdict(result, evidence, evidence_options, VerdictOptions());
   }
 
@@ -449,7 +444,7 @@ int RunCalibrate() {
     input.seconds_load = seconds_load;
     input.seconds_detect = seconds_detect + seconds_grid_decode;
     input.seconds_calibrate = seconds_calibrate;
-    input.seconds_total = SecondsSince(run_start);
+    input.seconds_total = run_timer.Seconds();
     input.threads = threads;
     if (calibrated) {
       input.evidence = &evidence;
@@ -472,7 +467,7 @@ int RunCalibrate() {
     return kExitNoResult;
   }
 
-  const double seconds_total = SecondsSince(run_start);
+  const double seconds_total = run_timer.Seconds();
   if (verbosity != Verbosity::kQuiet) {
     std::cout << CalibrationReport(result) << "\n";
     std::cout << "views used: " << result.num_views_used << " of "

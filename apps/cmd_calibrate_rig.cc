@@ -4,7 +4,6 @@
 #include <glog/logging.h>
 
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -23,6 +22,7 @@
 #include "calib/camera_yaml.h"
 #include "calib/rig_calibration.h"
 #include "calib/rig_yaml.h"
+#include "util/timer.h"
 
 namespace puzzlecal {
 namespace {
@@ -42,11 +42,6 @@ constexpr char kUsage[] =
     "atomically (ros: one\ncamera_info file per camera, OUT_STEM_NAME.yaml); "
     "a run that cannot produce a trustworthy\nresult exits non-zero and "
     "writes nothing.";
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 std::vector<std::string> SplitCommas(const std::string& text) {
   std::vector<std::string> parts;
@@ -83,7 +78,7 @@ bool ListCameraFolders(const std::string& root, std::vector<fs::path>* folders,
 }
 
 int RunCalibrateRig() {
-  const auto run_start = std::chrono::steady_clock::now();
+  const Timer run_timer;
   const char* kName = "puzzlecal calibrate-rig";
   if (FLAGS_images.empty() || FLAGS_board.empty() || FLAGS_out.empty()) {
     std::cerr << kName << ": --images, --board and --out are required. Run "
@@ -173,7 +168,7 @@ int RunCalibrateRig() {
           ? FLAGS_threads
           : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   cv::setNumThreads(1);
-  const auto images_start = std::chrono::steady_clock::now();
+  const Timer images_timer;
   std::vector<RigCameraInput> inputs(folders.size());
   std::vector<std::vector<std::string>> frame_files(
       folders.size(), std::vector<std::string>(num_frames));
@@ -214,7 +209,7 @@ int RunCalibrateRig() {
       return kExitBadInput;
     }
   }
-  const double seconds_images = SecondsSince(images_start);
+  const double seconds_images = images_timer.Seconds();
 
   RigCalibrationOptions options;
   options.camera.num_threads = threads;
@@ -230,7 +225,7 @@ int RunCalibrateRig() {
     report.calibration_error = calibration_error;
     report.files = frame_files;
     report.seconds_images = seconds_images;
-    report.seconds_total = SecondsSince(run_start);
+    report.seconds_total = run_timer.Seconds();
     report.threads = threads;
     if (!WriteRigReport(FLAGS_report, report, RigReportOptions(), &error)) {
       std::cerr << kName << ": report not written: " << error << "\n";
@@ -248,9 +243,8 @@ int RunCalibrateRig() {
     return kExitOutputError;
   }
   std::cout << RigCalibrationReport(result);
-  std::cout << "time: " << SecondsSince(run_start) << " s wall clock on "
-            << threads << " threads (images " << seconds_images
-            << " s, calibration "
+  std::cout << "time: " << run_timer.Seconds() << " s wall clock on " << threads
+            << " threads (images " << seconds_images << " s, calibration "
             << result.seconds_single + result.seconds_joint << " s)\n";
   for (const std::string& path : written) std::cout << "wrote " << path << "\n";
   return kExitOk;

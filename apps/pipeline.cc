@@ -4,20 +4,17 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <sstream>
 #include <thread>
 
+#include "util/enum_names.h"
+#include "util/timer.h"
+
 namespace puzzlecal {
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 // Relative labels of different components are not comparable: a view built
 // from them keeps the component with the most points (a checkerboard view;
@@ -48,24 +45,18 @@ void KeepLargestComponent(DecodeResult* decode) {
 
 }  // namespace
 
+constexpr EnumName<ImageOutcome> kImageOutcomeNames[] = {
+    {ImageOutcome::kUsable, "usable"},
+    {ImageOutcome::kUnreadable, "unreadable"},
+    {ImageOutcome::kNoCorners, "no corners"},
+    {ImageOutcome::kNoGrid, "no consistent grid"},
+    {ImageOutcome::kNotDecoded, "code not recognised"},
+    {ImageOutcome::kTooFewCorners, "too few corners"},
+    {ImageOutcome::kSizeMismatch, "image size differs"},
+};
+
 const char* ImageOutcomeName(ImageOutcome outcome) {
-  switch (outcome) {
-    case ImageOutcome::kUsable:
-      return "usable";
-    case ImageOutcome::kUnreadable:
-      return "unreadable";
-    case ImageOutcome::kNoCorners:
-      return "no corners";
-    case ImageOutcome::kNoGrid:
-      return "no consistent grid";
-    case ImageOutcome::kNotDecoded:
-      return "code not recognised";
-    case ImageOutcome::kTooFewCorners:
-      return "too few corners";
-    case ImageOutcome::kSizeMismatch:
-      return "image size differs";
-  }
-  return "unknown";
+  return NameOf(kImageOutcomeNames, outcome, "unknown");
 }
 
 bool PipelineOptions::Check(std::string* why) const {
@@ -102,13 +93,13 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
   CHECK(options.Check(&why)) << "pipeline options: " << why;
   result->width = grey.cols;
   result->height = grey.rows;
-  auto start = std::chrono::steady_clock::now();
+  Timer timer;
   DetectorSummary detector_summary;
   result->corners =
       detector != nullptr
           ? detector->Detect(grey, &detector_summary)
           : DetectCorners(grey, options.detector, &detector_summary);
-  result->seconds_detect = SecondsSince(start);
+  result->seconds_detect = timer.Seconds();
   if (!detector_summary.ok) {
     result->outcome = ImageOutcome::kNoCorners;
     result->reason = detector_summary.message;
@@ -121,12 +112,12 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
                      std::to_string(options.min_corners);
     return;
   }
-  start = std::chrono::steady_clock::now();
+  timer.Restart();
   result->components = BuildGrid(result->corners, grey, options.grid);
   if (result->components.empty() ||
       static_cast<int>(result->components.front().corner.size()) <
           options.min_corners) {
-    result->seconds_grid_decode = SecondsSince(start);
+    result->seconds_grid_decode = timer.Seconds();
     result->outcome = ImageOutcome::kNoGrid;
     result->reason = "no lattice of " + std::to_string(options.min_corners) +
                      " or more consistent corners among " +
@@ -134,7 +125,7 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
     return;
   }
   if (!options.run_decode) {
-    result->seconds_grid_decode = SecondsSince(start);
+    result->seconds_grid_decode = timer.Seconds();
     result->outcome = ImageOutcome::kUsable;
     result->reason = std::to_string(result->components.size()) +
                      " lattice components, largest " +
@@ -144,7 +135,7 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
   }
   result->decode = DecodeBoard(board, result->corners, result->components, grey,
                                options.decode);
-  result->seconds_grid_decode = SecondsSince(start);
+  result->seconds_grid_decode = timer.Seconds();
   if (board.type == BoardType::kPuzzleBoard && !result->decode.decoded) {
     result->outcome = ImageOutcome::kNotDecoded;
     result->reason = result->decode.reason;
@@ -168,11 +159,11 @@ ImageResult ProcessImageFile(const std::string& file, const Board& board,
                              CornerDetector* detector) {
   ImageResult result;
   result.file = file;
-  const auto start = std::chrono::steady_clock::now();
+  const Timer timer;
   cv::Mat grey;
   std::string error;
   const bool loaded = LoadGreyImage(file, options.load, &grey, &error);
-  result.seconds_load = SecondsSince(start);
+  result.seconds_load = timer.Seconds();
   if (!loaded) {
     result.outcome = ImageOutcome::kUnreadable;
     result.reason = error;

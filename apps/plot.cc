@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
-
 #include <opencv2/imgproc.hpp>
+
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace plot {
@@ -27,8 +27,8 @@ cv::Point2d Frame::ToCanvas(double x, double y) const {
   const double u = (x - x_min) / (x_max - x_min);
   const double v = (y - y_min) / (y_max - y_min);
   const double cx = area.x + u * area.width;
-  const double cy = y_down ? area.y + v * area.height
-                           : area.y + (1.0 - v) * area.height;
+  const double cy =
+      y_down ? area.y + v * area.height : area.y + (1.0 - v) * area.height;
   return {cx, cy};
 }
 
@@ -69,19 +69,10 @@ std::vector<double> NiceTicks(double lo, double hi, int target) {
 std::string FormatTick(double value, double step) {
   int decimals = 0;
   if (step > 0 && std::isfinite(step)) {
-    decimals = std::max(0, static_cast<int>(std::ceil(-std::log10(step) -
-                                                      1e-9)));
+    decimals =
+        std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9)));
   }
-  return Format("%.*f", std::min(decimals, 10), value);
-}
-
-std::string Format(const char* format, ...) {
-  char buffer[1024];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buffer, sizeof(buffer), format, args);
-  va_end(args);
-  return buffer;
+  return StringPrintf("%.*f", std::min(decimals, 10), value);
 }
 
 cv::Size TextSize(const std::string& text, double scale, int thickness) {
@@ -169,8 +160,8 @@ void DrawAxes(cv::Mat* canvas, const Frame& frame, const std::string& x_label,
       cv::line(*canvas, {a.x, y}, {a.x + a.width, y}, kLightGrey, 1);
     }
     cv::line(*canvas, {a.x - tick, y}, {a.x, y}, kBlack, 1);
-    DrawText(canvas, FormatTick(t, y_step), {a.x - tick - 4, y + 5},
-             kTickScale, kBlack, Align::kRight);
+    DrawText(canvas, FormatTick(t, y_step), {a.x - tick - 4, y + 5}, kTickScale,
+             kBlack, Align::kRight);
   }
   cv::rectangle(*canvas, a, kBlack, 1);
   if (!x_label.empty()) {
@@ -181,9 +172,11 @@ void DrawAxes(cv::Mat* canvas, const Frame& frame, const std::string& x_label,
     // Left of the widest tick label.
     int widest = 0;
     for (double t : y_ticks) {
-      widest = std::max(widest, TextSize(FormatTick(t, y_step), kTickScale).width);
+      widest =
+          std::max(widest, TextSize(FormatTick(t, y_step), kTickScale).width);
     }
-    DrawVerticalText(canvas, y_label, {a.x - tick - 14 - widest, a.y + a.height / 2},
+    DrawVerticalText(canvas, y_label,
+                     {a.x - tick - 14 - widest, a.y + a.height / 2},
                      kLabelScale, kBlack);
   }
 }
@@ -203,8 +196,8 @@ void DrawColourBar(cv::Mat* canvas, const cv::Rect& bar, double v_min,
                    double v_max, int colormap, const std::string& label) {
   cv::Mat ramp(bar.height, 1, CV_8UC1);
   for (int y = 0; y < bar.height; ++y) {
-    ramp.at<uint8_t>(y, 0) = cv::saturate_cast<uint8_t>(
-        std::lround(255.0 * (bar.height - 1 - y) / std::max(1, bar.height - 1)));
+    ramp.at<uint8_t>(y, 0) = cv::saturate_cast<uint8_t>(std::lround(
+        255.0 * (bar.height - 1 - y) / std::max(1, bar.height - 1)));
   }
   cv::Mat ramp_colour;
   cv::applyColorMap(ramp, ramp_colour, colormap);

@@ -5,10 +5,9 @@
 // labels, titles, colour bars and legends, for the calibration report's PNGs.
 // Colours are BGR, canvases CV_8UC3.
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace puzzlecal {
 namespace plot {
@@ -54,10 +53,6 @@ std::vector<double> NiceTicks(double lo, double hi, int target);
 
 // A tick value printed with as many decimals as the step needs.
 std::string FormatTick(double value, double step);
-
-// printf-style formatting into a std::string.
-std::string Format(const char* format, ...)
-    __attribute__((format(printf, 1, 2)));
 
 // Width and height of `text` drawn at `scale`.
 cv::Size TextSize(const std::string& text, double scale, int thickness = 1);

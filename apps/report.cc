@@ -12,12 +12,12 @@
 
 #include "apps/plot.h"
 #include "util/atomic_file.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
 
 using plot::Align;
-using plot::Format;
 
 constexpr double kDeg = M_PI / 180.0;
 // Largest image side the report accepts (guards the plot sizes).
@@ -143,7 +143,7 @@ std::string Cell(const std::string& text) {
 }
 
 std::string Seconds(double s) {
-  return s >= 0 ? Format("%.2f", s) : std::string("not measured");
+  return s >= 0 ? StringPrintf("%.2f", s) : std::string("not measured");
 }
 
 // ---------------------------------------------------------------------------
@@ -253,12 +253,12 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
   plot::DrawAxes(&canvas, frame, "x (px)", "y (px)", false);
   plot::DrawTitle(
       &canvas,
-      Format("Reprojection residuals, arrows %gx longer than the error",
-             arrow_scale),
-      Format("%d corners used (blue), %d outliers (red) from %d views; "
-             "RMS %.3f px per coordinate",
-             data.num_inliers, data.num_outliers, data.result->num_views_used,
-             data.result->rms_px));
+      StringPrintf("Reprojection residuals, arrows %gx longer than the error",
+                   arrow_scale),
+      StringPrintf("%d corners used (blue), %d outliers (red) from %d views; "
+                   "RMS %.3f px per coordinate",
+                   data.num_inliers, data.num_outliers,
+                   data.result->num_views_used, data.result->rms_px));
   // Scale reference: an arrow for a round residual near the 95th percentile.
   const double reference = plot::NiceNumber(p95 > 0 ? p95 : 1.0, false);
   const double reference_length = reference * arrow_scale * layout.scale;
@@ -268,17 +268,18 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
                   Fixed(cv::Point2d(x0 + reference_length, y0)), plot::kBlue, 1,
                   cv::LINE_AA, kShift,
                   std::min(0.35, 5.0 / std::max(1.0, reference_length)));
-  plot::DrawText(&canvas,
-                 Format("= %g px residual (scale x%g)", reference, arrow_scale),
-                 {x0 + static_cast<int>(reference_length) + 10, y0 + 5},
-                 plot::kTickScale, plot::kBlack);
-  DrawNote(
-      &layout, 1,
-      "Each arrow starts at a detected corner and points to where the "
-      "calibrated model reprojects it." +
-          (num_capped > 0 ? Format(" %d outlier arrows are cut to %.0f px.",
+  plot::DrawText(
+      &canvas,
+      StringPrintf("= %g px residual (scale x%g)", reference, arrow_scale),
+      {x0 + static_cast<int>(reference_length) + 10, y0 + 5}, plot::kTickScale,
+      plot::kBlack);
+  DrawNote(&layout, 1,
+           "Each arrow starts at a detected corner and points to where the "
+           "calibrated model reprojects it." +
+               (num_capped > 0
+                    ? StringPrintf(" %d outlier arrows are cut to %.0f px.",
                                    num_capped, outlier_cap)
-                          : std::string()));
+                    : std::string()));
   DrawNote(&layout, 2,
            "Random directions = noise; arrows aligned over a region = model "
            "error there (try another model) or a bent board.");
@@ -331,11 +332,12 @@ cv::Mat PlotCoverage(const ReportData& data, const ReportOptions& options) {
                       cv::COLORMAP_VIRIDIS, "used corners per cell (white: 0)");
   plot::DrawTitle(
       &canvas,
-      Format("Coverage: used corners per %.0f x %.0f px cell", cell, cell),
-      Format("%d corners from %d views; %d of %d cells empty (white); "
-             "the calibration's coverage figure: %.0f %%",
-             data.num_inliers, data.result->num_views_used, empty, rows * cols,
-             100.0 * data.result->coverage));
+      StringPrintf("Coverage: used corners per %.0f x %.0f px cell", cell,
+                   cell),
+      StringPrintf("%d corners from %d views; %d of %d cells empty (white); "
+                   "the calibration's coverage figure: %.0f %%",
+                   data.num_inliers, data.result->num_views_used, empty,
+                   rows * cols, 100.0 * data.result->coverage));
   DrawNote(&layout, 0,
            "The model is only trustworthy where corners were seen. Fill white "
            "cells (image corners and edges matter most for distortion)");
@@ -482,7 +484,7 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
       }
     }
     if (label_u >= 0) {
-      const std::string text = Format("%.0f deg", level);
+      const std::string text = StringPrintf("%.0f deg", level);
       const cv::Size size = plot::TextSize(text, plot::kTickScale);
       const cv::Point anchor(
           a.x + std::clamp(label_u + 4, 2, a.width - size.width - 4),
@@ -499,36 +501,41 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
   if (fisheye) {
     plot::DrawTitle(
         &canvas, "Distortion: shift from the equidistant fisheye r = f * theta",
-        Format("Pixels between where each pixel's ray lands with the model "
-               "and with k1..k4 = 0 (same fx fy cx cy); max %.1f px",
-               max_magnitude) +
+        StringPrintf(
+            "Pixels between where each pixel's ray lands with the model "
+            "and with k1..k4 = 0 (same fx fy cx cy); max %.1f px",
+            max_magnitude) +
             std::string(have_observed ? " where seen" : ""));
   } else {
     plot::DrawTitle(
         &canvas, "Distortion: shift from the distortion-free pinhole",
-        Format("Pixels between where each pixel's ray lands with the model "
-               "and with no distortion (same fx fy cx cy); max %.1f px",
-               max_magnitude) +
+        StringPrintf(
+            "Pixels between where each pixel's ray lands with the model "
+            "and with no distortion (same fx fy cx cy); max %.1f px",
+            max_magnitude) +
             std::string(have_observed ? " where seen" : ""));
   }
   DrawNote(&layout, 0,
-           Format("White lines: angle of the pixel's ray from the optical axis "
-                  "(every %.0f deg).%s",
-                  level_step,
-                  fisheye ? " Hatched: rays more than 90 deg off the axis "
-                            "(behind the image plane)."
-                          : ""));
-  DrawNote(&layout, 1,
-           Format("Red cross: principal point (%.1f, %.1f). Computed every %d "
-                  "px and interpolated.",
-                  principal.x(), principal.y(), step));
+           StringPrintf(
+               "White lines: angle of the pixel's ray from the optical axis "
+               "(every %.0f deg).%s",
+               level_step,
+               fisheye ? " Hatched: rays more than 90 deg off the axis "
+                         "(behind the image plane)."
+                       : ""));
+  DrawNote(
+      &layout, 1,
+      StringPrintf("Red cross: principal point (%.1f, %.1f). Computed every %d "
+                   "px and interpolated.",
+                   principal.x(), principal.y(), step));
   int line = 2;
   if (have_observed && observed_theta < max_theta) {
     DrawNote(&layout, line++,
-             Format("Faded: rays beyond %.1f deg, the widest angle of any used "
-                    "corner; the model is extrapolated there (colours scaled "
-                    "to the rest).",
-                    observed_theta));
+             StringPrintf(
+                 "Faded: rays beyond %.1f deg, the widest angle of any used "
+                 "corner; the model is extrapolated there (colours scaled "
+                 "to the rest).",
+                 observed_theta));
   }
   if (num_without_ray > 0) {
     DrawNote(&layout, line++,
@@ -620,10 +627,11 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   cv::rectangle(canvas, frame.area, plot::kBlack, 1);
   plot::DrawTitle(
       &canvas, "Residual lengths",
-      Format("%zu used corners, %zu outliers; RMS %.3f px per coordinate; "
-             "median length %.3f px, 95 %% below %.3f px",
-             inlier_norms.size(), outlier_norms.size(), sigma,
-             Percentile(inlier_norms, 0.5), Percentile(inlier_norms, 0.95)));
+      StringPrintf(
+          "%zu used corners, %zu outliers; RMS %.3f px per coordinate; "
+          "median length %.3f px, 95 %% below %.3f px",
+          inlier_norms.size(), outlier_norms.size(), sigma,
+          Percentile(inlier_norms, 0.5), Percentile(inlier_norms, 0.95)));
   // The overflow bar, on the histogram's count scale.
   const cv::Rect overflow(frame.area.x + frame.area.width + 20, frame.area.y,
                           kOverflowWidth, frame.area.height);
@@ -644,10 +652,10 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
                            inlier_top - outlier_top),
                   plot::kRed, cv::FILLED);
   }
-  plot::DrawText(&canvas, Format("> %.3g", range),
+  plot::DrawText(&canvas, StringPrintf("> %.3g", range),
                  {overflow.x + overflow.width / 2, base_y + 21},
                  plot::kTickScale, plot::kBlack, Align::kCenter);
-  plot::DrawText(&canvas, Format("%d", inliers_beyond + outliers_beyond),
+  plot::DrawText(&canvas, StringPrintf("%d", inliers_beyond + outliers_beyond),
                  {overflow.x + overflow.width / 2, outlier_top - 6},
                  plot::kTickScale, plot::kBlack, Align::kCenter);
   const std::vector<plot::LegendEntry> legend = {
@@ -712,7 +720,7 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
     const bool crowds_worst =
         v != worst && worst >= 0 && std::abs(v - worst) * bar_pitch < 34;
     if ((v % label_every == 0 && !crowds_worst) || v == worst) {
-      plot::DrawText(&canvas, Format("%d", data.view_number[v]),
+      plot::DrawText(&canvas, StringPrintf("%d", data.view_number[v]),
                      {static_cast<int>(std::lround(base.x)),
                       frame.area.y + frame.area.height + 20},
                      plot::kTickScale, v == worst ? plot::kRed : plot::kBlack,
@@ -731,16 +739,17 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
                  plot::kLabelScale, plot::kBlack, Align::kCenter);
   plot::DrawTitle(
       &canvas, "Reprojection RMS per view",
-      Format("%d views: %d used, %d not used; %d above %.3gx the overall RMS",
-             num_views, num_views - num_unused, num_unused, num_high,
-             options.high_rms_factor));
+      StringPrintf(
+          "%d views: %d used, %d not used; %d above %.3gx the overall RMS",
+          num_views, num_views - num_unused, num_unused, num_high,
+          options.high_rms_factor));
   const std::vector<plot::LegendEntry> legend = {
       {plot::LegendEntry::Marker::kBox, plot::kBlue, "view RMS"},
       {plot::LegendEntry::Marker::kBox, plot::kOrange,
-       Format("view RMS above %gx overall (dotted): check the image",
-              options.high_rms_factor)},
+       StringPrintf("view RMS above %gx overall (dotted): check the image",
+                    options.high_rms_factor)},
       {plot::LegendEntry::Marker::kDashedLine, plot::kRed,
-       Format("overall RMS %.3f px", overall)},
+       StringPrintf("overall RMS %.3f px", overall)},
       {plot::LegendEntry::Marker::kCross, plot::kGrey,
        "view not used (reason in summary.md)"}};
   const cv::Size legend_size = plot::LegendSize(legend);
@@ -762,7 +771,7 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
     *warning = "overlay drawn without the image: " + load_error;
     grey = cv::Mat(data.height, data.width, CV_8UC1, cv::Scalar(128));
   } else if (grey.cols != data.width || grey.rows != data.height) {
-    *warning = Format(
+    *warning = StringPrintf(
         "%s is %d x %d, the calibration %d x %d; overlay "
         "drawn at the image's size",
         data.view_file[v].c_str(), grey.cols, grey.rows, data.width,
@@ -825,15 +834,16 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
     }
   }
   const std::string name = FileName(data.view_file[v]);
+  plot::DrawText(&canvas,
+                 StringPrintf("#%d %s  (%s)", data.view_number[v], name.c_str(),
+                              rank.c_str()),
+                 {12, 28}, plot::kTitleScale, plot::kBlack, Align::kLeft, 2);
   plot::DrawText(
       &canvas,
-      Format("#%d %s  (%s)", data.view_number[v], name.c_str(), rank.c_str()),
-      {12, 28}, plot::kTitleScale, plot::kBlack, Align::kLeft, 2);
-  plot::DrawText(
-      &canvas,
-      Format("view RMS %.3f px per coordinate (overall %.3f px); %d corners "
-             "used, %d outliers",
-             data.view_rms[v], result.rms_px, inliers, outliers),
+      StringPrintf(
+          "view RMS %.3f px per coordinate (overall %.3f px); %d corners "
+          "used, %d outliers",
+          data.view_rms[v], result.rms_px, inliers, outliers),
       {12, 56}, plot::kLabelScale, cv::Scalar(60, 60, 60));
   // Legend line; each entry placed after the previous one's text.
   const int y = canvas.rows - 15;
@@ -856,9 +866,9 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
   x += plot::TextSize(cross_text, plot::kTickScale).width + 30;
   cv::arrowedLine(canvas, {x - 6, y - 5}, {x + 22, y - 5}, arrow_colour, 2,
                   cv::LINE_AA, 0, 0.3);
-  plot::DrawText(&canvas,
-                 Format("residual x%g (as in residuals.png)", arrow_scale),
-                 {x + 30, y}, plot::kTickScale, plot::kBlack);
+  plot::DrawText(
+      &canvas, StringPrintf("residual x%g (as in residuals.png)", arrow_scale),
+      {x + 30, y}, plot::kTickScale, plot::kBlack);
   return canvas;
 }
 
@@ -944,9 +954,9 @@ cv::Mat PlotCrossValidation(const ReportData& data,
   return PlotPixelMap(
       data, options, cv.difference_px, largest_band,
       "Cross-validation: projection difference between two halves of the views",
-      Format("%d + %d views calibrated apart (alternating); far-field "
-             "difference after the best-fit rotation (%.3f deg)",
-             cv.views_a, cv.views_b, cv.rotation_deg),
+      StringPrintf("%d + %d views calibrated apart (alternating); far-field "
+                   "difference after the best-fit rotation (%.3f deg)",
+                   cv.views_a, cv.views_b, cv.rotation_deg),
       "|A - B| (px)",
       {"Each pixel's ray under half A, rotated into half B's frame and "
        "projected by B, against the pixel. Colours up to the largest "
@@ -974,9 +984,9 @@ cv::Mat PlotUncertainty(const ReportData& data, const ReportOptions& options,
       "sqrt(tr(C) / 2) per axis, C = A Sigma A^T, A = d pixel / d intrinsics "
       "(ray fixed) less the part a common rotation undoes",
       "1 sigma (px)",
-      {Format("Colours scaled to the observed field (up to %.1f deg); "
-              "beyond it the value grows and saturates.",
-              max_angle_deg),
+      {StringPrintf("Colours scaled to the observed field (up to %.1f deg); "
+                    "beyond it the value grows and saturates.",
+                    max_angle_deg),
        "Sigma: the intrinsics' covariance marginal over the board poses, "
        "scaled by the residual variance."});
 }
@@ -1023,7 +1033,7 @@ cv::Mat PlotResidualBins(const ReportData& data, const ReportOptions& options,
         cv::circle(canvas, frame.ToCanvasPixel(x, mean), 5, colour, cv::FILLED,
                    cv::LINE_AA);
       }
-      plot::DrawText(&canvas, Format("%d", b.count),
+      plot::DrawText(&canvas, StringPrintf("%d", b.count),
                      frame.ToCanvasPixel(b.lo + 0.5 * width, frame.y_max) +
                          cv::Point(0, 14),
                      plot::kTickScale, plot::kGrey, Align::kCenter);
@@ -1086,17 +1096,18 @@ std::vector<std::pair<int, std::string>> PickOverlayViews(
                   static_cast<int>(picked.size()) < num_worst;
        ++k) {
     if (k == 1 && most_outliers >= 0 && !taken.count(most_outliers)) {
-      take(most_outliers,
-           Format("most outliers: %d", data.view_outliers[most_outliers]));
+      take(most_outliers, StringPrintf("most outliers: %d",
+                                       data.view_outliers[most_outliers]));
       if (static_cast<int>(picked.size()) >= num_worst) break;
     }
-    take(used[k], k == 0 ? "worst view" : Format("%d. worst view", k + 1));
+    take(used[k],
+         k == 0 ? "worst view" : StringPrintf("%d. worst view", k + 1));
   }
   for (int k = 0;
        k < static_cast<int>(used.size()) && static_cast<int>(picked.size()) < n;
        ++k) {
     take(used[used.size() - 1 - k],
-         k == 0 ? "best view" : Format("%d. best view", k + 1));
+         k == 0 ? "best view" : StringPrintf("%d. best view", k + 1));
   }
   return picked;
 }
@@ -1205,11 +1216,11 @@ std::string FormatWithSigma(double value, double sigma,
   if (sigma > 0 && std::isfinite(sigma)) {
     const int decimals =
         std::clamp(2 - static_cast<int>(std::floor(std::log10(sigma))), 0, 12);
-    if (sigma_text) *sigma_text = Format("%.*f", decimals, sigma);
-    return Format("%.*f", decimals, value);
+    if (sigma_text) *sigma_text = StringPrintf("%.*f", decimals, sigma);
+    return StringPrintf("%.*f", decimals, value);
   }
   if (sigma_text) *sigma_text = "";
-  return Format("%.8g", value);
+  return StringPrintf("%.8g", value);
 }
 
 namespace {
@@ -1234,7 +1245,7 @@ std::string EvidenceMarkdown(const ReportInput& input) {
   const CrossValidation& cv = evidence.cross_validation;
   md << "### Cross-validation (two halves of the views)\n\n";
   if (cv.ok) {
-    md << Format(
+    md << StringPrintf(
         "Views alternately into halves of %d and %d, each calibrated alone "
         "(RMS %.3f and %.3f px). Far-field projection difference after the "
         "best-fit rotation between the halves' camera frames (%.3f deg), "
@@ -1247,9 +1258,9 @@ std::string EvidenceMarkdown(const ReportInput& input) {
       const AngleBand& d = cv.difference_bands[b];
       const AngleBand& e = cv.expected_bands[b];
       if (d.count == 0) continue;
-      md << Format("| %.0f-%.0f deg | %d | %.3f | %.3f | %.3f | %.3f |\n",
-                   d.lo_deg, d.hi_deg, d.count, d.median, d.p95, e.median,
-                   e.p95);
+      md << StringPrintf("| %.0f-%.0f deg | %d | %.3f | %.3f | %.3f | %.3f |\n",
+                         d.lo_deg, d.hi_deg, d.count, d.median, d.p95, e.median,
+                         e.p95);
     }
     md << "\n";
   } else {
@@ -1270,9 +1281,9 @@ std::string EvidenceMarkdown(const ReportInput& input) {
           "|\n|---|---:|---:|\n";
     for (const UncertaintyPoint& p : u.points) {
       md << "| " << p.label << " | "
-         << (p.in_image
-                 ? Format("%.4f | %.4f", p.sigma_px, p.camera_frame_sigma_px)
-                 : std::string("not in image | not in image"))
+         << (p.in_image ? StringPrintf("%.4f | %.4f", p.sigma_px,
+                                       p.camera_frame_sigma_px)
+                        : std::string("not in image | not in image"))
          << " |\n";
     }
     md << "\n";
@@ -1289,17 +1300,17 @@ std::string EvidenceMarkdown(const ReportInput& input) {
     md << "| " << what << " | corners | radial (px) | tangential (px) |\n"
        << "|---|---:|---:|---:|\n";
     for (const ResidualBin& b : bins) {
-      md << (metres ? Format("| %.3f-%.3f m", b.lo, b.hi)
-                    : Format("| %.0f-%.0f deg", b.lo, b.hi))
-         << Format(" | %d | %+.4f ± %.4f | %+.4f ± %.4f |\n", b.count,
-                   b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
-                   b.se_tangential_px);
+      md << (metres ? StringPrintf("| %.3f-%.3f m", b.lo, b.hi)
+                    : StringPrintf("| %.0f-%.0f deg", b.lo, b.hi))
+         << StringPrintf(" | %d | %+.4f ± %.4f | %+.4f ± %.4f |\n", b.count,
+                         b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
+                         b.se_tangential_px);
     }
     md << "\n";
   };
   table(evidence.residuals.by_angle, "field angle", false);
   table(evidence.residuals.by_distance, "distance from the camera", true);
-  md << Format(
+  md << StringPrintf(
       "Evidence computed in %.2f s (of which the two half "
       "calibrations %.2f s).\n\n",
       evidence.seconds, cv.seconds);
@@ -1326,7 +1337,7 @@ std::string ReportMarkdown(const ReportInput& input,
      << camera.width << " x " << camera.height
      << " px; board: " << BoardTypeName(input.board.type) << ", "
      << input.board.cols << " x " << input.board.rows << " inner corners, "
-     << Format("%g", input.board.tile_size_m * 1000) << " mm tiles.\n\n";
+     << StringPrintf("%g", input.board.tile_size_m * 1000) << " mm tiles.\n\n";
   if (!input.calibration_ok) {
     md << "> **Calibration failed:** " << input.calibration_error
        << "\n>\n> The figures below show what the failed attempt reached; do "
@@ -1334,28 +1345,28 @@ std::string ReportMarkdown(const ReportInput& input,
   }
 
   md << "## Result\n\n| | |\n|---|---|\n";
-  md << Format(
+  md << StringPrintf(
       "| RMS reprojection error | %.4f px per coordinate (%.4f px "
       "per corner, OpenCV's figure) |\n",
       result.rms_px, result.rms_point_px);
-  md << Format(
+  md << StringPrintf(
       "| images | %zu, %d used as views (%d views passed to the "
       "calibration) |\n",
       input.images.size(), result.num_views_used,
       static_cast<int>(input.views->size()));
-  md << Format(
+  md << StringPrintf(
       "| corners used | %d (%d outliers dropped in %d rejection "
       "round%s) |\n",
       result.num_corners_used, result.num_outliers, result.outlier_rounds,
       result.outlier_rounds == 1 ? "" : "s");
-  md << Format("| board orientations | normals spread over %.1f deg |\n",
-               result.orientation_spread_deg);
-  md << Format(
+  md << StringPrintf("| board orientations | normals spread over %.1f deg |\n",
+                     result.orientation_spread_deg);
+  md << StringPrintf(
       "| coverage | %.0f %% of the cells of an 8 x 8 grid over the "
       "image hold corners |\n",
       100 * result.coverage);
   md << "| initialisation | " << Cell(result.initialization_method) << " |\n";
-  md << Format("| solver | %d iterations, ", result.iterations)
+  md << StringPrintf("| solver | %d iterations, ", result.iterations)
      << Cell(result.termination) << " |\n\n";
 
   md << "## Parameters (value ± 1 sigma)\n\n";
@@ -1396,8 +1407,9 @@ std::string ReportMarkdown(const ReportInput& input,
   });
   md << "## Worst views\n\n";
   if (!used.empty()) {
-    md << Format("Highest RMS of the %zu used views (overall %.3f px).\n\n",
-                 used.size(), result.rms_px);
+    md << StringPrintf(
+        "Highest RMS of the %zu used views (overall %.3f px).\n\n", used.size(),
+        result.rms_px);
   }
   if (used.empty()) {
     md << "No view was used.\n\n";
@@ -1412,11 +1424,11 @@ std::string ReportMarkdown(const ReportInput& input,
           data.view_rms[v] > options.high_rms_factor * result.rms_px;
       md << "| " << data.view_number[v] << " | "
          << Cell(FileName(data.view_file[v])) << " | "
-         << Format("%.3f", data.view_rms[v]) << " | " << data.view_inliers[v]
-         << " | " << data.view_outliers[v] << " | "
-         << (high ? Format("above %gx the overall RMS: check the image "
-                           "(blur, a bent or moving board, wrong ids)",
-                           options.high_rms_factor)
+         << StringPrintf("%.3f", data.view_rms[v]) << " | "
+         << data.view_inliers[v] << " | " << data.view_outliers[v] << " | "
+         << (high ? StringPrintf("above %gx the overall RMS: check the image "
+                                 "(blur, a bent or moving board, wrong ids)",
+                                 options.high_rms_factor)
                   : std::string(""))
          << " |\n";
     }
@@ -1443,7 +1455,8 @@ std::string ReportMarkdown(const ReportInput& input,
     md << "| " << i + 1 << " | " << Cell(image.file) << " | " << Cell(outcome)
        << " | " << image.corners_detected << " | "
        << (used_view ? data.view_inliers[v] : image.corners_used) << " | "
-       << (used_view ? Format("%.3f", data.view_rms[v]) : std::string("-"))
+       << (used_view ? StringPrintf("%.3f", data.view_rms[v])
+                     : std::string("-"))
        << " | " << Cell(reason) << " |\n";
   }
   md << "\n";
@@ -1549,7 +1562,7 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
   }
   const CalibrationResult& result = *input.result;
   if (result.view_used.size() != input.views->size()) {
-    *error = Format(
+    *error = StringPrintf(
         "report for %s: the result has %zu views, the view list "
         "%zu",
         dir.c_str(), result.view_used.size(), input.views->size());
@@ -1582,8 +1595,8 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
   };
   if (!size_ok) {
     summary->warnings.push_back(
-        Format("no plots: the result's image size %d x %d is not valid", width,
-               height));
+        StringPrintf("no plots: the result's image size %d x %d is not valid",
+                     width, height));
   } else {
     if (!write_png("residuals.png", PlotResiduals(data, options)) ||
         !write_png("residual_histogram.png", PlotHistogram(data, options)) ||
@@ -1622,7 +1635,8 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
     for (const auto& [v, rank] : PickOverlayViews(data, options.num_overlays)) {
       std::string name = "overlay_" + SafeStem(data.view_file[v]);
       for (int k = 2; taken.count(name); ++k) {
-        name = "overlay_" + SafeStem(data.view_file[v]) + Format("_%d", k);
+        name =
+            "overlay_" + SafeStem(data.view_file[v]) + StringPrintf("_%d", k);
       }
       taken.insert(name);
       std::string warning;

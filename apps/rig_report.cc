@@ -10,16 +10,12 @@
 
 #include "apps/image_io.h"
 #include "util/atomic_file.h"
+#include "util/failure.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
-
-bool Fail(const std::string& message, std::string* error) {
-  if (error != nullptr) *error = message;
-  return false;
-}
 
 }  // namespace
 

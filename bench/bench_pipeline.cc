@@ -47,6 +47,7 @@
 #include "detection/detector.h"
 #include "grid/grid.h"
 #include "tests/support/deltille_data.h"
+#include "util/statistics.h"
 
 namespace puzzlecal {
 namespace {
@@ -61,13 +62,6 @@ double WallMs() {
   return std::chrono::duration<double, std::milli>(
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 == 1 ? v[v.size() / 2]
-                           : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 std::vector<unsigned char> ReadBytes(const std::string& path) {

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -14,23 +13,16 @@
 #include "calib/marginal_covariance.h"
 #include "calib/parallel_reprojection.h"
 #include "calib/reprojection_error.h"
+#include "util/enum_names.h"
+#include "util/failure.h"
+#include "util/statistics.h"
+#include "util/string_format.h"
+#include "util/timer.h"
 
 namespace puzzlecal {
 namespace {
 
 using Pose = std::array<double, kPoseBlockSize>;
-
-bool Fail(const std::string& message, std::string* error) {
-  if (error != nullptr) *error = message;
-  return false;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
-}
 
 Pose PoseFromIsometry(const Eigen::Isometry3d& cam_from_board) {
   Pose pose;
@@ -49,18 +41,6 @@ Eigen::Isometry3d IsometryFromPose(const Pose& pose) {
   result.linear() = rotation;
   result.translation() = Eigen::Vector3d(pose[3], pose[4], pose[5]);
   return result;
-}
-
-std::string Format(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
-}
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                       start)
-      .count();
 }
 
 // Everything one Calibrate() call works on: its inputs, the current
@@ -87,8 +67,7 @@ struct CalibrationState {
   CalibrationResult* const result;
   std::string* const error;
   const std::vector<std::string> names;  // parameter names of the model
-  const std::chrono::steady_clock::time_point start =
-      std::chrono::steady_clock::now();
+  const Timer timer;
 
   // The estimate: intrinsics (model order), one pose per view, which
   // intrinsics are held.
@@ -142,8 +121,8 @@ bool FailParallelViews(const CalibrationState& s, double spread_deg) {
   return Fail(
       "all views show the board at nearly the same orientation "
       "(largest angle between board normals " +
-          Format("%.1f", spread_deg) + " degrees, need " +
-          Format("%.1f", s.options.min_orientation_spread_deg) +
+          StringPrintf("%.1f", spread_deg) + " degrees, need " +
+          StringPrintf("%.1f", s.options.min_orientation_spread_deg) +
           "), so the focal length is undetermined: add views with "
           "the board tilted by 30 degrees or more",
       s.error);
@@ -242,9 +221,9 @@ bool CheckViews(CalibrationState* s) {
   s->result->coverage = Coverage(*s);
   if (s->result->coverage < s->options.min_coverage) {
     return Fail("the corners cover only " +
-                    Format("%.0f", 100 * s->result->coverage) +
+                    StringPrintf("%.0f", 100 * s->result->coverage) +
                     " % of the image (need " +
-                    Format("%.0f", 100 * s->options.min_coverage) +
+                    StringPrintf("%.0f", 100 * s->options.min_coverage) +
                     " %): the views are all at one spot; move the board "
                     "towards the corners and borders of the image",
                 s->error);
@@ -272,14 +251,14 @@ bool Initialise(CalibrationState* s) {
   }
   InitializationResult init;
   std::string why;
-  if (!InitializeCalibration(clean, s->view_used, s->model, s->width,
-                             s->height, s->options.initial_params,
+  if (!InitializeCalibration(clean, s->view_used, s->model, s->width, s->height,
+                             s->options.initial_params,
                              s->options.initialization, &init, &why)) {
     return Fail("initialisation failed: " + why, s->error);
   }
   s->result->initialization_method = init.method;
   s->result->orientation_spread_deg = init.orientation_spread_deg;
-  s->result->initialization_seconds = SecondsSince(s->start);
+  s->result->initialization_seconds = s->timer.Seconds();
   s->params = init.camera.params;
   s->poses.assign(num_views, Pose{});
   for (size_t v = 0; v < num_views; ++v) {
@@ -335,11 +314,10 @@ bool SelectInitialInliers(CalibrationState* s) {
       projecting += s->inlier[v][i] ? 1 : 0;
     }
     if (projecting < s->options.min_corners_per_view) {
-      SetViewOutcome(
-          s, v, ViewOutcome::kTooFewProjecting,
-          "only " + std::to_string(projecting) +
-              " corners project through the initial camera (need " +
-              std::to_string(s->options.min_corners_per_view) + ")");
+      SetViewOutcome(s, v, ViewOutcome::kTooFewProjecting,
+                     "only " + std::to_string(projecting) +
+                         " corners project through the initial camera (need " +
+                         std::to_string(s->options.min_corners_per_view) + ")");
       std::fill(s->inlier[v].begin(), s->inlier[v].end(), false);
     }
   }
@@ -698,9 +676,8 @@ void ComputeCovariance(CalibrationState* s) {
     for (size_t v = 0; v < s->poses.size(); ++v) {
       if (s->view_used[v]) poses.push_back(s->poses[v].data());
     }
-    ok = MarginalCovariance(s->problem.get(), s->params.data(), poses,
-                            s->fixed, s->options.covariance_min_eigenvalue_ratio,
-                            &block);
+    ok = MarginalCovariance(s->problem.get(), s->params.data(), poses, s->fixed,
+                            s->options.covariance_min_eigenvalue_ratio, &block);
   } else {
     ok = CeresCovariance<Model>(s, &block);
   }
@@ -728,7 +705,7 @@ bool Judge(const CalibrationState& s) {
                     std::to_string(options.max_iterations) +
                     " iterations: raise the iteration limit or check the "
                     "correspondences (RMS " +
-                    Format("%.3f", r.rms_px) + " px)",
+                    StringPrintf("%.3f", r.rms_px) + " px)",
                 s.error);
   }
   if (r.num_views_used < options.min_views) {
@@ -743,17 +720,17 @@ bool Judge(const CalibrationState& s) {
     if (r.covariance_ok && !s.fixed[k] &&
         !(r.param_stddev[k] <=
           options.max_focal_relative_stddev * std::abs(s.params[k]))) {
-      return Fail("the views do not determine the focal length (" +
-                      s.names[k] + " = " + Format("%.1f", s.params[k]) +
-                      " +- " + Format("%.3g", r.param_stddev[k]) +
+      return Fail("the views do not determine the focal length (" + s.names[k] +
+                      " = " + StringPrintf("%.1f", s.params[k]) + " +- " +
+                      StringPrintf("%.3g", r.param_stddev[k]) +
                       " px): add views with the board tilted by 30 degrees "
                       "or more, near the image borders too",
                   s.error);
     }
   }
   if (!(r.rms_px <= options.max_rms_px)) {
-    return Fail("the reprojection RMS is " + Format("%.2f", r.rms_px) +
-                    " px (limit " + Format("%.2f", options.max_rms_px) +
+    return Fail("the reprojection RMS is " + StringPrintf("%.2f", r.rms_px) +
+                    " px (limit " + StringPrintf("%.2f", options.max_rms_px) +
                     " px): the correspondences do not fit the " +
                     CameraModelName(s.model) +
                     " model; check the board definition and the model",
@@ -772,7 +749,7 @@ bool CalibrateModel(CalibrationState* s) {
   RejectOutliers<Model>(s);
   FillResult(s);
   ComputeCovariance<Model>(s);
-  s->result->solve_seconds = SecondsSince(s->start);
+  s->result->solve_seconds = s->timer.Seconds();
   return Judge(*s);
 }
 
@@ -843,7 +820,7 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
   options->initial_params = result.camera.params;
   options->initial_params.resize(CameraModelNumParams(model), 0.0);
   *method = std::string("the central ") + CameraModelName(far.model) +
-            " calibration (RMS " + Format("%.3f", result.rms_px) +
+            " calibration (RMS " + StringPrintf("%.3f", result.rms_px) +
             " px), pupil shift 0";
   return true;
 }
@@ -851,9 +828,8 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
 // Per-view fields sized to the input, so that a failure at any step still
 // returns a result a report can describe (every view unused, with its
 // outcome).
-void ResetResult(const std::vector<CalibrationView>& views,
-                 CameraModelId model, int width, int height,
-                 CalibrationResult* result) {
+void ResetResult(const std::vector<CalibrationView>& views, CameraModelId model,
+                 int width, int height, CalibrationResult* result) {
   *result = CalibrationResult();
   result->camera.model = model;
   result->camera.width = width;
@@ -874,49 +850,34 @@ void ResetResult(const std::vector<CalibrationView>& views,
 
 }  // namespace
 
+constexpr EnumName<RobustLoss> kRobustLossNames[] = {
+    {RobustLoss::kNone, "none"},
+    {RobustLoss::kHuber, "huber"},
+    {RobustLoss::kCauchy, "cauchy"},
+};
+
 const char* RobustLossName(RobustLoss loss) {
-  switch (loss) {
-    case RobustLoss::kNone:
-      return "none";
-    case RobustLoss::kHuber:
-      return "huber";
-    case RobustLoss::kCauchy:
-      return "cauchy";
-  }
-  return "none";
+  return NameOf(kRobustLossNames, loss, "none");
 }
 
 bool RobustLossFromName(const std::string& name, RobustLoss* loss) {
-  for (RobustLoss candidate :
-       {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy}) {
-    if (name == RobustLossName(candidate)) {
-      *loss = candidate;
-      return true;
-    }
-  }
-  return false;
+  return ValueOf(kRobustLossNames, name, loss);
 }
 
+constexpr EnumName<ViewOutcome> kViewOutcomeNames[] = {
+    {ViewOutcome::kUsed, "used"},
+    {ViewOutcome::kNotReached, "not reached"},
+    {ViewOutcome::kMismatchedPoints, "mismatched points"},
+    {ViewOutcome::kNotPlanar, "board points not planar"},
+    {ViewOutcome::kTooFewCorners, "too few corners"},
+    {ViewOutcome::kNoInitialPose, "no initial pose"},
+    {ViewOutcome::kTooFewProjecting, "too few corners project"},
+    {ViewOutcome::kTooFewAfterRejection,
+     "too few corners after outlier rejection"},
+};
+
 const char* ViewOutcomeName(ViewOutcome outcome) {
-  switch (outcome) {
-    case ViewOutcome::kUsed:
-      return "used";
-    case ViewOutcome::kNotReached:
-      return "not reached";
-    case ViewOutcome::kMismatchedPoints:
-      return "mismatched points";
-    case ViewOutcome::kNotPlanar:
-      return "board points not planar";
-    case ViewOutcome::kTooFewCorners:
-      return "too few corners";
-    case ViewOutcome::kNoInitialPose:
-      return "no initial pose";
-    case ViewOutcome::kTooFewProjecting:
-      return "too few corners project";
-    case ViewOutcome::kTooFewAfterRejection:
-      return "too few corners after outlier rejection";
-  }
-  return "not reached";
+  return NameOf(kViewOutcomeNames, outcome, "not reached");
 }
 
 bool CalibrationOptions::Check(std::string* why) const {

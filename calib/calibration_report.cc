@@ -1,21 +1,15 @@
 // The readable summary of a CalibrationResult (calib/calibrate.h), made
 // from its facts on demand.
 
-#include <cstdio>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "calib/calibrate.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
-
-std::string Format(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
-}
 
 // One line per parameter: value, and "(fixed)" or its standard deviation.
 void ReportParameters(const CalibrationResult& result, std::ostream* out) {
@@ -24,11 +18,11 @@ void ReportParameters(const CalibrationResult& result, std::ostream* out) {
   const std::vector<double>& params = result.camera.params;
   if (params.size() != names.size()) return;  // stopped before a solve
   for (size_t k = 0; k < names.size(); ++k) {
-    *out << "  " << names[k] << " = " << Format("%.10g", params[k]);
+    *out << "  " << names[k] << " = " << StringPrintf("%.10g", params[k]);
     if (k < result.param_fixed.size() && result.param_fixed[k]) {
       *out << " (fixed)";
     } else if (result.covariance_ok && k < result.param_stddev.size()) {
-      *out << " +- " << Format("%.3g", result.param_stddev[k]);
+      *out << " +- " << StringPrintf("%.3g", result.param_stddev[k]);
     }
     *out << "\n";
   }
@@ -45,7 +39,7 @@ void ReportRejectedPerView(const CalibrationResult& result, std::ostream* out) {
     const std::string name =
         v < result.view_name.size() ? result.view_name[v] : "";
     *out << "  view " << v << " (" << name << "): "
-         << Format("%.1f", 100 * result.view_rejected_fraction[v])
+         << StringPrintf("%.1f", 100 * result.view_rejected_fraction[v])
          << " % of its corners rejected\n";
   }
 }
@@ -59,22 +53,24 @@ std::string CalibrationReport(const CalibrationResult& result) {
          << camera.width << "x" << camera.height << "\n";
   report << "initialisation: " << result.initialization_method << "\n";
   ReportParameters(result, &report);
-  report << "rms: " << Format("%.4f", result.rms_px) << " px per coordinate ("
-         << Format("%.4f", result.rms_point_px) << " px per corner)\n";
+  report << "rms: " << StringPrintf("%.4f", result.rms_px)
+         << " px per coordinate (" << StringPrintf("%.4f", result.rms_point_px)
+         << " px per corner)\n";
   report << "views used: " << result.num_views_used << " of "
          << result.view_used.size()
          << ", corners used: " << result.num_corners_used
          << ", outliers rejected: " << result.num_outliers << " ("
-         << Format("%.2f", 100 * result.rejected_fraction) << " %, "
+         << StringPrintf("%.2f", 100 * result.rejected_fraction) << " %, "
          << result.outlier_rounds << " rejection rounds, threshold "
-         << Format("%.3f", result.outlier_threshold_px) << " px, noise sigma "
-         << Format("%.3f", result.noise_sigma_px) << " px)\n";
+         << StringPrintf("%.3f", result.outlier_threshold_px)
+         << " px, noise sigma " << StringPrintf("%.3f", result.noise_sigma_px)
+         << " px)\n";
   ReportRejectedPerView(result, &report);
-  report << "coverage: " << Format("%.0f", 100 * result.coverage)
+  report << "coverage: " << StringPrintf("%.0f", 100 * result.coverage)
          << " % of the image, board orientation spread "
-         << Format("%.1f", result.orientation_spread_deg) << " degrees\n";
+         << StringPrintf("%.1f", result.orientation_spread_deg) << " degrees\n";
   report << "solver: " << result.iterations << " iterations, "
-         << Format("%.3f", result.solve_seconds) << " s, "
+         << StringPrintf("%.3f", result.solve_seconds) << " s, "
          << result.termination << "\n";
   for (size_t v = 0; v < result.view_reason.size(); ++v) {
     if (result.view_reason[v].empty()) continue;

@@ -10,16 +10,13 @@
 #include <sstream>
 
 #include "util/atomic_file.h"
+#include "util/enum_names.h"
+#include "util/failure.h"
 
 namespace puzzlecal {
 namespace {
 
 constexpr const char* kPuzzlecalFormatTag = "puzzlecal-camera";
-
-bool Fail(const std::string& message, std::string* error) {
-  if (error != nullptr) *error = message;
-  return false;
-}
 
 
 YAML::Emitter& Flow(YAML::Emitter& out, const std::vector<double>& values) {
@@ -456,9 +453,9 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
       !r.Matrix(node, "camera_matrix", 3, 3, &k)) {
     return false;
   }
-  const char* distortion_key =
-      !ros && root[kOpenCvFisheyeKey] ? kOpenCvFisheyeKey
-                                      : "distortion_coefficients";
+  const char* distortion_key = !ros && root[kOpenCvFisheyeKey]
+                                   ? kOpenCvFisheyeKey
+                                   : "distortion_coefficients";
   if (!r.Get(root, distortion_key, distortion_key, &node) ||
       !r.Matrix(node, distortion_key, 0, 0, &d)) {
     return false;
@@ -600,31 +597,20 @@ const char* RosDistortionModel(CameraModelId id) {
   return "plumb_bob";
 }
 
+constexpr EnumName<CameraFileFormat> kCameraFileFormatNames[] = {
+    {CameraFileFormat::kPuzzlecal, "puzzlecal"},
+    {CameraFileFormat::kOpenCv, "opencv"},
+    {CameraFileFormat::kRos, "ros"},
+    {CameraFileFormat::kKalibr, "kalibr"},
+};
+
 const char* CameraFileFormatName(CameraFileFormat format) {
-  switch (format) {
-    case CameraFileFormat::kPuzzlecal:
-      return "puzzlecal";
-    case CameraFileFormat::kOpenCv:
-      return "opencv";
-    case CameraFileFormat::kRos:
-      return "ros";
-    case CameraFileFormat::kKalibr:
-      return "kalibr";
-  }
-  return "puzzlecal";
+  return NameOf(kCameraFileFormatNames, format, "puzzlecal");
 }
 
 bool CameraFileFormatFromName(const std::string& name,
                               CameraFileFormat* format) {
-  for (CameraFileFormat candidate :
-       {CameraFileFormat::kPuzzlecal, CameraFileFormat::kOpenCv,
-        CameraFileFormat::kRos, CameraFileFormat::kKalibr}) {
-    if (name == CameraFileFormatName(candidate)) {
-      *format = candidate;
-      return true;
-    }
-  }
-  return false;
+  return ValueOf(kCameraFileFormatNames, name, format);
 }
 
 bool CameraFormatFixedParams(CameraFileFormat format, CameraModelId model,
@@ -743,8 +729,8 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
     // The far-field part in the format, and a comment that says what is
     // missing (after OpenCV's "%YAML:1.0" line, which must come first).
     std::string body;
-    if (!FormatCameraFile(FarFieldCamera(camera), stats, format, &body,
-                          error, names)) {
+    if (!FormatCameraFile(FarFieldCamera(camera), stats, format, &body, error,
+                          names)) {
       return false;
     }
     const std::string comment = "# " + omission.note + "\n";

@@ -1,19 +1,16 @@
 #include "calib/model_selection.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <sstream>
 
+#include "util/failure.h"
+#include "util/string_format.h"
+#include "util/timer.h"
+
 namespace puzzlecal {
 namespace {
-
-bool Fail(const std::string& message, std::string* why) {
-  if (why != nullptr) *why = message;
-  return false;
-}
 
 // The widest angle from the optical axis of a used corner under the fitted
 // poses, degrees.
@@ -139,7 +136,7 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
   });
   double widest_deg = 0;
   for (CameraModelId model : models) {
-    const auto start = std::chrono::steady_clock::now();
+    const Timer timer;
     ModelCandidate candidate;
     candidate.model = model;
     candidate.num_params = CameraModelNumParams(model);
@@ -150,12 +147,10 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
     std::string fit_error;
     if (CameraModelIsPinhole(model) &&
         widest_deg > options.pinhole_max_field_deg) {
-      char text[160];
-      std::snprintf(text, sizeof(text),
-                    "skipped: the corners reach %.1f deg off the axis "
-                    "(limit %.1f deg for a pinhole model)",
-                    widest_deg, options.pinhole_max_field_deg);
-      candidate.error = text;
+      candidate.error = StringPrintf(
+          "skipped: the corners reach %.1f deg off the axis "
+          "(limit %.1f deg for a pinhole model)",
+          widest_deg, options.pinhole_max_field_deg);
     } else if (!Calibrate(fit, model, width, height, fit_options, &result,
                           &fit_error)) {
       candidate.error = "calibration failed: " + fit_error;
@@ -173,9 +168,7 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
         candidate.error = "held-out fit failed: " + holdout_error;
       }
     }
-    candidate.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-            .count();
+    candidate.seconds = timer.Seconds();
     selection->candidates.push_back(candidate);
   }
   // Lowest held-out error; a model with more parameters must beat the best
@@ -217,19 +210,16 @@ std::string ModelSelection::Table() const {
            "corners  time\n";
   for (size_t k = 0; k < candidates.size(); ++k) {
     const ModelCandidate& c = candidates[k];
-    char line[256];
     if (c.ok) {
-      std::snprintf(line, sizeof(line),
-                    "%s %-27s %6d  %7.4f   %12.4f  %7d  %.1f s\n",
-                    static_cast<int>(k) == chosen ? "*" : " ",
-                    CameraModelName(c.model), c.num_params, c.fit_rms_px,
-                    c.holdout_rms_px, c.holdout_corners, c.seconds);
-      table << line;
+      table << StringPrintf("%s %-27s %6d  %7.4f   %12.4f  %7d  %.1f s\n",
+                            static_cast<int>(k) == chosen ? "*" : " ",
+                            CameraModelName(c.model), c.num_params,
+                            c.fit_rms_px, c.holdout_rms_px, c.holdout_corners,
+                            c.seconds);
     } else {
-      std::snprintf(line, sizeof(line),
-                    "  %-27s %6d  failed (%.1f s): ", CameraModelName(c.model),
-                    c.num_params, c.seconds);
-      table << line << c.error << "\n";
+      table << StringPrintf("  %-27s %6d  failed (%.1f s): ",
+                            CameraModelName(c.model), c.num_params, c.seconds)
+            << c.error << "\n";
     }
   }
   if (chosen >= 0) {

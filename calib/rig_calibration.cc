@@ -7,44 +7,23 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
 #include <sstream>
 #include <thread>
 
 #include "calib/reprojection_error.h"
+#include "util/failure.h"
+#include "util/statistics.h"
+#include "util/string_format.h"
+#include "util/timer.h"
 
 namespace puzzlecal {
 namespace {
 
 using Pose = std::array<double, kPoseBlockSize>;
 constexpr double kDegree = M_PI / 180.0;
-
-bool Fail(const std::string& message, std::string* error) {
-  if (error != nullptr) *error = message;
-  return false;
-}
-
-std::string Format(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
-}
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
-}
 
 Pose PoseFromIsometry(const Eigen::Isometry3d& transform) {
   Pose pose;
@@ -512,7 +491,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
 
   // 1. Each camera alone, in parallel over cameras (each solve is
   // sequential, so the result does not depend on the thread count).
-  const auto single_start = std::chrono::steady_clock::now();
+  const Timer single_timer;
   std::vector<CalibrationResult> single(num_cameras);
   std::vector<std::string> single_error(num_cameras);
   std::vector<char> single_ok(num_cameras, 0);
@@ -536,7 +515,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
     }
     for (std::thread& worker : workers) worker.join();
   }
-  result->seconds_single = SecondsSince(single_start);
+  result->seconds_single = single_timer.Seconds();
   for (size_t c = 0; c < num_cameras; ++c) {
     result->cameras[c].single_rms_px = single[c].rms_px;
     result->cameras[c].single_views_used = single[c].num_views_used;
@@ -546,7 +525,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
                   error);
     }
   }
-  const auto joint_start = std::chrono::steady_clock::now();
+  const Timer joint_timer;
 
   // 2. Starting cam_from_rig: frames two cameras share, chained along the
   // maximum spanning tree of shared frames from the reference camera.
@@ -861,7 +840,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
       }
     }
   }
-  result->seconds_joint = SecondsSince(joint_start);
+  result->seconds_joint = joint_timer.Seconds();
 
   if (!outcome.summary.IsSolutionUsable()) {
     return Fail(
@@ -871,7 +850,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
   if (outcome.summary.termination_type == ceres::NO_CONVERGENCE) {
     return Fail("the joint bundle adjustment did not converge within " +
                     std::to_string(copt.max_iterations) + " iterations (RMS " +
-                    Format("%.3f", result->rms_px) +
+                    StringPrintf("%.3f", result->rms_px) +
                     " px): raise the iteration limit or check the "
                     "correspondences",
                 error);
@@ -907,8 +886,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
       return Fail("camera '" + out.name +
                       "': the reprojection RMS of the "
                       "joint solve is " +
-                      Format("%.2f", out.rms_px) + " px (limit " +
-                      Format("%.2f", copt.max_rms_px) +
+                      StringPrintf("%.2f", out.rms_px) + " px (limit " +
+                      StringPrintf("%.2f", copt.max_rms_px) +
                       " px): the frames of the folders may not be the same "
                       "instants, or the rig moved between photos",
                   error);
@@ -919,8 +898,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
             copt.max_focal_relative_stddev * std::abs(out.camera.params[k]))) {
         return Fail("camera '" + out.name +
                         "': the frames do not determine the focal length (" +
-                        Format("%.1f", out.camera.params[k]) + " +- " +
-                        Format("%.3g", out.param_stddev[k]) +
+                        StringPrintf("%.1f", out.camera.params[k]) + " +- " +
+                        StringPrintf("%.3g", out.param_stddev[k]) +
                         " px): add photos with the board tilted",
                     error);
       }
@@ -935,7 +914,7 @@ std::string RigCalibrationReport(const RigCalibrationResult& result) {
       << result.num_frames_used << " of " << result.frame_used.size()
       << " frames used, " << result.num_corners_used << " corners, "
       << result.num_outliers << " outliers (" << result.outlier_rounds
-      << " rejection rounds), RMS " << Format("%.4f", result.rms_px)
+      << " rejection rounds), RMS " << StringPrintf("%.4f", result.rms_px)
       << " px per coordinate\n";
   for (size_t c = 0; c < result.cameras.size(); ++c) {
     const RigCameraResult& cam = result.cameras[c];
@@ -946,11 +925,12 @@ std::string RigCalibrationReport(const RigCalibrationResult& result) {
         << cam.camera.height << ")" << (c == 0 ? ", the rig frame" : "")
         << "\n";
     for (size_t k = 0; k < names.size() && k < cam.camera.params.size(); ++k) {
-      out << "  " << names[k] << " = " << Format("%.10g", cam.camera.params[k]);
+      out << "  " << names[k] << " = "
+          << StringPrintf("%.10g", cam.camera.params[k]);
       if (cam.param_fixed[k]) {
         out << " (fixed)";
       } else if (result.covariance_ok) {
-        out << " +- " << Format("%.3g", cam.param_stddev[k]);
+        out << " +- " << StringPrintf("%.3g", cam.param_stddev[k]);
       }
       out << "\n";
     }
@@ -958,23 +938,25 @@ std::string RigCalibrationReport(const RigCalibrationResult& result) {
       const Eigen::AngleAxisd rotation(cam.cam_from_rig.linear());
       const Eigen::Vector3d t = cam.cam_from_rig.translation();
       out << "  cam_from_rig: rotation "
-          << Format("%.5f", rotation.angle() / kDegree) << " deg";
+          << StringPrintf("%.5f", rotation.angle() / kDegree) << " deg";
       if (result.covariance_ok) {
-        out << " +- " << Format("%.2g", cam.rotation_stddev_deg);
+        out << " +- " << StringPrintf("%.2g", cam.rotation_stddev_deg);
       }
-      out << ", t = (" << Format("%.6f", t.x()) << ", " << Format("%.6f", t.y())
-          << ", " << Format("%.6f", t.z()) << ") m, baseline "
-          << Format("%.3f", 1000 * cam.baseline_m) << " mm";
+      out << ", t = (" << StringPrintf("%.6f", t.x()) << ", "
+          << StringPrintf("%.6f", t.y()) << ", " << StringPrintf("%.6f", t.z())
+          << ") m, baseline " << StringPrintf("%.3f", 1000 * cam.baseline_m)
+          << " mm";
       if (result.covariance_ok) {
-        out << " +- " << Format("%.3g", 1000 * cam.baseline_stddev_m) << " mm";
+        out << " +- " << StringPrintf("%.3g", 1000 * cam.baseline_stddev_m)
+            << " mm";
       }
       out << " (started from camera " << result.start_parent[c] << ")\n";
     }
     out << "  joint: " << cam.num_frames_used << " frames, "
         << cam.num_corners_used << " corners, " << cam.num_outliers
-        << " outliers, RMS " << Format("%.4f", cam.rms_px)
+        << " outliers, RMS " << StringPrintf("%.4f", cam.rms_px)
         << " px; alone: " << cam.single_views_used << " views, RMS "
-        << Format("%.4f", cam.single_rms_px) << " px\n";
+        << StringPrintf("%.4f", cam.single_rms_px) << " px\n";
   }
   if (!result.covariance_ok) {
     out << "covariance: not available (the problem is rank deficient)\n";
@@ -986,8 +968,9 @@ std::string RigCalibrationReport(const RigCalibrationResult& result) {
     }
   }
   out << "\nsolver: " << result.iterations << " iterations, "
-      << result.termination << "; " << Format("%.3f", result.seconds_single)
-      << " s alone, " << Format("%.3f", result.seconds_joint) << " s joint\n";
+      << result.termination << "; "
+      << StringPrintf("%.3f", result.seconds_single) << " s alone, "
+      << StringPrintf("%.3f", result.seconds_joint) << " s joint\n";
   return out.str();
 }
 

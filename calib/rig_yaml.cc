@@ -11,16 +11,12 @@
 #include <sstream>
 
 #include "util/atomic_file.h"
+#include "util/failure.h"
 
 namespace puzzlecal {
 namespace {
 
 constexpr const char* kRigFormatTag = "puzzlecal-rig";
-
-bool Fail(const std::string& message, std::string* error) {
-  if (error != nullptr) *error = message;
-  return false;
-}
 
 YAML::Emitter& Flow(YAML::Emitter& out, const std::vector<double>& values) {
   out << YAML::Flow << YAML::BeginSeq;

@@ -16,7 +16,7 @@
 //   pair's rectification R and projection P for two cameras;
 // - kalibr: a camchain with T_cn_cnm1, cam_overlaps and a rostopic per
 //   camera.
-// Files are written atomically (calib/atomic_file.h).
+// Files are written atomically (util/atomic_file.h).
 
 #include <Eigen/Geometry>
 #include <string>

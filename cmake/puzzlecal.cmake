@@ -2,7 +2,7 @@ include(GNUInstallDirs)
 
 # puzzlecal_add_library(NAME SOURCES ... DEPS ...)
 # One library target per folder; includes are full paths from the repository
-# root ("grid/kruskal.h"). Each library and its folder's headers are
+# root ("grid/grid.h"). Each library and its folder's headers are
 # installed (`cmake --install`) and exported as puzzlecal::NAME through the
 # puzzlecal CMake package (find_package(puzzlecal)).
 function(puzzlecal_add_library name)

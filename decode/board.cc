@@ -3,29 +3,21 @@
 #include <cmath>
 
 #include "decode/puzzleboard_codes.h"
+#include "util/enum_names.h"
 
 namespace puzzlecal {
 
+constexpr EnumName<BoardType> kBoardTypeNames[] = {
+    {BoardType::kPuzzleBoard, "puzzleboard"},
+    {BoardType::kCheckerboard, "checkerboard"},
+};
+
 const char* BoardTypeName(BoardType type) {
-  switch (type) {
-    case BoardType::kPuzzleBoard:
-      return "puzzleboard";
-    case BoardType::kCheckerboard:
-      return "checkerboard";
-  }
-  return "unknown";
+  return NameOf(kBoardTypeNames, type, "unknown");
 }
 
 bool BoardTypeFromName(const std::string& name, BoardType* type) {
-  if (name == "puzzleboard") {
-    *type = BoardType::kPuzzleBoard;
-    return true;
-  }
-  if (name == "checkerboard") {
-    *type = BoardType::kCheckerboard;
-    return true;
-  }
-  return false;
+  return ValueOf(kBoardTypeNames, name, type);
 }
 
 bool Board::Check(std::string* why) const {

@@ -2,23 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <utility>
 
 #include "decode/position_search.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
-
-std::string Format(const char* format, double a, double b = 0.0,
-                   double c = 0.0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), format, a, b, c);
-  return buffer;
-}
 
 // Relative labels of a component: right-handed, smallest label at (0, 0).
 void AppendRelativeLabels(const LabelLattice& lattice, int handedness,
@@ -129,29 +122,29 @@ std::string RefusalReason(const PositionSearchResult& search,
                           const ComponentDecoding& decoding,
                           const DecodeOptions& options) {
   if (decoding.agreement < options.min_agreement) {
-    return Format(
-        "best position agrees with %.1f %% of %.0f bits (need %.1f %%)",
+    return StringPrintf(
+        "best position agrees with %.1f %% of %d bits (need %.1f %%)",
         100.0 * decoding.agreement, decoding.bits_read,
         100.0 * options.min_agreement);
   }
   if (decoding.margin < RequiredMargin(decoding.agreement, options)) {
-    return Format(
-        "ambiguous: best position leads the second by %.0f bits "
-        "(need %.0f at %.1f %% agreement)",
+    return StringPrintf(
+        "ambiguous: best position leads the second by %d bits "
+        "(need %d at %.1f %% agreement)",
         decoding.margin, RequiredMargin(decoding.agreement, options),
         100.0 * decoding.agreement);
   }
   if (decoding.log10_nfa > options.max_log10_nfa) {
-    return Format(
+    return StringPrintf(
         "too little evidence: a random pattern would match this well "
         "10^%.1f times (allowed 10^%.1f)",
         decoding.log10_nfa, options.max_log10_nfa);
   }
   if (options.refuse_better_off_board &&
       search.torus_best_score > search.best_score) {
-    return Format(
-        "a position outside the printed board matches better (%.0f vs "
-        "%.0f agreeing bits): wrong board file or print?",
+    return StringPrintf(
+        "a position outside the printed board matches better (%d vs "
+        "%d agreeing bits): wrong board file or print?",
         (search.torus_best_score + search.num_edges) / 2,
         search.edges_agreeing);
   }
@@ -181,14 +174,15 @@ void NameMirroredOrInverted(const std::vector<LabelEdgeVote>& votes,
   decoding->inverted_agreement = agreement(inverted);
   if (decoding->mirrored_agreement >= options.min_agreement &&
       mirrored.edges_agreeing > search.edges_agreeing) {
-    *why += Format(
+    *why += StringPrintf(
         "; the bits match a mirrored PuzzleBoard (%.1f %%): mirrored "
         "image or print",
         100.0 * decoding->mirrored_agreement);
   } else if (decoding->inverted_agreement >= options.min_agreement &&
              inverted.edges_agreeing > search.edges_agreeing) {
-    *why += Format("; the bits match a contrast-inverted PuzzleBoard (%.1f %%)",
-                   100.0 * decoding->inverted_agreement);
+    *why += StringPrintf(
+        "; the bits match a contrast-inverted PuzzleBoard (%.1f %%)",
+        100.0 * decoding->inverted_agreement);
   }
 }
 
@@ -235,8 +229,8 @@ bool DecodeComponentBits(const LabelLattice& lattice,
   decoding->edges = static_cast<int>(reading.edges.size());
   decoding->bits_read = reading.num_read;
   if (reading.num_read < options.min_bits_read) {
-    decoding->reason = Format(
-        "only %.0f of %.0f edge bits readable (need %.0f): no discs "
+    decoding->reason = StringPrintf(
+        "only %d of %d edge bits readable (need %d): no discs "
         "(plain checkerboard?), blur or tiles too small",
         reading.num_read, decoding->edges, options.min_bits_read);
     return false;
@@ -251,8 +245,8 @@ bool DecodeComponentBits(const LabelLattice& lattice,
   const PositionSearchResult search = SearchPuzzleBoardPosition(
       votes, Eigen::Vector2i::Zero(), label_max, handedness, parity, board);
   if (!search.found) {
-    decoding->reason = Format(
-        "labels spanning %.0f x %.0f corners fit on the %.0f-column board in "
+    decoding->reason = StringPrintf(
+        "labels spanning %d x %d corners fit on the %d-column board in "
         "no rotation",
         lattice.width, lattice.height, board.cols);
     return false;
@@ -382,8 +376,8 @@ bool UsableLattice(const std::vector<Corner>& corners,
   decoding->corners_dropped = dropped;
   decoding->handedness = LabelHandedness(*lattice);
   if (decoding->num_corners < options.min_corners) {
-    decoding->reason = Format("only %.0f usable corners (need %.0f)",
-                              decoding->num_corners, options.min_corners);
+    decoding->reason = StringPrintf("only %d usable corners (need %d)",
+                                    decoding->num_corners, options.min_corners);
     return false;
   }
   return true;

@@ -1,7 +1,6 @@
 #include "grid/grid.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -12,158 +11,140 @@
 #include "grid/lattice_cleanup.h"
 #include "grid/lattice_forest.h"
 #include "grid/nearest_neighbors.h"
+#include "util/enum_names.h"
+#include "util/failure.h"
+#include "util/timer.h"
 
 namespace puzzlecal {
-namespace {
-
-bool Fail(std::string* why, const std::string& message) {
-  if (why) *why = message;
-  return false;
-}
-
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(
-             std::chrono::steady_clock::now() - start)
-      .count();
-}
-
-}  // namespace
+constexpr EnumName<GridEdgeDecision> kGridEdgeDecisionNames[] = {
+    {GridEdgeDecision::kMerged, "merged"},
+    {GridEdgeDecision::kSameTree, "same tree"},
+    {GridEdgeDecision::kNeighborWeight, "neighbor weight"},
+    {GridEdgeDecision::kTreeMeanWeight, "tree mean weight"},
+    {GridEdgeDecision::kAmbiguousAxis, "ambiguous axis"},
+    {GridEdgeDecision::kLabelCollision, "label collision"},
+    {GridEdgeDecision::kNeighborContradiction, "neighbor contradiction"},
+    {GridEdgeDecision::kCollinearity, "collinearity"},
+    {GridEdgeDecision::kSidesFlip, "sides flip"},
+    {GridEdgeDecision::kPenalised, "penalised"},
+};
 
 const char* GridEdgeDecisionName(GridEdgeDecision decision) {
-  switch (decision) {
-    case GridEdgeDecision::kMerged:
-      return "merged";
-    case GridEdgeDecision::kSameTree:
-      return "same tree";
-    case GridEdgeDecision::kNeighborWeight:
-      return "neighbor weight";
-    case GridEdgeDecision::kTreeMeanWeight:
-      return "tree mean weight";
-    case GridEdgeDecision::kAmbiguousAxis:
-      return "ambiguous axis";
-    case GridEdgeDecision::kLabelCollision:
-      return "label collision";
-    case GridEdgeDecision::kNeighborContradiction:
-      return "neighbor contradiction";
-    case GridEdgeDecision::kCollinearity:
-      return "collinearity";
-    case GridEdgeDecision::kSidesFlip:
-      return "sides flip";
-    case GridEdgeDecision::kPenalised:
-      return "penalised";
-  }
-  return "unknown";
+  return NameOf(kGridEdgeDecisionNames, decision, "unknown");
 }
 
 bool GridCandidateOptions::Check(std::string* why) const {
   if (num_neighbors < 1 || num_neighbors > 64)
-    return Fail(why, "candidates.num_neighbors must be in [1, 64]");
+    return Fail("candidates.num_neighbors must be in [1, 64]", why);
   if (!(min_orientation_difference_deg >= 0 &&
         min_orientation_difference_deg < 90))
-    return Fail(why,
-                "candidates.min_orientation_difference_deg must be in [0, 90)");
+    return Fail("candidates.min_orientation_difference_deg must be in [0, 90)",
+                why);
   if (!(min_edge_length_px >= 0 && std::isfinite(min_edge_length_px)))
-    return Fail(why, "candidates.min_edge_length_px must be finite and >= 0");
+    return Fail("candidates.min_edge_length_px must be finite and >= 0", why);
   if (!(max_abs_coordinate_px > 0 && max_abs_coordinate_px <= 1e9))
-    return Fail(why, "candidates.max_abs_coordinate_px must be in (0, 1e9]");
+    return Fail("candidates.max_abs_coordinate_px must be in (0, 1e9]", why);
   return true;
 }
 
 bool GridEdgeImageOptions::Check(std::string* why) const {
   if (intensity_samples < 3 || intensity_samples > 1000)
-    return Fail(why, "image_tests.intensity_samples must be in [3, 1000]");
+    return Fail("image_tests.intensity_samples must be in [3, 1000]", why);
   if (!(intensity_difference_fraction > 0 &&
         std::isfinite(intensity_difference_fraction)))
-    return Fail(why,
-                "image_tests.intensity_difference_fraction must be finite and "
-                "> 0");
+    return Fail(
+        "image_tests.intensity_difference_fraction must be finite and "
+        "> 0",
+        why);
   if (!(penalty_factor >= 1 && std::isfinite(penalty_factor)))
-    return Fail(why, "image_tests.penalty_factor must be finite and >= 1");
+    return Fail("image_tests.penalty_factor must be finite and >= 1", why);
   if (!(side_offset_fraction > 0 && side_offset_fraction <= 0.5))
-    return Fail(why, "image_tests.side_offset_fraction must be in (0, 0.5]");
+    return Fail("image_tests.side_offset_fraction must be in (0, 0.5]", why);
   if (!(side_min_contrast >= 0 && std::isfinite(side_min_contrast)))
-    return Fail(why, "image_tests.side_min_contrast must be finite and >= 0");
+    return Fail("image_tests.side_min_contrast must be finite and >= 0", why);
   return true;
 }
 
 bool GridMergeOptions::Check(std::string* why) const {
   if (!(neighbor_weight_ratio > 1 && std::isfinite(neighbor_weight_ratio)))
-    return Fail(why, "merge.neighbor_weight_ratio must be finite and > 1");
+    return Fail("merge.neighbor_weight_ratio must be finite and > 1", why);
   if (!(tree_mean_weight_ratio_min > 0 && tree_mean_weight_ratio_min < 1 &&
         tree_mean_weight_ratio_max > 1 &&
         std::isfinite(tree_mean_weight_ratio_max)))
-    return Fail(why,
-                "merge.tree_mean_weight_ratio_min must be in (0, 1) and "
-                "merge.tree_mean_weight_ratio_max finite and > 1");
+    return Fail(
+        "merge.tree_mean_weight_ratio_min must be in (0, 1) and "
+        "merge.tree_mean_weight_ratio_max finite and > 1",
+        why);
   if (!(max_collinearity_sin > 0 && max_collinearity_sin <= 1))
-    return Fail(why, "merge.max_collinearity_sin must be in (0, 1]");
+    return Fail("merge.max_collinearity_sin must be in (0, 1]", why);
   if (!(max_line_spacing_ratio >= 1 && std::isfinite(max_line_spacing_ratio)))
-    return Fail(why, "merge.max_line_spacing_ratio must be finite and >= 1");
+    return Fail("merge.max_line_spacing_ratio must be finite and >= 1", why);
   if (!(max_axis_deviation_deg > 0 && max_axis_deviation_deg <= 45))
-    return Fail(why, "merge.max_axis_deviation_deg must be in (0, 45]");
+    return Fail("merge.max_axis_deviation_deg must be in (0, 45]", why);
   if (!(max_axis_deviation_with_image_deg > 0 &&
         max_axis_deviation_with_image_deg <= 45))
-    return Fail(why,
-                "merge.max_axis_deviation_with_image_deg must be in (0, 45]");
+    return Fail("merge.max_axis_deviation_with_image_deg must be in (0, 45]",
+                why);
   if (!(max_adjacency_deviation_with_image_deg > 0 &&
         max_adjacency_deviation_with_image_deg < 90))
     return Fail(
-        why, "merge.max_adjacency_deviation_with_image_deg must be in (0, 90)");
+        "merge.max_adjacency_deviation_with_image_deg must be in (0, 90)", why);
   if (!(max_adjacency_length_ratio >= 1 &&
         std::isfinite(max_adjacency_length_ratio)))
-    return Fail(why,
-                "merge.max_adjacency_length_ratio must be finite and >= 1");
+    return Fail("merge.max_adjacency_length_ratio must be finite and >= 1",
+                why);
   if (!(max_axis_aspect_ratio >= 1 && std::isfinite(max_axis_aspect_ratio)))
-    return Fail(why, "merge.max_axis_aspect_ratio must be finite and >= 1");
+    return Fail("merge.max_axis_aspect_ratio must be finite and >= 1", why);
   if (kruskal_passes < 1 || kruskal_passes > 10)
-    return Fail(why, "merge.kruskal_passes must be in [1, 10]");
+    return Fail("merge.kruskal_passes must be in [1, 10]", why);
   return true;
 }
 
 bool GridCleanupOptions::Check(std::string* why) const {
   if (!(saddle_sample_fraction > 0 && saddle_sample_fraction <= 0.5))
-    return Fail(why, "cleanup.saddle_sample_fraction must be in (0, 0.5]");
+    return Fail("cleanup.saddle_sample_fraction must be in (0, 0.5]", why);
   if (!(line_prediction_tolerance > 0 &&
         std::isfinite(line_prediction_tolerance)))
-    return Fail(why,
-                "cleanup.line_prediction_tolerance must be finite and > 0");
+    return Fail("cleanup.line_prediction_tolerance must be finite and > 0",
+                why);
   if (min_component_size < 1)
-    return Fail(why, "cleanup.min_component_size must be >= 1");
+    return Fail("cleanup.min_component_size must be >= 1", why);
   return true;
 }
 
 bool GridAttachOptions::Check(std::string* why) const {
   if (rounds < 0 || rounds > 100)
-    return Fail(why, "attach.rounds must be in [0, 100]");
+    return Fail("attach.rounds must be in [0, 100]", why);
   if (!(tolerance > 0 && tolerance < 1))
-    return Fail(why, "attach.tolerance must be in (0, 1)");
+    return Fail("attach.tolerance must be in (0, 1)", why);
   if (!(contradiction_tolerance >= tolerance && contradiction_tolerance < 1))
-    return Fail(why,
-                "attach.contradiction_tolerance must be in [attach.tolerance, "
-                "1)");
+    return Fail(
+        "attach.contradiction_tolerance must be in [attach.tolerance, "
+        "1)",
+        why);
   if (min_support < 1 || min_support > 8)
-    return Fail(why, "attach.min_support must be in [1, 8]");
+    return Fail("attach.min_support must be in [1, 8]", why);
   if (!(saddle_sample_fraction > 0 && saddle_sample_fraction <= 0.5))
-    return Fail(why, "attach.saddle_sample_fraction must be in (0, 0.5]");
+    return Fail("attach.saddle_sample_fraction must be in (0, 0.5]", why);
   if (!(max_join_direction_deviation_deg > 0 &&
         max_join_direction_deviation_deg < 90))
-    return Fail(why,
-                "attach.max_join_direction_deviation_deg must be in (0, 90)");
+    return Fail("attach.max_join_direction_deviation_deg must be in (0, 90)",
+                why);
   if (max_component_joins < 0 || max_component_joins > 1000)
-    return Fail(why, "attach.max_component_joins must be in [0, 1000]");
+    return Fail("attach.max_component_joins must be in [0, 1000]", why);
   return true;
 }
 
 bool GridOffLatticeOptions::Check(std::string* why) const {
   if (!(tolerance > 0 && tolerance < 1))
-    return Fail(why, "off_lattice.tolerance must be in (0, 1)");
+    return Fail("off_lattice.tolerance must be in (0, 1)", why);
   if (!(agreement > 0 && agreement <= tolerance))
-    return Fail(why,
-                "off_lattice.agreement must be in (0, off_lattice.tolerance]");
+    return Fail("off_lattice.agreement must be in (0, off_lattice.tolerance]",
+                why);
   if (min_agreeing < 2 || min_agreeing > 10)
-    return Fail(why, "off_lattice.min_agreeing must be in [2, 10]");
+    return Fail("off_lattice.min_agreeing must be in [2, 10]", why);
   if (max_rounds < 1 || max_rounds > 10)
-    return Fail(why, "off_lattice.max_rounds must be in [1, 10]");
+    return Fail("off_lattice.max_rounds must be in [1, 10]", why);
   return true;
 }
 
@@ -379,7 +360,7 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
                                      GridSummary* summary_out,
                                      std::vector<GridEdgeTrace>* trace) {
   if (trace != nullptr) trace->clear();
-  const auto start = std::chrono::steady_clock::now();
+  const Timer timer;
   GridSummary local_summary;
   GridSummary& summary = summary_out ? *summary_out : local_summary;
   summary = GridSummary();
@@ -389,31 +370,31 @@ std::vector<GridComponent> BuildGrid(const std::vector<Corner>& corners,
   summary.image_used = !image.empty();
   const GridNodes nodes = MakeGridNodes(corners, options, &summary);
 
-  auto phase_start = std::chrono::steady_clock::now();
+  Timer phase;
   const std::vector<std::pair<int, int>> pairs =
       CandidatePairs(nodes, options.candidates.num_neighbors);
   summary.num_candidate_edges = static_cast<int>(pairs.size());
-  summary.neighbors_ms = MillisecondsSince(phase_start);
+  summary.neighbors_ms = phase.Milliseconds();
 
-  phase_start = std::chrono::steady_clock::now();
+  phase.Restart();
   std::vector<GridEdge> edges = FilterPairs(pairs, nodes, options, &summary);
   SortEdgesByLength(&edges);
   summary.num_edges_considered = static_cast<int>(edges.size());
-  summary.weights_ms = MillisecondsSince(phase_start);
+  summary.weights_ms = phase.Milliseconds();
 
-  phase_start = std::chrono::steady_clock::now();
+  phase.Restart();
   const LatticeForest forest =
       RunKruskal(nodes.lattice, edges, image, options, &summary, trace);
-  summary.kruskal_ms = MillisecondsSince(phase_start);
+  summary.kruskal_ms = phase.Milliseconds();
 
-  phase_start = std::chrono::steady_clock::now();
+  phase.Restart();
   std::vector<GridComponent> components = ExtractComponents(
       nodes.lattice.xy, image, forest, edges, options, &summary);
-  summary.cleanup_ms = MillisecondsSince(phase_start);
+  summary.cleanup_ms = phase.Milliseconds();
 
   SummarizeComponents(components, &summary);
   summary.ok = true;
-  summary.total_ms = MillisecondsSince(start);
+  summary.total_ms = timer.Milliseconds();
   return components;
 }
 

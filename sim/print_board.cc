@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "decode/puzzleboard.h"
+#include "util/enum_names.h"
 
 namespace puzzlecal {
 namespace {
@@ -307,31 +308,20 @@ bool PrintFormatFromPath(const std::string& path, PrintFormat* format) {
   return true;
 }
 
+constexpr EnumName<PageSize> kPageSizeNames[] = {
+    {PageSize::kPatternOnly, "pattern"},
+    {PageSize::kFit, "fit"},
+    {PageSize::kA4, "a4"},
+    {PageSize::kA3, "a3"},
+    {PageSize::kLetter, "letter"},
+};
+
 const char* PageSizeName(PageSize page) {
-  switch (page) {
-    case PageSize::kPatternOnly:
-      return "pattern";
-    case PageSize::kFit:
-      return "fit";
-    case PageSize::kA4:
-      return "a4";
-    case PageSize::kA3:
-      return "a3";
-    case PageSize::kLetter:
-      return "letter";
-  }
-  return "pattern";
+  return NameOf(kPageSizeNames, page, "pattern");
 }
 
 bool PageSizeFromName(const std::string& name, PageSize* page) {
-  for (PageSize candidate : {PageSize::kPatternOnly, PageSize::kFit,
-                             PageSize::kA4, PageSize::kA3, PageSize::kLetter}) {
-    if (name == PageSizeName(candidate)) {
-      *page = candidate;
-      return true;
-    }
-  }
-  return false;
+  return ValueOf(kPageSizeNames, name, page);
 }
 
 bool LayOutPage(const Board& board, const PrintOptions& options,
