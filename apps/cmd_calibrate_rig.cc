@@ -20,8 +20,10 @@
 #include "apps/rig_report.h"
 #include "apps/subcommand.h"
 #include "calib/camera_yaml.h"
+#include "calib/evidence.h"
 #include "calib/rig_calibration.h"
 #include "calib/rig_yaml.h"
+#include "calib/verdict.h"
 #include "util/timer.h"
 
 namespace puzzlecal {
@@ -243,6 +245,17 @@ int RunCalibrateRig() {
     return kExitOutputError;
   }
   std::cout << RigCalibrationReport(result);
+  // Each camera's own calibration judged as `calibrate` judges one camera
+  // (halves, uncertainty, binned residuals; calib/verdict.h).
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    const RigCameraResult& cam = result.cameras[c];
+    const EvidenceOptions evidence_options;
+    const Evidence evidence = ComputeEvidence(
+        inputs[c].frames, cam.single, options.camera, evidence_options);
+    const Verdict verdict = MakeVerdict(cam.single, evidence, evidence_options,
+                                        VerdictOptions());
+    std::cout << cam.name << ": " << verdict.Line() << "\n";
+  }
   std::cout << "time: " << run_timer.Seconds() << " s wall clock on " << threads
             << " threads (images " << seconds_images << " s, calibration "
             << result.seconds_single + result.seconds_joint << " s)\n";

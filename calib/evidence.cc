@@ -11,6 +11,8 @@
 #include <limits>
 #include <sstream>
 
+#include "util/failure.h"
+
 namespace puzzlecal {
 namespace {
 
@@ -27,11 +29,6 @@ std::string Printf(const char* format, double a, double b = 0, double c = 0,
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer), format, a, b, c, d, e);
   return buffer;
-}
-
-bool Fail(const std::string& message, std::string* why) {
-  if (why != nullptr) *why = message;
-  return false;
 }
 
 double Quantile(std::vector<double> values, double q) {

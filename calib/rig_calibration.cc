@@ -517,6 +517,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
   }
   result->seconds_single = single_timer.Seconds();
   for (size_t c = 0; c < num_cameras; ++c) {
+    result->cameras[c].single = single[c];
     result->cameras[c].single_rms_px = single[c].rms_px;
     result->cameras[c].single_views_used = single[c].num_views_used;
     if (!single_ok[c]) {

@@ -89,7 +89,9 @@ struct RigCameraResult {
   // that order; zero for the reference camera.
   Eigen::Matrix<double, 6, 6> extrinsics_covariance =
       Eigen::Matrix<double, 6, 6>::Zero();
-  // The camera's own calibration (the starting point).
+  // The camera's own calibration (the starting point): its whole result,
+  // so that the single-camera evidence and verdict can be made from it.
+  CalibrationResult single;
   double single_rms_px = 0;
   int single_views_used = 0;
   // The joint solve, this camera's corners: RMS per coordinate of the

@@ -142,6 +142,11 @@ TEST(CalibrateRigTest, FisheyeAndPinholeRendersMeetTheFigures) {
       rig.board + " --model kannala-brandt,pinhole-radtan --out " +
       out.string() + " --report " + report.string() + " --threads 2");
   ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  // Each camera's own calibration gets the single-camera verdict.
+  for (const RigSceneCamera& spec : rig.scene.cameras) {
+    EXPECT_NE(run.output.find(spec.name + ": verdict: "), std::string::npos)
+        << run.output;
+  }
   std::vector<RigFileCamera> cameras;
   std::string error;
   ASSERT_TRUE(ReadRigFile(out.string(), &cameras, &error)) << error;
