@@ -81,8 +81,8 @@ struct InitializationOptions {
   // Huber scale of the start refinement, pixels. Default 2.
   double start_refine_loss_px = 2.0;
   // Pose-refinement iterations (as pose_refine_iterations) for every view
-  // after a successful start refinement. Default 5.
-  int start_refine_pose_iterations = 5;
+  // after a successful start refinement. Default 0 (the homography pose through the refined camera is close enough).
+  int start_refine_pose_iterations = 0;
 
   bool Check(std::string* why) const;
 };
