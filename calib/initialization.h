@@ -15,7 +15,10 @@
 // - per view: a pose "PnP through the model": pixels are unprojected to rays
 //   with the current intrinsics, a board-to-ray homography gives the pose,
 //   optionally polished by a small robust Ceres refinement
-//   (pose_refine_iterations > 0; off by default).
+//   (pose_refine_iterations > 0; off by default);
+// - then (no intrinsics from the caller) the start refinement: a joint solve
+//   of fx, fy, cx, cy, k1, k2 and the poses on a subset of views and corners,
+//   after which every view is posed again through the refined camera.
 // Every estimate is robust to a few gross outliers (iteratively reweighted).
 
 #include <Eigen/Core>
@@ -63,6 +66,23 @@ struct InitializationOptions {
   int pose_refine_iterations = 0;
   // Huber scale of the pose refinement, pixels. Default 2.
   double pose_refine_loss_px = 2.0;
+  // Start refinement (without intrinsics from the caller): a joint solve of
+  // fx, fy, cx, cy, k1, k2 and the poses on a subset of the posed views and
+  // corners, from the distortion-free start; every view is then posed again
+  // through the refined camera. The full bundle adjustment so starts near
+  // its minimum instead of walking there over all corners. At most this
+  // many Levenberg-Marquardt iterations; 0 turns it off. Default 100.
+  int start_refine_iterations = 100;
+  // At most this many posed views (evenly spread) take part. Default 20.
+  int start_refine_max_views = 20;
+  // At most this many corners per view (evenly spread over its list) take
+  // part. Default 40.
+  int start_refine_max_corners_per_view = 40;
+  // Huber scale of the start refinement, pixels. Default 2.
+  double start_refine_loss_px = 2.0;
+  // Pose-refinement iterations (as pose_refine_iterations) for every view
+  // after a successful start refinement. Default 0 (the homography pose through the refined camera is close enough).
+  int start_refine_pose_iterations = 0;
 
   bool Check(std::string* why) const;
 };
@@ -77,6 +97,10 @@ struct InitializationResult {
   // Largest angle between the board normals of two posed views, degrees: a
   // small value means the focal length is poorly determined.
   double orientation_spread_deg = 0;
+  // Iterations of the start refinement (0: not run), and whether its
+  // camera replaced the closed-form / search start.
+  int start_refine_iterations = 0;
+  bool start_refined = false;
 };
 
 // Board-to-ray homography (ray ~ H * (X, Y, 1)) from board-plane points and
