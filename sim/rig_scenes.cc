@@ -15,12 +15,6 @@ namespace {
 
 constexpr double kDegree = M_PI / 180.0;
 
-// Uniform double in [lo, hi] from mt19937_64 (fully specified).
-double Uniform(std::mt19937_64* rng, double lo, double hi) {
-  const double unit = ((*rng)() >> 11) * (1.0 / 9007199254740992.0);
-  return lo + (hi - lo) * unit;
-}
-
 // A camera centred at `centre` (rig frame, metres) whose optical axis is
 // turned by `yaw_deg` about the rig's y axis (positive: towards +x) and
 // `pitch_deg` about its x axis.
@@ -131,19 +125,7 @@ std::vector<Eigen::Isometry3d> RigFramePoses(const RigSceneSpec& scene) {
         r.aim_cameras.empty()
             ? k % static_cast<int>(scene.cameras.size())
             : r.aim_cameras[k % static_cast<int>(r.aim_cameras.size())];
-    ViewPose view;
-    view.target = Eigen::Vector2d(
-        Uniform(&rng, board.origin.x() - r.target_margin_tiles,
-                board.origin.x() + board.cols - 1 + r.target_margin_tiles),
-        Uniform(&rng, board.origin.y() - r.target_margin_tiles,
-                board.origin.y() + board.rows - 1 + r.target_margin_tiles));
-    view.distance_m = Uniform(&rng, r.min_distance_m, r.max_distance_m);
-    view.view_angle_deg =
-        Uniform(&rng, r.min_view_angle_deg, r.max_view_angle_deg);
-    view.tilt_direction_deg = Uniform(&rng, 0.0, 360.0);
-    view.roll_deg = Uniform(&rng, -r.max_roll_deg, r.max_roll_deg);
-    view.off_axis_deg = r.max_off_axis_deg * std::sqrt(Uniform(&rng, 0.0, 1.0));
-    view.off_axis_direction_deg = Uniform(&rng, 0.0, 360.0);
+    const ViewPose view = DrawViewPose(board, r, &rng);
     poses.push_back(scene.cameras[aim].cam_from_rig.inverse() *
                     PoseFromView(board, view));
   }

@@ -6,16 +6,15 @@
 #include <random>
 
 namespace puzzlecal {
-namespace {
 
-constexpr double kDegree = M_PI / 180.0;
-
-// Uniform double in [lo, hi] from mt19937_64 (fully specified, so the same
-// seed draws the same views everywhere).
-double Uniform(std::mt19937_64* rng, double lo, double hi) {
+double UniformDraw(std::mt19937_64* rng, double lo, double hi) {
   const double unit = ((*rng)() >> 11) * (1.0 / 9007199254740992.0);
   return lo + (hi - lo) * unit;
 }
+
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
 
 std::string ViewName(int index) {
   char name[32];
@@ -40,12 +39,12 @@ std::vector<Occluder> RandomOccluders(const SceneSpec& scene,
   for (int i = 0; i < r.occluders_per_view; ++i) {
     for (int attempt = 0; attempt < 50; ++attempt) {
       const double u =
-          Uniform(rng, board.origin.x(), board.origin.x() + board.cols - 1);
+          UniformDraw(rng, board.origin.x(), board.origin.x() + board.cols - 1);
       const double v =
-          Uniform(rng, board.origin.y(), board.origin.y() + board.rows - 1);
+          UniformDraw(rng, board.origin.y(), board.origin.y() + board.rows - 1);
       const double radius =
-          Uniform(rng, r.min_occluder_radius_px, r.max_occluder_radius_px);
-      const double grey = Uniform(rng, 0.2, 0.7);
+          UniformDraw(rng, r.min_occluder_radius_px, r.max_occluder_radius_px);
+      const double grey = UniformDraw(rng, 0.2, 0.7);
       Eigen::Vector2d pixel;
       const Eigen::Vector3d point =
           pose *
@@ -209,21 +208,7 @@ std::vector<SceneViewSpec> SceneViewSpecs(const SceneSpec& scene) {
   const RandomViews& rv = scene.random_views;
   std::mt19937_64 rng(rv.seed);
   for (int i = 0; i < rv.count; ++i) {
-    ViewPose view;
-    view.target = Eigen::Vector2d(
-        Uniform(&rng, board.origin.x() - rv.target_margin_tiles,
-                board.origin.x() + board.cols - 1 + rv.target_margin_tiles),
-        Uniform(&rng, board.origin.y() - rv.target_margin_tiles,
-                board.origin.y() + board.rows - 1 + rv.target_margin_tiles));
-    view.distance_m = Uniform(&rng, rv.min_distance_m, rv.max_distance_m);
-    view.view_angle_deg =
-        Uniform(&rng, rv.min_view_angle_deg, rv.max_view_angle_deg);
-    view.tilt_direction_deg = Uniform(&rng, 0.0, 360.0);
-    view.roll_deg = Uniform(&rng, -rv.max_roll_deg, rv.max_roll_deg);
-    // Uniform over the image disc of directions, not clustered at the axis.
-    view.off_axis_deg =
-        rv.max_off_axis_deg * std::sqrt(Uniform(&rng, 0.0, 1.0));
-    view.off_axis_direction_deg = Uniform(&rng, 0.0, 360.0);
+    const ViewPose view = DrawViewPose(board, rv, &rng);
     SceneViewSpec spec;
     spec.name = ViewName(index++);
     spec.cam_from_board = PoseFromView(board, view);

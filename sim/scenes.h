@@ -7,8 +7,10 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -38,6 +40,39 @@ struct ViewPose {
 
 // The cam_from_board transform of a ViewPose.
 Eigen::Isometry3d PoseFromView(const Board& board, const ViewPose& view);
+
+// Uniform double in [lo, hi] from mt19937_64 (fully specified, so the same
+// seed draws the same views everywhere).
+double UniformDraw(std::mt19937_64* rng, double lo, double hi);
+
+// A random ViewPose of `board`, drawn from `rng` in a fixed order: the
+// target within the printed area grown by ranges.target_margin_tiles, the
+// distance, view angle, tilt direction, roll, and an off-axis angle uniform
+// over the image disc of directions (not clustered at the axis). `Ranges`
+// is RandomViews or RigRandomFrames (sim/rig_scenes.h): both name these
+// fields alike.
+template <typename Ranges>
+ViewPose DrawViewPose(const Board& board, const Ranges& ranges,
+                      std::mt19937_64* rng) {
+  ViewPose view;
+  view.target = Eigen::Vector2d(
+      UniformDraw(
+          rng, board.origin.x() - ranges.target_margin_tiles,
+          board.origin.x() + board.cols - 1 + ranges.target_margin_tiles),
+      UniformDraw(
+          rng, board.origin.y() - ranges.target_margin_tiles,
+          board.origin.y() + board.rows - 1 + ranges.target_margin_tiles));
+  view.distance_m =
+      UniformDraw(rng, ranges.min_distance_m, ranges.max_distance_m);
+  view.view_angle_deg =
+      UniformDraw(rng, ranges.min_view_angle_deg, ranges.max_view_angle_deg);
+  view.tilt_direction_deg = UniformDraw(rng, 0.0, 360.0);
+  view.roll_deg = UniformDraw(rng, -ranges.max_roll_deg, ranges.max_roll_deg);
+  view.off_axis_deg =
+      ranges.max_off_axis_deg * std::sqrt(UniformDraw(rng, 0.0, 1.0));
+  view.off_axis_direction_deg = UniformDraw(rng, 0.0, 360.0);
+  return view;
+}
 
 // One view of a scene: a pose and the occluders in front of it.
 struct SceneViewSpec {
