@@ -343,19 +343,22 @@ bool StereoRectify(const Camera& first, const Camera& second,
   cv::Mat r1, r2, p1, p2, q;
   const bool fisheye1 = first.model == CameraModelId::kKannalaBrandt;
   const bool fisheye2 = second.model == CameraModelId::kKannalaBrandt;
+  // cv::Mat over a std::vector does not copy: the vectors must outlive the
+  // calls.
+  const std::vector<double> distortion1 = Distortion(first);
+  const std::vector<double> distortion2 = Distortion(second);
   try {
     if (fisheye1 && fisheye2) {
-      cv::Mat d1(Distortion(first)), d2(Distortion(second));
+      const cv::Mat d1(distortion1), d2(distortion2);
       cv::fisheye::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1, r2,
                                  p1, p2, q, cv::CALIB_ZERO_DISPARITY, size, 0.0,
                                  1.0);
     } else {
       // A fisheye's coefficients mean nothing to cv::stereoRectify: leave
       // the distortion out (the rotations do not depend on it).
-      cv::Mat d1 =
-          fisheye1 || fisheye2 ? cv::Mat() : cv::Mat(Distortion(first));
-      cv::Mat d2 =
-          fisheye1 || fisheye2 ? cv::Mat() : cv::Mat(Distortion(second));
+      const bool pinholes = !fisheye1 && !fisheye2;
+      const cv::Mat d1 = pinholes ? cv::Mat(distortion1) : cv::Mat();
+      const cv::Mat d2 = pinholes ? cv::Mat(distortion2) : cv::Mat();
       cv::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1, r2, p1, p2,
                         q, cv::CALIB_ZERO_DISPARITY, 0.0);
     }

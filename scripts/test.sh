@@ -48,6 +48,8 @@ if [ "$full" = 1 ]; then
   # containers forbid it, then leaks are not checked (said below).
   export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
   export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:print_stacktrace=1"
+  # Process-wide caches of system libraries only (each line says which).
+  export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp"
   if build-asan/apps/puzzlecal version 2>&1 >/dev/null |
       grep -q "LeakSanitizer has encountered a fatal error"; then
     echo "test.sh: LeakSanitizer does not work here; leaks are not checked"
