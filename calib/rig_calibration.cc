@@ -434,34 +434,17 @@ std::string CameraList(const std::vector<RigCameraInput>& cameras,
   return list;
 }
 
-}  // namespace
+// ---- the stages of CalibrateRig ----
 
-double RotationDifferenceDeg(const Eigen::Matrix3d& a,
-                             const Eigen::Matrix3d& b) {
-  return Eigen::AngleAxisd(a * b.transpose()).angle() / kDegree;
-}
+using CornerResiduals = std::vector<std::vector<std::vector<Eigen::Vector2d>>>;
+using CornerFlags = std::vector<std::vector<std::vector<bool>>>;
 
-bool RigCalibrationOptions::Check(std::string* why) const {
-  if (min_shared_frames < 1) {
-    return Fail("min_shared_frames must be >= 1", why);
-  }
-  if (!(max_start_rotation_deviation_deg > 0)) {
-    return Fail("max_start_rotation_deviation_deg must be > 0", why);
-  }
-  return camera.Check(why);
-}
-
-bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
-                  const RigCalibrationOptions& options,
-                  RigCalibrationResult* result, std::string* error) {
-  *result = RigCalibrationResult();
-  std::string why;
-  if (!options.Check(&why))
-    return Fail("rig calibration options: " + why, error);
-  const size_t num_cameras = cameras.size();
-  if (num_cameras < 2) {
+// Every camera holds one (possibly empty) view per frame.
+bool CheckRigInput(const std::vector<RigCameraInput>& cameras,
+                   std::string* error) {
+  if (cameras.size() < 2) {
     return Fail("a rig needs at least two cameras (got " +
-                    std::to_string(num_cameras) + ")",
+                    std::to_string(cameras.size()) + ")",
                 error);
   }
   const size_t num_frames = cameras[0].frames.size();
@@ -476,60 +459,90 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
                   error);
     }
   }
-  const CalibrationOptions& copt = options.camera;
-  result->cameras.resize(num_cameras);
-  result->frame_used.assign(num_frames, false);
-  result->rig_from_board.assign(num_frames, Eigen::Isometry3d::Identity());
-  result->start_parent.assign(num_cameras, -1);
-  result->shared_frames = Eigen::MatrixXi::Zero(num_cameras, num_cameras);
-  for (size_t c = 0; c < num_cameras; ++c) {
-    result->cameras[c].name = cameras[c].name;
-    result->cameras[c].camera.model = cameras[c].model;
-    result->cameras[c].camera.width = cameras[c].width;
-    result->cameras[c].camera.height = cameras[c].height;
-  }
+  return true;
+}
 
-  // 1. Each camera alone, in parallel over cameras (each solve is
-  // sequential, so the result does not depend on the thread count).
-  const Timer single_timer;
-  std::vector<CalibrationResult> single(num_cameras);
+// Stage 1: each camera alone, in parallel over cameras (each solve is
+// sequential, so the result does not depend on the thread count).
+bool CalibrateEachCamera(const std::vector<RigCameraInput>& cameras,
+                         const CalibrationOptions& options,
+                         std::vector<CalibrationResult>* single,
+                         std::string* error) {
+  const size_t num_cameras = cameras.size();
+  single->assign(num_cameras, CalibrationResult());
   std::vector<std::string> single_error(num_cameras);
   std::vector<char> single_ok(num_cameras, 0);
-  {
-    const int threads = std::max(
-        1, std::min<int>(copt.num_threads, static_cast<int>(num_cameras)));
-    std::vector<std::thread> workers;
-    for (int t = 0; t < threads; ++t) {
-      workers.emplace_back([&, t]() {
-        for (size_t c = t; c < num_cameras; c += threads) {
-          CalibrationOptions camera_options = copt;
-          camera_options.fixed_params.insert(
-              camera_options.fixed_params.end(),
-              cameras[c].fixed_params.begin(), cameras[c].fixed_params.end());
-          single_ok[c] = Calibrate(cameras[c].frames, cameras[c].model,
-                                   cameras[c].width, cameras[c].height,
-                                   camera_options, &single[c],
-                                   &single_error[c]);
-        }
-      });
-    }
-    for (std::thread& worker : workers) worker.join();
+  const int threads = std::max(
+      1, std::min<int>(options.num_threads, static_cast<int>(num_cameras)));
+  std::vector<std::thread> workers;
+  for (int t = 0; t < threads; ++t) {
+    workers.emplace_back([&, t]() {
+      for (size_t c = t; c < num_cameras; c += threads) {
+        CalibrationOptions camera_options = options;
+        camera_options.fixed_params.insert(camera_options.fixed_params.end(),
+                                           cameras[c].fixed_params.begin(),
+                                           cameras[c].fixed_params.end());
+        single_ok[c] = Calibrate(
+            cameras[c].frames, cameras[c].model, cameras[c].width,
+            cameras[c].height, camera_options, &(*single)[c], &single_error[c]);
+      }
+    });
   }
-  result->seconds_single = single_timer.Seconds();
+  for (std::thread& worker : workers) worker.join();
   for (size_t c = 0; c < num_cameras; ++c) {
-    result->cameras[c].single = single[c];
-    result->cameras[c].single_rms_px = single[c].rms_px;
-    result->cameras[c].single_views_used = single[c].num_views_used;
     if (!single_ok[c]) {
       return Fail("camera '" + cameras[c].name +
                       "' cannot be calibrated alone: " + single_error[c],
                   error);
     }
   }
-  const Timer joint_timer;
+  return true;
+}
 
-  // 2. Starting cam_from_rig: frames two cameras share, chained along the
-  // maximum spanning tree of shared frames from the reference camera.
+// Why the cameras outside `in_tree` cannot be placed in the rig.
+bool FailUnplacedCameras(const std::vector<RigCameraInput>& cameras,
+                         const std::vector<bool>& in_tree,
+                         const Eigen::MatrixXi& posed_shared,
+                         int min_shared_frames, std::string* error) {
+  const size_t num_cameras = cameras.size();
+  for (size_t c = 0; c < num_cameras; ++c) {
+    if (in_tree[c]) continue;
+    bool shares_any = false;
+    for (size_t o = 0; o < num_cameras; ++o) {
+      shares_any |= o != c && posed_shared(c, o) >= min_shared_frames;
+    }
+    if (!shares_any) {
+      return Fail("camera '" + cameras[c].name +
+                      "' shares no frame with any other camera (no instant "
+                      "at which it and another camera both see the board), "
+                      "so its place in the rig is undetermined: take photos "
+                      "in which it and a neighbouring camera see the board "
+                      "together",
+                  error);
+    }
+    std::vector<bool> outside(num_cameras);
+    for (size_t o = 0; o < num_cameras; ++o) outside[o] = !in_tree[o];
+    return Fail("cameras " + CameraList(cameras, outside) +
+                    " share no frame with the reference camera's group (" +
+                    CameraList(cameras, in_tree) +
+                    "), so their place in the rig is undetermined: take "
+                    "photos in which a camera of each group sees the board",
+                error);
+  }
+  return true;
+}
+
+// Stage 2: the starting cam_from_rig of every camera, from the frames two
+// cameras share, chained along the maximum spanning tree of shared frames
+// from the reference camera. `start_parent` receives each camera's parent
+// in that tree (-1 for the reference).
+bool StartCamFromRig(const std::vector<RigCameraInput>& cameras,
+                     const std::vector<CalibrationResult>& single,
+                     const RigCalibrationOptions& options,
+                     std::vector<Eigen::Isometry3d>* cam_from_rig,
+                     std::vector<int>* start_parent, std::string* error) {
+  const size_t num_cameras = cameras.size();
+  const size_t num_frames = cameras[0].frames.size();
   Eigen::MatrixXi posed_shared =
       Eigen::MatrixXi::Zero(num_cameras, num_cameras);
   for (size_t a = 0; a < num_cameras; ++a) {
@@ -540,8 +553,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
     }
   }
   std::vector<bool> in_tree(num_cameras, false);
-  std::vector<Eigen::Isometry3d> cam_from_rig(num_cameras,
-                                              Eigen::Isometry3d::Identity());
+  cam_from_rig->assign(num_cameras, Eigen::Isometry3d::Identity());
+  start_parent->assign(num_cameras, -1);
   in_tree[0] = true;
   for (;;) {
     int best_a = -1, best_b = -1, best_count = 0;
@@ -565,59 +578,42 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
                           single[best_a].cam_from_board[f].inverse());
       }
     }
-    cam_from_rig[best_b] =
+    (*cam_from_rig)[best_b] =
         RobustAverage(samples, options.max_start_rotation_deviation_deg) *
-        cam_from_rig[best_a];
-    result->start_parent[best_b] = best_a;
+        (*cam_from_rig)[best_a];
+    (*start_parent)[best_b] = best_a;
     in_tree[best_b] = true;
   }
-  for (size_t c = 0; c < num_cameras; ++c) {
-    if (in_tree[c]) continue;
-    const bool shares_any = [&]() {
-      for (size_t o = 0; o < num_cameras; ++o) {
-        if (o != c && posed_shared(c, o) >= options.min_shared_frames) {
-          return true;
-        }
-      }
-      return false;
-    }();
-    if (!shares_any) {
-      return Fail("camera '" + cameras[c].name +
-                      "' shares no frame with any other camera (no instant "
-                      "at which it and another camera both see the board), "
-                      "so its place in the rig is undetermined: take photos "
-                      "in which it and a neighbouring camera see the board "
-                      "together",
-                  error);
-    }
-    std::vector<bool> outside(num_cameras);
-    for (size_t o = 0; o < num_cameras; ++o) outside[o] = !in_tree[o];
-    return Fail("cameras " + CameraList(cameras, outside) +
-                    " share no frame with the reference camera's group (" +
-                    CameraList(cameras, in_tree) +
-                    "), so their place in the rig is undetermined: take "
-                    "photos in which a camera of each group sees the board",
-                error);
-  }
+  return FailUnplacedCameras(cameras, in_tree, posed_shared,
+                             options.min_shared_frames, error);
+}
 
-  // 3. Starting rig_from_board: from the camera that saw the most corners
-  // in the frame.
-  JointState state;
-  state.input = &cameras;
-  state.fixed.resize(num_cameras);
+// Stage 3: the joint state at its start. Intrinsics from each camera's own
+// calibration; rig_from_board of each frame from the camera that saw the
+// most corners in it; the (camera, frame) pairs and corners that take part:
+// finite corners that project with the starting state, at least
+// min_corners_per_view of them.
+void StartJointState(const std::vector<RigCameraInput>& cameras,
+                     const std::vector<CalibrationResult>& single,
+                     const std::vector<Eigen::Isometry3d>& cam_from_rig,
+                     int min_corners_per_view, JointState* state) {
+  const size_t num_cameras = cameras.size();
+  const size_t num_frames = cameras[0].frames.size();
+  state->input = &cameras;
+  state->fixed.resize(num_cameras);
   for (size_t c = 0; c < num_cameras; ++c) {
-    state.num_params.push_back(
+    state->num_params.push_back(
         static_cast<int>(single[c].camera.params.size()));
-    state.params_offset.push_back(state.global.size());
-    state.global.insert(state.global.end(), single[c].camera.params.begin(),
-                        single[c].camera.params.end());
-    state.extrinsics_offset.push_back(state.global.size());
+    state->params_offset.push_back(state->global.size());
+    state->global.insert(state->global.end(), single[c].camera.params.begin(),
+                         single[c].camera.params.end());
+    state->extrinsics_offset.push_back(state->global.size());
     const Pose pose = PoseFromIsometry(cam_from_rig[c]);
-    state.global.insert(state.global.end(), pose.begin(), pose.end());
-    state.fixed[c] = single[c].param_fixed;
+    state->global.insert(state->global.end(), pose.begin(), pose.end());
+    state->fixed[c] = single[c].param_fixed;
   }
-  state.rig_from_board.assign(num_frames, Pose{});
-  state.frame_posed.assign(num_frames, false);
+  state->rig_from_board.assign(num_frames, Pose{});
+  state->frame_posed.assign(num_frames, false);
   for (size_t f = 0; f < num_frames; ++f) {
     int best = -1;
     size_t best_corners = 0;
@@ -629,113 +625,144 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
       }
     }
     if (best < 0) continue;
-    state.rig_from_board[f] = PoseFromIsometry(cam_from_rig[best].inverse() *
-                                               single[best].cam_from_board[f]);
-    state.frame_posed[f] = true;
+    state->rig_from_board[f] = PoseFromIsometry(cam_from_rig[best].inverse() *
+                                                single[best].cam_from_board[f]);
+    state->frame_posed[f] = true;
   }
-
-  // Which (camera, frame) pairs and corners take part: finite corners that
-  // project with the starting state, at least min_corners_per_view of them.
-  state.used.assign(num_cameras, std::vector<bool>(num_frames, false));
-  state.valid.resize(num_cameras);
+  state->used.assign(num_cameras, std::vector<bool>(num_frames, false));
+  state->valid.resize(num_cameras);
   for (size_t c = 0; c < num_cameras; ++c) {
-    state.valid[c].resize(num_frames);
+    state->valid[c].resize(num_frames);
     for (size_t f = 0; f < num_frames; ++f) {
       const CalibrationView& view = cameras[c].frames[f];
       const size_t n = view.board_points.size();
-      state.valid[c][f].assign(n, false);
-      if (!state.frame_posed[f] || view.image_points.size() != n) continue;
+      state->valid[c][f].assign(n, false);
+      if (!state->frame_posed[f] || view.image_points.size() != n) continue;
       int good = 0;
       for (size_t i = 0; i < n; ++i) {
         Eigen::Vector2d r;
         const bool ok = view.board_points[i].allFinite() &&
                         view.image_points[i].allFinite() &&
-                        Residual(state, c, f, i, &r);
-        state.valid[c][f][i] = ok;
+                        Residual(*state, c, f, i, &r);
+        state->valid[c][f][i] = ok;
         good += ok ? 1 : 0;
       }
-      state.used[c][f] = good >= copt.min_corners_per_view;
+      state->used[c][f] = good >= min_corners_per_view;
     }
   }
-  state.inlier = state.valid;
+  state->inlier = state->valid;
+}
 
-  // 4. Joint solves with k-sigma outlier rejection per camera.
+// The residual of every valid corner of every used (camera, frame);
+// `projects` is false (and the residual NaN) where the corner does not
+// project with the current state.
+void ComputeJointResiduals(const JointState& state, CornerResiduals* residuals,
+                           CornerFlags* projects) {
+  const std::vector<RigCameraInput>& cameras = *state.input;
+  const size_t num_cameras = cameras.size();
+  const size_t num_frames = cameras[0].frames.size();
+  residuals->assign(num_cameras, {});
+  projects->assign(num_cameras, {});
+  for (size_t c = 0; c < num_cameras; ++c) {
+    (*residuals)[c].assign(num_frames, {});
+    (*projects)[c].assign(num_frames, {});
+    for (size_t f = 0; f < num_frames; ++f) {
+      if (!state.used[c][f]) continue;
+      const size_t n = cameras[c].frames[f].board_points.size();
+      (*residuals)[c][f].assign(n, Eigen::Vector2d::Zero());
+      (*projects)[c][f].assign(n, false);
+      for (size_t i = 0; i < n; ++i) {
+        if (!state.valid[c][f][i]) continue;
+        Eigen::Vector2d r;
+        if (Residual(state, c, f, i, &r)) {
+          (*residuals)[c][f][i] = r;
+          (*projects)[c][f][i] = true;
+        } else {
+          (*residuals)[c][f][i].setConstant(
+              std::numeric_limits<double>::quiet_NaN());
+        }
+      }
+    }
+  }
+}
+
+// One round of k-sigma rejection per camera (the threshold from the MAD of
+// that camera's residual coordinates, with a floor); a (camera, frame) left
+// with too few corners drops out. True when any inlier flag changed.
+bool RejectJointOutliers(const CornerResiduals& residuals,
+                         const CornerFlags& projects,
+                         const CalibrationOptions& options, JointState* state) {
+  bool changed = false;
+  for (size_t c = 0; c < residuals.size(); ++c) {
+    std::vector<double> magnitudes;
+    for (size_t f = 0; f < residuals[c].size(); ++f) {
+      for (size_t i = 0; i < residuals[c][f].size(); ++i) {
+        if (!projects[c][f][i]) continue;
+        magnitudes.push_back(std::abs(residuals[c][f][i].x()));
+        magnitudes.push_back(std::abs(residuals[c][f][i].y()));
+      }
+    }
+    const double threshold =
+        std::max(options.outlier_k * 1.4826 * Median(magnitudes),
+                 options.min_outlier_threshold_px);
+    for (size_t f = 0; f < residuals[c].size(); ++f) {
+      if (!state->used[c][f]) continue;
+      int kept = 0;
+      for (size_t i = 0; i < residuals[c][f].size(); ++i) {
+        const bool keep =
+            projects[c][f][i] && residuals[c][f][i].norm() <= threshold;
+        changed |= keep != state->inlier[c][f][i];
+        state->inlier[c][f][i] = keep;
+        kept += keep ? 1 : 0;
+      }
+      if (kept < options.min_corners_per_view) {
+        state->used[c][f] = false;
+        std::fill(state->inlier[c][f].begin(), state->inlier[c][f].end(),
+                  false);
+        changed = true;
+      }
+    }
+  }
+  return changed;
+}
+
+// Stage 4: joint solves, each followed by a rejection round, until no
+// inlier changes or the round limit is reached.
+struct JointSolveRun {
   std::unique_ptr<ceres::LossFunction> loss;
   SolveOutcome outcome;
+  CornerResiduals residuals;
+  CornerFlags projects;
   int iterations = 0;
-  SolveJoint(&state, copt, &loss, &outcome);
-  iterations += static_cast<int>(outcome.summary.iterations.size());
-  std::vector<std::vector<std::vector<Eigen::Vector2d>>> residuals(num_cameras);
-  std::vector<std::vector<std::vector<bool>>> projects(num_cameras);
-  auto compute_residuals = [&]() {
-    for (size_t c = 0; c < num_cameras; ++c) {
-      residuals[c].assign(num_frames, {});
-      projects[c].assign(num_frames, {});
-      for (size_t f = 0; f < num_frames; ++f) {
-        if (!state.used[c][f]) continue;
-        const size_t n = cameras[c].frames[f].board_points.size();
-        residuals[c][f].assign(n, Eigen::Vector2d::Zero());
-        projects[c][f].assign(n, false);
-        for (size_t i = 0; i < n; ++i) {
-          if (!state.valid[c][f][i]) continue;
-          Eigen::Vector2d r;
-          if (Residual(state, c, f, i, &r)) {
-            residuals[c][f][i] = r;
-            projects[c][f][i] = true;
-          } else {
-            residuals[c][f][i].setConstant(
-                std::numeric_limits<double>::quiet_NaN());
-          }
-        }
-      }
-    }
-  };
-  compute_residuals();
   int rounds = 0;
-  while (copt.outlier_k > 0 && rounds < copt.outlier_iterations &&
-         outcome.summary.IsSolutionUsable()) {
-    bool changed = false;
-    for (size_t c = 0; c < num_cameras; ++c) {
-      std::vector<double> magnitudes;
-      for (size_t f = 0; f < num_frames; ++f) {
-        for (size_t i = 0; i < residuals[c][f].size(); ++i) {
-          if (!projects[c][f][i]) continue;
-          magnitudes.push_back(std::abs(residuals[c][f][i].x()));
-          magnitudes.push_back(std::abs(residuals[c][f][i].y()));
-        }
-      }
-      const double threshold =
-          std::max(copt.outlier_k * 1.4826 * Median(magnitudes),
-                   copt.min_outlier_threshold_px);
-      for (size_t f = 0; f < num_frames; ++f) {
-        if (!state.used[c][f]) continue;
-        int kept = 0;
-        for (size_t i = 0; i < residuals[c][f].size(); ++i) {
-          const bool keep =
-              projects[c][f][i] && residuals[c][f][i].norm() <= threshold;
-          changed |= keep != state.inlier[c][f][i];
-          state.inlier[c][f][i] = keep;
-          kept += keep ? 1 : 0;
-        }
-        if (kept < copt.min_corners_per_view) {
-          state.used[c][f] = false;
-          std::fill(state.inlier[c][f].begin(), state.inlier[c][f].end(),
-                    false);
-          changed = true;
-        }
-      }
-    }
-    if (!changed) break;
-    ++rounds;
-    SolveJoint(&state, copt, &loss, &outcome);
-    iterations += static_cast<int>(outcome.summary.iterations.size());
-    compute_residuals();
-  }
+};
 
-  // 5. The result.
-  result->outlier_rounds = rounds;
-  result->iterations = iterations;
-  result->termination = outcome.summary.message;
+void SolveWithOutlierRejection(const CalibrationOptions& options,
+                               JointState* state, JointSolveRun* run) {
+  SolveJoint(state, options, &run->loss, &run->outcome);
+  run->iterations += static_cast<int>(run->outcome.summary.iterations.size());
+  ComputeJointResiduals(*state, &run->residuals, &run->projects);
+  while (options.outlier_k > 0 && run->rounds < options.outlier_iterations &&
+         run->outcome.summary.IsSolutionUsable()) {
+    if (!RejectJointOutliers(run->residuals, run->projects, options, state)) {
+      break;
+    }
+    ++run->rounds;
+    SolveJoint(state, options, &run->loss, &run->outcome);
+    run->iterations += static_cast<int>(run->outcome.summary.iterations.size());
+    ComputeJointResiduals(*state, &run->residuals, &run->projects);
+  }
+}
+
+// Stage 5: the per-camera and rig-wide figures of the final state. Returns
+// the sum of squared inlier residuals over all cameras.
+double FillRigResult(const JointState& state, const JointSolveRun& run,
+                     RigCalibrationResult* result) {
+  const size_t num_cameras = result->cameras.size();
+  const size_t num_frames = result->frame_used.size();
+  result->outlier_rounds = run.rounds;
+  result->iterations = run.iterations;
+  result->termination = run.outcome.summary.message;
   double sum2_all = 0;
   int corners_all = 0, outliers_all = 0;
   for (size_t c = 0; c < num_cameras; ++c) {
@@ -746,7 +773,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
     out.cam_from_rig = IsometryFromPose(state.cam_from_rig(c));
     if (c == 0) out.cam_from_rig = Eigen::Isometry3d::Identity();
     out.frame_used = state.used[c];
-    out.residuals = residuals[c];
+    out.residuals = run.residuals[c];
     out.inlier.resize(num_frames);
     double sum2 = 0;
     for (size_t f = 0; f < num_frames; ++f) {
@@ -756,9 +783,9 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
       if (!state.used[c][f]) continue;
       ++out.num_frames_used;
       result->frame_used[f] = true;
-      for (size_t i = 0; i < residuals[c][f].size(); ++i) {
+      for (size_t i = 0; i < run.residuals[c][f].size(); ++i) {
         if (state.inlier[c][f][i]) {
-          sum2 += residuals[c][f][i].squaredNorm();
+          sum2 += run.residuals[c][f][i].squaredNorm();
           ++out.num_corners_used;
         } else if (state.valid[c][f][i]) {
           ++out.num_outliers;
@@ -792,79 +819,87 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
   result->num_outliers = outliers_all;
   result->rms_px =
       corners_all > 0 ? std::sqrt(sum2_all / (2.0 * corners_all)) : 0.0;
+  return sum2_all;
+}
 
-  // Covariance, scaled by the residual variance.
-  if (copt.compute_covariance && outcome.problem &&
-      outcome.summary.IsSolutionUsable()) {
-    GlobalLayout layout;
-    Eigen::MatrixXd covariance;
-    if (JointMarginalCovariance(state, &outcome,
-                                copt.covariance_min_eigenvalue_ratio, &layout,
-                                &covariance)) {
-      const int free_params =
-          layout.size + kPoseBlockSize * result->num_frames_used;
-      if (2 * corners_all > free_params) {
-        const double variance = sum2_all / (2.0 * corners_all - free_params);
-        covariance *= variance;
-        result->covariance_ok = true;
-        for (size_t c = 0; c < num_cameras; ++c) {
-          RigCameraResult& out = result->cameras[c];
-          if (layout.params_begin[c] >= 0) {
-            int index = layout.params_begin[c];
-            for (int k = 0; k < state.num_params[c]; ++k) {
-              if (state.fixed[c][k]) continue;
-              out.param_stddev[k] =
-                  std::sqrt(std::max(0.0, covariance(index, index)));
-              ++index;
-            }
-          }
-          if (layout.extrinsics_begin[c] >= 0) {
-            const int e = layout.extrinsics_begin[c];
-            out.extrinsics_covariance = covariance.block<6, 6>(e, e);
-            const Eigen::Matrix<double, 3, 6> jr =
-                RotationJacobian(state.CamFromRig(c));
-            out.rotation_stddev_deg =
-                std::sqrt(std::max(
-                    0.0, (jr * out.extrinsics_covariance * jr.transpose())
-                             .trace())) /
-                kDegree;
-            for (int k = 0; k < 3; ++k) {
-              out.translation_stddev_m(k) = std::sqrt(
-                  std::max(0.0, out.extrinsics_covariance(3 + k, 3 + k)));
-            }
-            Eigen::Matrix<double, 1, 6> g;
-            Baseline(state.CamFromRig(c), &g);
-            out.baseline_stddev_m = std::sqrt(std::max(
-                0.0, (g * out.extrinsics_covariance * g.transpose())(0, 0)));
-          }
-        }
+// Stage 6: σ of every free intrinsic and of each cam_from_rig (rotation in
+// degrees, translation, baseline), from the joint covariance scaled by the
+// residual variance (from `sum2_all`, the sum of squared inlier residuals).
+// Leaves covariance_ok false when it is singular.
+void FillRigCovariance(const JointState& state, double sum2_all,
+                       double min_eigenvalue_ratio, SolveOutcome* outcome,
+                       RigCalibrationResult* result) {
+  GlobalLayout layout;
+  Eigen::MatrixXd covariance;
+  if (!JointMarginalCovariance(state, outcome, min_eigenvalue_ratio, &layout,
+                               &covariance)) {
+    return;
+  }
+  const int corners_all = result->num_corners_used;
+  const int free_params =
+      layout.size + kPoseBlockSize * result->num_frames_used;
+  if (2 * corners_all <= free_params) return;
+  covariance *= sum2_all / (2.0 * corners_all - free_params);
+  result->covariance_ok = true;
+  for (size_t c = 0; c < result->cameras.size(); ++c) {
+    RigCameraResult& out = result->cameras[c];
+    if (layout.params_begin[c] >= 0) {
+      int index = layout.params_begin[c];
+      for (int k = 0; k < state.num_params[c]; ++k) {
+        if (state.fixed[c][k]) continue;
+        out.param_stddev[k] =
+            std::sqrt(std::max(0.0, covariance(index, index)));
+        ++index;
       }
     }
+    if (layout.extrinsics_begin[c] < 0) continue;
+    const int e = layout.extrinsics_begin[c];
+    out.extrinsics_covariance = covariance.block<6, 6>(e, e);
+    const Eigen::Matrix<double, 3, 6> jr =
+        RotationJacobian(state.CamFromRig(c));
+    out.rotation_stddev_deg =
+        std::sqrt(std::max(
+            0.0, (jr * out.extrinsics_covariance * jr.transpose()).trace())) /
+        kDegree;
+    for (int k = 0; k < 3; ++k) {
+      out.translation_stddev_m(k) =
+          std::sqrt(std::max(0.0, out.extrinsics_covariance(3 + k, 3 + k)));
+    }
+    Eigen::Matrix<double, 1, 6> g;
+    Baseline(state.CamFromRig(c), &g);
+    out.baseline_stddev_m = std::sqrt(
+        std::max(0.0, (g * out.extrinsics_covariance * g.transpose())(0, 0)));
   }
-  result->seconds_joint = joint_timer.Seconds();
+}
 
-  if (!outcome.summary.IsSolutionUsable()) {
-    return Fail(
-        "the joint bundle adjustment failed: " + outcome.summary.message,
-        error);
+// Stage 7: a result the user can rely on, or the reason it is not one:
+// the solve converged, every camera still reaches the reference through
+// shared frames after outlier rejection, every RMS is within its limit and
+// every free focal length is determined.
+bool CheckRigResult(const std::vector<RigCameraInput>& cameras,
+                    const ceres::Solver::Summary& summary,
+                    const CalibrationOptions& options,
+                    const RigCalibrationResult& result, std::string* error) {
+  if (!summary.IsSolutionUsable()) {
+    return Fail("the joint bundle adjustment failed: " + summary.message,
+                error);
   }
-  if (outcome.summary.termination_type == ceres::NO_CONVERGENCE) {
+  if (summary.termination_type == ceres::NO_CONVERGENCE) {
     return Fail("the joint bundle adjustment did not converge within " +
-                    std::to_string(copt.max_iterations) + " iterations (RMS " +
-                    StringPrintf("%.3f", result->rms_px) +
+                    std::to_string(options.max_iterations) +
+                    " iterations (RMS " + StringPrintf("%.3f", result.rms_px) +
                     " px): raise the iteration limit or check the "
                     "correspondences",
                 error);
   }
-  // Outlier rejection may have taken a camera out of every frame it shared:
-  // every camera must still reach the reference through shared frames.
+  const size_t num_cameras = cameras.size();
   std::vector<bool> reached(num_cameras, false);
   reached[0] = true;
   for (bool grew = true; grew;) {
     grew = false;
     for (size_t a = 0; a < num_cameras; ++a) {
       for (size_t b = 0; b < num_cameras; ++b) {
-        if (reached[a] && !reached[b] && result->shared_frames(a, b) > 0) {
+        if (reached[a] && !reached[b] && result.shared_frames(a, b) > 0) {
           reached[b] = true;
           grew = true;
         }
@@ -881,22 +916,21 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
                   error);
     }
   }
-  for (size_t c = 0; c < num_cameras; ++c) {
-    const RigCameraResult& out = result->cameras[c];
-    if (!(out.rms_px <= copt.max_rms_px)) {
+  for (const RigCameraResult& out : result.cameras) {
+    if (!(out.rms_px <= options.max_rms_px)) {
       return Fail("camera '" + out.name +
                       "': the reprojection RMS of the "
                       "joint solve is " +
                       StringPrintf("%.2f", out.rms_px) + " px (limit " +
-                      StringPrintf("%.2f", copt.max_rms_px) +
+                      StringPrintf("%.2f", options.max_rms_px) +
                       " px): the frames of the folders may not be the same "
                       "instants, or the rig moved between photos",
                   error);
     }
     for (int k = 0; k < 2; ++k) {
-      if (result->covariance_ok && !out.param_fixed[k] &&
-          !(out.param_stddev[k] <=
-            copt.max_focal_relative_stddev * std::abs(out.camera.params[k]))) {
+      if (result.covariance_ok && !out.param_fixed[k] &&
+          !(out.param_stddev[k] <= options.max_focal_relative_stddev *
+                                       std::abs(out.camera.params[k]))) {
         return Fail("camera '" + out.name +
                         "': the frames do not determine the focal length (" +
                         StringPrintf("%.1f", out.camera.params[k]) + " +- " +
@@ -907,6 +941,77 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
     }
   }
   return true;
+}
+
+}  // namespace
+
+double RotationDifferenceDeg(const Eigen::Matrix3d& a,
+                             const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a * b.transpose()).angle() / kDegree;
+}
+
+bool RigCalibrationOptions::Check(std::string* why) const {
+  if (min_shared_frames < 1) {
+    return Fail("min_shared_frames must be >= 1", why);
+  }
+  if (!(max_start_rotation_deviation_deg > 0)) {
+    return Fail("max_start_rotation_deviation_deg must be > 0", why);
+  }
+  return camera.Check(why);
+}
+
+bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
+                  const RigCalibrationOptions& options,
+                  RigCalibrationResult* result, std::string* error) {
+  *result = RigCalibrationResult();
+  std::string why;
+  if (!options.Check(&why))
+    return Fail("rig calibration options: " + why, error);
+  if (!CheckRigInput(cameras, error)) return false;
+  const size_t num_cameras = cameras.size();
+  const size_t num_frames = cameras[0].frames.size();
+  const CalibrationOptions& copt = options.camera;
+  result->cameras.resize(num_cameras);
+  result->frame_used.assign(num_frames, false);
+  result->rig_from_board.assign(num_frames, Eigen::Isometry3d::Identity());
+  result->shared_frames = Eigen::MatrixXi::Zero(num_cameras, num_cameras);
+  for (size_t c = 0; c < num_cameras; ++c) {
+    result->cameras[c].name = cameras[c].name;
+    result->cameras[c].camera.model = cameras[c].model;
+    result->cameras[c].camera.width = cameras[c].width;
+    result->cameras[c].camera.height = cameras[c].height;
+  }
+
+  const Timer single_timer;
+  std::vector<CalibrationResult> single;
+  const bool single_ok = CalibrateEachCamera(cameras, copt, &single, error);
+  result->seconds_single = single_timer.Seconds();
+  for (size_t c = 0; c < num_cameras && c < single.size(); ++c) {
+    result->cameras[c].single = single[c];
+    result->cameras[c].single_rms_px = single[c].rms_px;
+    result->cameras[c].single_views_used = single[c].num_views_used;
+  }
+  if (!single_ok) return false;
+
+  const Timer joint_timer;
+  std::vector<Eigen::Isometry3d> cam_from_rig;
+  if (!StartCamFromRig(cameras, single, options, &cam_from_rig,
+                       &result->start_parent, error)) {
+    return false;
+  }
+  JointState state;
+  StartJointState(cameras, single, cam_from_rig, copt.min_corners_per_view,
+                  &state);
+  JointSolveRun run;
+  SolveWithOutlierRejection(copt, &state, &run);
+  const double sum2_all = FillRigResult(state, run, result);
+  if (copt.compute_covariance && run.outcome.problem &&
+      run.outcome.summary.IsSolutionUsable()) {
+    FillRigCovariance(state, sum2_all, copt.covariance_min_eigenvalue_ratio,
+                      &run.outcome, result);
+  }
+  result->seconds_joint = joint_timer.Seconds();
+  return CheckRigResult(cameras, run.outcome.summary, copt, *result, error);
 }
 
 std::string RigCalibrationReport(const RigCalibrationResult& result) {

@@ -199,241 +199,246 @@ cv::Mat RenderBoard(const Board& board, const Camera& camera,
                      summary);
 }
 
-cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
-                    const Eigen::Isometry3d& cam_from_board,
-                    const RenderOptions& options, RenderTruth* truth,
-                    RenderSummary* summary) {
-  RenderSummary local_summary;
-  if (summary == nullptr) summary = &local_summary;
-  *summary = RenderSummary();
-  std::string why;
-  if (!options.Check(&why)) return Fail(summary, "render options: " + why);
-  if (!board.Check(&why)) return Fail(summary, "board: " + why);
-  if (rays.empty()) {
-    return Fail(summary, "pixel rays were not computed (unusable camera)");
+namespace {
+
+// Shades the board as the camera sees it, one pixel at a time, in linear
+// grey (before lighting, gamma and noise). Holds what every pixel shares:
+// the camera's place in the board frame (lengths in tiles), the pattern and
+// the supersampling grid.
+class BoardShader {
+ public:
+  BoardShader(const Board& board, const PixelRayGrid& rays,
+              const Eigen::Isometry3d& cam_from_board,
+              const RenderOptions& options)
+      : rays_(rays),
+        options_(options),
+        board_from_cam_rotation_(cam_from_board.linear().transpose()),
+        center_(-(board_from_cam_rotation_ * cam_from_board.translation()) /
+                board.tile_size_m),
+        // A non-central camera's rays start at (0, 0, OriginZ) in the
+        // camera frame: center + OriginZ * axis in the board frame (tiles).
+        axis_(board_from_cam_rotation_.col(2) / board.tile_size_m),
+        pattern_(board, options.variant, options.paper_margin_tiles),
+        black_value_(center_.z() < 0 ? options.black_level
+                                     : options.white_level) {
+    sub_.n = options.supersampling;
+    for (int i = 0; i < sub_.n; ++i) sub_.offset[i] = (i + 0.5) / sub_.n;
+    inv_samples_ = 1.0 / (sub_.n * sub_.n);
   }
-  if (!PoseIsValid(cam_from_board, &why)) return Fail(summary, why);
 
-  const Camera& camera = rays.camera();
-  const int width = camera.width, height = camera.height;
+  // The linear grey of pixel (x, y); `on_board` is set when its centre sees
+  // the board, `has_ray` when the model has a ray at each of its corners.
+  // `row_occluders` are the occluders that reach row y.
+  float Shade(int x, int y, const std::vector<const Occluder*>& row_occluders,
+              bool* on_board, bool* has_ray_out) const {
+    *on_board = false;
+    const double* corner_rays[4] = {rays_.Ray(x, y), rays_.Ray(x + 1, y),
+                                    rays_.Ray(x, y + 1),
+                                    rays_.Ray(x + 1, y + 1)};
+    bool has_ray = true;
+    Eigen::Vector3d b[4], c[4];  // corner ray directions and origins
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Map<const Eigen::Vector3d> r(corner_rays[k]);
+      if (!r.allFinite()) has_ray = false;
+      b[k] = board_from_cam_rotation_ * r;
+      c[k] = rays_.central()
+                 ? center_
+                 : center_ + rays_.OriginZ(x + k % 2, y + k / 2) * axis_;
+    }
+    *has_ray_out = has_ray;
+    // Where the pixel's corner rays meet the board plane (tiles).
+    Eigen::Vector2d hit[4];
+    int num_hits = 0;
+    for (int k = 0; k < 4 && has_ray; ++k) {
+      if (!(b[k].z() * c[k].z() < 0)) continue;
+      const double t = -c[k].z() / b[k].z();
+      hit[k] = c[k].head<2>() + t * b[k].head<2>();
+      ++num_hits;
+    }
+    const bool all_hit = has_ray && num_hits == 4;
+    const bool may_be_occluded =
+        !row_occluders.empty() && PixelMayBeOccluded(row_occluders, x, y);
+    // Sub-pixel rays are convex combinations of the corner rays, so when
+    // no corner ray heads towards the plane none does; without rays the
+    // model sees nothing. Either way the pixel is background.
+    if ((!has_ray || num_hits == 0) && !may_be_occluded) {
+      return static_cast<float>(options_.background_level);
+    }
+    // Board-plane footprint of one sample step (zero = hard samples when
+    // a corner ray misses the plane).
+    Eigen::Matrix2d footprint = Eigen::Matrix2d::Zero();
+    if (all_hit) {
+      footprint.col(0) = 0.5 * ((hit[1] - hit[0]) + (hit[3] - hit[2]));
+      footprint.col(1) = 0.5 * ((hit[2] - hit[0]) + (hit[3] - hit[1]));
+      float value;
+      if (!may_be_occluded &&
+          ShadeSimplePixel(b, c, hit, footprint, &value, on_board)) {
+        return value;
+      }
+      footprint /= sub_.n;
+    }
+    const float value = static_cast<float>(
+        SupersamplePixel(x, y, b, c, has_ray, footprint, row_occluders));
+    if (all_hit) {
+      const Eigen::Vector2d mid = 0.25 * (hit[0] + hit[1] + hit[2] + hit[3]);
+      *on_board = pattern_.Sample(mid.x(), mid.y()) != BoardInk::kNone;
+    }
+    return value;
+  }
 
-  // Camera centre and rotation in the board frame, lengths in tiles.
-  const Eigen::Matrix3d board_from_cam_rotation =
-      cam_from_board.linear().transpose();
-  const Eigen::Vector3d center =
-      -(board_from_cam_rotation * cam_from_board.translation()) /
-      board.tile_size_m;
-  const bool sees_print = center.z() < 0;
-  // A non-central camera's rays start at (0, 0, OriginZ) in the camera
-  // frame: center + OriginZ * axis in the board frame (tiles).
-  const Eigen::Vector3d axis =
-      board_from_cam_rotation.col(2) / board.tile_size_m;
-
-  const BoardPattern pattern(board, options.variant,
-                             options.paper_margin_tiles);
-  SubGrid sub;
-  sub.n = options.supersampling;
-  for (int i = 0; i < sub.n; ++i) sub.offset[i] = (i + 0.5) / sub.n;
-  const double inv_samples = 1.0 / (sub.n * sub.n);
-
-  const double black_value =
-      sees_print ? options.black_level : options.white_level;
-  auto ink_value = [&](BoardInk ink) {
+ private:
+  double InkValue(BoardInk ink) const {
     switch (ink) {
       case BoardInk::kBlack:
-        return black_value;
+        return black_value_;
       case BoardInk::kWhite:
       case BoardInk::kPaper:
-        return options.white_level;
+        return options_.white_level;
       case BoardInk::kNone:
         break;
     }
-    return options.background_level;
-  };
-  auto mix_value = [&](const InkMix& mix) {
-    return mix.black * black_value + mix.white * options.white_level +
-           mix.none * options.background_level;
-  };
+    return options_.background_level;
+  }
 
-  cv::Mat1f linear(height, width);
-  std::vector<int> no_ray_per_row(height, 0), on_board_per_row(height, 0);
-  const std::vector<Occluder>& occluders = options.occluders;
+  double MixValue(const InkMix& mix) const {
+    return mix.black * black_value_ + mix.white * options_.white_level +
+           mix.none * options_.background_level;
+  }
 
-  // Rows are independent: the same image for any thread count.
-  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
-    std::vector<const Occluder*> row_occluders;
-    row_occluders.reserve(occluders.size());
-    for (int y = range.start; y < range.end; ++y) {
-      row_occluders.clear();
-      for (const Occluder& o : occluders) {
-        if (std::abs(o.center_px.y() - y) <= o.radius_px + 0.5) {
-          row_occluders.push_back(&o);
+  // Most pixels see one ink only, or one straight edge: shade them without
+  // supersamples. False when the pixel needs them. The box of the corner
+  // hits is padded for the curvature of distorted pixel footprints.
+  bool ShadeSimplePixel(const Eigen::Vector3d b[4], const Eigen::Vector3d c[4],
+                        const Eigen::Vector2d hit[4],
+                        const Eigen::Matrix2d& footprint, float* value,
+                        bool* on_board) const {
+    Eigen::Vector2d lo = hit[0], hi = hit[0];
+    for (int k = 1; k < 4; ++k) {
+      lo = lo.cwiseMin(hit[k]);
+      hi = hi.cwiseMax(hit[k]);
+    }
+    const Eigen::Vector2d pad = 0.25 * (hi - lo);
+    lo -= pad;
+    hi += pad;
+    const BoardPattern::BoxContent content =
+        pattern_.Classify(lo.x(), lo.y(), hi.x(), hi.y());
+    // Where the pixel centre's ray meets the plane (the centre ray heads
+    // towards it: it is a mean of the corner rays).
+    const Eigen::Vector3d d_mid = 0.25 * (b[0] + b[1] + b[2] + b[3]);
+    const Eigen::Vector3d c_mid = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+    const Eigen::Vector2d mid =
+        c_mid.head<2>() + (-c_mid.z() / d_mid.z()) * d_mid.head<2>();
+    if (content == BoardPattern::BoxContent::kUniform) {
+      const BoardInk ink = pattern_.Sample(mid.x(), mid.y());
+      *value = static_cast<float>(InkValue(ink));
+      *on_board = ink != BoardInk::kNone;
+      return true;
+    }
+    if (content == BoardPattern::BoxContent::kOneEdge) {
+      // One straight edge: the exact coverage of the whole pixel's
+      // footprint needs no supersamples.
+      *value = static_cast<float>(
+          MixValue(pattern_.SampleArea(mid.x(), mid.y(), footprint)));
+      *on_board = true;
+      return true;
+    }
+    return false;
+  }
+
+  // The mean of the pixel's n x n sub-pixel rays (occluders, background
+  // where a ray misses the plane or the model has no ray).
+  double SupersamplePixel(
+      int x, int y, const Eigen::Vector3d b[4], const Eigen::Vector3d c[4],
+      bool has_ray, const Eigen::Matrix2d& footprint,
+      const std::vector<const Occluder*>& row_occluders) const {
+    double sum = 0.0;
+    for (int j = 0; j < sub_.n; ++j) {
+      const double wy = sub_.offset[j];
+      const Eigen::Vector3d left = b[0] + wy * (b[2] - b[0]);
+      const Eigen::Vector3d right = b[1] + wy * (b[3] - b[1]);
+      const Eigen::Vector3d step = right - left;
+      const Eigen::Vector3d origin_left = c[0] + wy * (c[2] - c[0]);
+      const Eigen::Vector3d origin_step =
+          c[1] + wy * (c[3] - c[1]) - origin_left;
+      for (int i = 0; i < sub_.n; ++i) {
+        const double wx = sub_.offset[i];
+        bool occluded = false;
+        for (const Occluder* o : row_occluders) {
+          const double dx = x - 0.5 + wx - o->center_px.x();
+          const double dy = y - 0.5 + wy - o->center_px.y();
+          if (dx * dx + dy * dy < o->radius_px * o->radius_px) {
+            sum += o->grey;
+            occluded = true;
+            break;
+          }
         }
-      }
-      float* out = linear.ptr<float>(y);
-      for (int x = 0; x < width; ++x) {
-        const double* corner_rays[4] = {rays.Ray(x, y), rays.Ray(x + 1, y),
-                                        rays.Ray(x, y + 1),
-                                        rays.Ray(x + 1, y + 1)};
-        bool has_ray = true;
-        Eigen::Vector3d b[4], c[4];  // corner ray directions and origins
-        for (int k = 0; k < 4; ++k) {
-          const Eigen::Map<const Eigen::Vector3d> r(corner_rays[k]);
-          if (!r.allFinite()) has_ray = false;
-          b[k] = board_from_cam_rotation * r;
-          c[k] = rays.central()
-                     ? center
-                     : center + rays.OriginZ(x + k % 2, y + k / 2) * axis;
-        }
-        if (!has_ray) ++no_ray_per_row[y];
-        // Where the pixel's corner rays meet the board plane (tiles).
-        Eigen::Vector2d hit[4];
-        int num_hits = 0;
-        for (int k = 0; k < 4 && has_ray; ++k) {
-          if (!(b[k].z() * c[k].z() < 0)) continue;
-          const double t = -c[k].z() / b[k].z();
-          hit[k] = c[k].head<2>() + t * b[k].head<2>();
-          ++num_hits;
-        }
-        const bool all_hit = has_ray && num_hits == 4;
-        // Sub-pixel rays are convex combinations of the corner rays, so when
-        // no corner ray heads towards the plane none does; without rays the
-        // model sees nothing. Either way the pixel is background.
-        if ((!has_ray || num_hits == 0) &&
-            (row_occluders.empty() ||
-             !PixelMayBeOccluded(row_occluders, x, y))) {
-          out[x] = static_cast<float>(options.background_level);
+        if (occluded) continue;
+        if (!has_ray) {
+          sum += options_.background_level;
           continue;
         }
-        // Board-plane footprint of one sample step (zero = hard samples when
-        // a corner ray misses the plane).
-        Eigen::Matrix2d footprint = Eigen::Matrix2d::Zero();
-        if (all_hit) {
-          footprint.col(0) = 0.5 * ((hit[1] - hit[0]) + (hit[3] - hit[2]));
-          footprint.col(1) = 0.5 * ((hit[2] - hit[0]) + (hit[3] - hit[1]));
-          // Most pixels see one ink only: shade them once. The box of the
-          // corner hits is padded for the curvature of distorted pixel
-          // footprints.
-          if (row_occluders.empty() ||
-              !PixelMayBeOccluded(row_occluders, x, y)) {
-            Eigen::Vector2d lo = hit[0], hi = hit[0];
-            for (int k = 1; k < 4; ++k) {
-              lo = lo.cwiseMin(hit[k]);
-              hi = hi.cwiseMax(hit[k]);
-            }
-            const Eigen::Vector2d pad = 0.25 * (hi - lo);
-            lo -= pad;
-            hi += pad;
-            const BoardPattern::BoxContent content =
-                pattern.Classify(lo.x(), lo.y(), hi.x(), hi.y());
-            // Where the pixel centre's ray meets the plane (the centre
-            // ray heads towards it: it is a mean of the corner rays).
-            const Eigen::Vector3d d_mid = 0.25 * (b[0] + b[1] + b[2] + b[3]);
-            const Eigen::Vector3d c_mid = 0.25 * (c[0] + c[1] + c[2] + c[3]);
-            const Eigen::Vector2d mid =
-                c_mid.head<2>() + (-c_mid.z() / d_mid.z()) * d_mid.head<2>();
-            if (content == BoardPattern::BoxContent::kUniform) {
-              const BoardInk ink = pattern.Sample(mid.x(), mid.y());
-              out[x] = static_cast<float>(ink_value(ink));
-              if (ink != BoardInk::kNone) ++on_board_per_row[y];
-              continue;
-            }
-            if (content == BoardPattern::BoxContent::kOneEdge) {
-              // One straight edge: the exact coverage of the whole pixel's
-              // footprint needs no supersamples.
-              out[x] = static_cast<float>(
-                  mix_value(pattern.SampleArea(mid.x(), mid.y(), footprint)));
-              ++on_board_per_row[y];
-              continue;
-            }
-          }
-          footprint /= sub.n;
+        const Eigen::Vector3d d = left + wx * step;
+        const Eigen::Vector3d o = origin_left + wx * origin_step;
+        // The ray meets the plane z = 0 in front of the camera only when
+        // it heads towards it.
+        if (!(d.z() * o.z() < 0)) {
+          sum += options_.background_level;
+          continue;
         }
-        double sum = 0.0;
-        for (int j = 0; j < sub.n; ++j) {
-          const double wy = sub.offset[j];
-          const Eigen::Vector3d left = b[0] + wy * (b[2] - b[0]);
-          const Eigen::Vector3d right = b[1] + wy * (b[3] - b[1]);
-          const Eigen::Vector3d step = right - left;
-          const Eigen::Vector3d origin_left = c[0] + wy * (c[2] - c[0]);
-          const Eigen::Vector3d origin_step =
-              c[1] + wy * (c[3] - c[1]) - origin_left;
-          for (int i = 0; i < sub.n; ++i) {
-            const double wx = sub.offset[i];
-            bool occluded = false;
-            for (const Occluder* o : row_occluders) {
-              const double dx = x - 0.5 + wx - o->center_px.x();
-              const double dy = y - 0.5 + wy - o->center_px.y();
-              if (dx * dx + dy * dy < o->radius_px * o->radius_px) {
-                sum += o->grey;
-                occluded = true;
-                break;
-              }
-            }
-            if (occluded) continue;
-            if (!has_ray) {
-              sum += options.background_level;
-              continue;
-            }
-            const Eigen::Vector3d d = left + wx * step;
-            const Eigen::Vector3d o = origin_left + wx * origin_step;
-            // The ray meets the plane z = 0 in front of the camera only when
-            // it heads towards it.
-            if (!(d.z() * o.z() < 0)) {
-              sum += options.background_level;
-              continue;
-            }
-            const double t = -o.z() / d.z();
-            sum += mix_value(pattern.SampleArea(o.x() + t * d.x(),
-                                                o.y() + t * d.y(), footprint));
-          }
+        const double t = -o.z() / d.z();
+        sum += MixValue(pattern_.SampleArea(o.x() + t * d.x(),
+                                            o.y() + t * d.y(), footprint));
+      }
+    }
+    return sum * inv_samples_;
+  }
+
+  const PixelRayGrid& rays_;
+  const RenderOptions& options_;
+  const Eigen::Matrix3d board_from_cam_rotation_;
+  const Eigen::Vector3d center_;
+  const Eigen::Vector3d axis_;
+  const BoardPattern pattern_;
+  const double black_value_;
+  SubGrid sub_;
+  double inv_samples_ = 1.0;
+};
+
+// The lens's image circle: black beyond half the field of view, with an
+// anti-aliased rim one pixel wide (measured by the corner rays' spread).
+void ApplyImageCircle(const PixelRayGrid& rays, double field_of_view_deg,
+                      cv::Mat1f* linear) {
+  const double max_angle = 0.5 * field_of_view_deg * M_PI / 180.0;
+  cv::parallel_for_(cv::Range(0, linear->rows), [&](const cv::Range& range) {
+    for (int y = range.start; y < range.end; ++y) {
+      float* out = linear->ptr<float>(y);
+      for (int x = 0; x < linear->cols; ++x) {
+        const Eigen::Map<const Eigen::Vector3d> r0(rays.Ray(x, y));
+        const Eigen::Map<const Eigen::Vector3d> r3(rays.Ray(x + 1, y + 1));
+        const Eigen::Map<const Eigen::Vector3d> r1(rays.Ray(x + 1, y));
+        const Eigen::Map<const Eigen::Vector3d> r2(rays.Ray(x, y + 1));
+        const Eigen::Vector3d mean = r0 + r1 + r2 + r3;
+        if (!mean.allFinite()) {  // no ray: outside the lens as well
+          out[x] = 0.0f;
+          continue;
         }
-        out[x] = static_cast<float>(sum * inv_samples);
-        if (all_hit) {
-          const Eigen::Vector2d mid =
-              0.25 * (hit[0] + hit[1] + hit[2] + hit[3]);
-          if (pattern.Sample(mid.x(), mid.y()) != BoardInk::kNone) {
-            ++on_board_per_row[y];
-          }
-        }
+        const double angle = std::atan2(mean.head<2>().norm(), mean.z());
+        const double pixel_angle = std::max(
+            std::acos(std::clamp(r0.dot(r3), -1.0, 1.0)) / std::sqrt(2.0),
+            1e-12);
+        const double inside =
+            std::clamp(0.5 + (max_angle - angle) / pixel_angle, 0.0, 1.0);
+        out[x] = static_cast<float>(out[x] * inside);
       }
     }
   });
+}
 
-  if (options.field_of_view_deg > 0) {
-    // The lens's image circle: black beyond half the field of view, with an
-    // anti-aliased rim one pixel wide (measured by the corner rays' spread).
-    const double max_angle = 0.5 * options.field_of_view_deg * M_PI / 180.0;
-    cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
-      for (int y = range.start; y < range.end; ++y) {
-        float* out = linear.ptr<float>(y);
-        for (int x = 0; x < width; ++x) {
-          const Eigen::Map<const Eigen::Vector3d> r0(rays.Ray(x, y));
-          const Eigen::Map<const Eigen::Vector3d> r3(rays.Ray(x + 1, y + 1));
-          const Eigen::Map<const Eigen::Vector3d> r1(rays.Ray(x + 1, y));
-          const Eigen::Map<const Eigen::Vector3d> r2(rays.Ray(x, y + 1));
-          const Eigen::Vector3d mean = r0 + r1 + r2 + r3;
-          if (!mean.allFinite()) {  // no ray: outside the lens as well
-            out[x] = 0.0f;
-            continue;
-          }
-          const double angle = std::atan2(mean.head<2>().norm(), mean.z());
-          const double pixel_angle = std::max(
-              std::acos(std::clamp(r0.dot(r3), -1.0, 1.0)) / std::sqrt(2.0),
-              1e-12);
-          const double inside =
-              std::clamp(0.5 + (max_angle - angle) / pixel_angle, 0.0, 1.0);
-          out[x] = static_cast<float>(out[x] * inside);
-        }
-      }
-    });
-  }
-
-  if (options.blur_sigma_px > 0) {
-    cv::GaussianBlur(linear, linear, cv::Size(0, 0), options.blur_sigma_px,
-                     options.blur_sigma_px, cv::BORDER_REPLICATE);
-  }
-
+// The 8-bit sensor image of the linear one: lighting gradient, vignetting,
+// gamma and Gaussian noise. Each row draws its noise from its own stream,
+// so the image is the same for any thread count.
+cv::Mat1b ToSensorImage(const cv::Mat1f& linear, const RenderOptions& options) {
+  const int width = linear.cols, height = linear.rows;
   cv::Mat1b image(height, width);
   const double contrast = options.white_level - options.black_level;
   const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
@@ -478,6 +483,59 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
       }
     }
   });
+  return image;
+}
+
+}  // namespace
+
+cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
+                    const Eigen::Isometry3d& cam_from_board,
+                    const RenderOptions& options, RenderTruth* truth,
+                    RenderSummary* summary) {
+  RenderSummary local_summary;
+  if (summary == nullptr) summary = &local_summary;
+  *summary = RenderSummary();
+  std::string why;
+  if (!options.Check(&why)) return Fail(summary, "render options: " + why);
+  if (!board.Check(&why)) return Fail(summary, "board: " + why);
+  if (rays.empty()) {
+    return Fail(summary, "pixel rays were not computed (unusable camera)");
+  }
+  if (!PoseIsValid(cam_from_board, &why)) return Fail(summary, why);
+
+  const Camera& camera = rays.camera();
+  const int width = camera.width, height = camera.height;
+  const BoardShader shader(board, rays, cam_from_board, options);
+  cv::Mat1f linear(height, width);
+  std::vector<int> no_ray_per_row(height, 0), on_board_per_row(height, 0);
+  // Rows are independent: the same image for any thread count.
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+    std::vector<const Occluder*> row_occluders;
+    row_occluders.reserve(options.occluders.size());
+    for (int y = range.start; y < range.end; ++y) {
+      row_occluders.clear();
+      for (const Occluder& o : options.occluders) {
+        if (std::abs(o.center_px.y() - y) <= o.radius_px + 0.5) {
+          row_occluders.push_back(&o);
+        }
+      }
+      float* out = linear.ptr<float>(y);
+      for (int x = 0; x < width; ++x) {
+        bool on_board = false, has_ray = true;
+        out[x] = shader.Shade(x, y, row_occluders, &on_board, &has_ray);
+        on_board_per_row[y] += on_board ? 1 : 0;
+        no_ray_per_row[y] += has_ray ? 0 : 1;
+      }
+    }
+  });
+  if (options.field_of_view_deg > 0) {
+    ApplyImageCircle(rays, options.field_of_view_deg, &linear);
+  }
+  if (options.blur_sigma_px > 0) {
+    cv::GaussianBlur(linear, linear, cv::Size(0, 0), options.blur_sigma_px,
+                     options.blur_sigma_px, cv::BORDER_REPLICATE);
+  }
+  cv::Mat1b image = ToSensorImage(linear, options);
 
   summary->ok = true;
   for (int y = 0; y < height; ++y) {
