@@ -91,17 +91,15 @@ class Progress {
 
 // One line per input image for the log and the report.
 std::vector<ReportImage> ReportLines(const std::vector<ImageResult>& images,
-                                     const std::vector<int>& view_of_image,
                                      const CalibrationResult* result) {
   std::vector<ReportImage> lines;
-  for (size_t i = 0; i < images.size(); ++i) {
-    const ImageResult& image = images[i];
+  for (const ImageResult& image : images) {
     ReportImage line;
     line.file = image.file;
     line.outcome = ImageOutcomeName(image.outcome);
     line.reason = image.reason;
     line.corners_detected = static_cast<int>(image.corners.size());
-    line.view_index = view_of_image[i];
+    line.view_index = image.view_index;
     const int v = line.view_index;
     if (v >= 0 && result != nullptr) {
       if (!result->view_used[v]) {
@@ -258,35 +256,61 @@ void PrintImageProblems(const std::vector<ReportImage>& lines) {
   }
 }
 
-// ---- the command ----
+// ---- the command, in stages ----
 
-int RunCalibrate() {
-  std::signal(SIGINT, OnInterrupt);
-  const Timer run_timer;
+// What the command line asks for, checked before any image is read.
+struct CalibrateRequest {
+  bool auto_model = false;
+  CameraModelId model = CameraModelId::kPinholeRadtan;
+  CameraFileFormat format = CameraFileFormat::kPuzzlecal;
+  // The format decides the model's free parameters (Kalibr's radtan has no
+  // k3), so they are settled here.
+  CalibrationOptions calibration_options;
+  int threads = 1;
+  Board board;
+  ImageListing listing;
+  Verbosity verbosity = Verbosity::kNormal;
+};
+
+// What the run produced, image by image and as a whole.
+struct CalibrationRun {
+  std::vector<ImageResult> images;  // one record per image, in file order
+  std::vector<CalibrationView> views;
+  int width = 0, height = 0;
+  ModelSelection selection;  // --model auto only
+  CalibrationResult result;
+  bool calibrated = false;
+  std::string calibration_error;
+  Evidence evidence;
+  Verdict verdict;
+  double seconds_load = 0, seconds_detect = 0, seconds_grid_decode = 0;
+  double seconds_calibrate = 0;
+};
+
+// Flags, formats, outputs, the board file and the image folder. Returns
+// kExitOk or the exit code, having said why.
+int ParseRequest(CalibrateRequest* request) {
   if (FLAGS_images.empty() || FLAGS_board.empty() || FLAGS_out.empty()) {
     std::cerr << "puzzlecal calibrate: --images, --board and --out are "
                  "required. Run `puzzlecal calibrate --help`.\n";
     return kExitUsage;
   }
-  CameraModelId model = CameraModelId::kPinholeRadtan;
-  const bool auto_model = FLAGS_model == "auto";
-  if (!auto_model && !CameraModelIdFromName(FLAGS_model, &model)) {
+  request->auto_model = FLAGS_model == "auto";
+  if (!request->auto_model &&
+      !CameraModelIdFromName(FLAGS_model, &request->model)) {
     std::cerr << "puzzlecal calibrate: unknown model '" << FLAGS_model
               << "'; choose one of " << CameraModelNames() << " or auto.\n";
     return kExitUsage;
   }
   std::string error;
-  CameraFileFormat format;
-  if (!CameraFileFormatFromName(FLAGS_format, &format)) {
+  if (!CameraFileFormatFromName(FLAGS_format, &request->format)) {
     std::cerr << "puzzlecal calibrate: unknown format '" << FLAGS_format
               << "'; choose one of puzzlecal, opencv, ros, kalibr.\n";
     return kExitUsage;
   }
-  // The format decides the model's free parameters (Kalibr's radtan has no
-  // k3), so it is settled before any image is read.
-  CalibrationOptions calibration_options;
-  if (!auto_model &&
-      !CameraFormatFixedParams(format, model, &calibration_options.fixed_params,
+  if (!request->auto_model &&
+      !CameraFormatFixedParams(request->format, request->model,
+                               &request->calibration_options.fixed_params,
                                &error)) {
     std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
               << error << ".\n";
@@ -296,200 +320,235 @@ int RunCalibrate() {
     std::cerr << "puzzlecal calibrate: --threads must be >= 0.\n";
     return kExitUsage;
   }
+  request->threads =
+      FLAGS_threads > 0
+          ? FLAGS_threads
+          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   // Every output is checked before the work starts.
   if (!CheckOutputPath(FLAGS_out, &error) ||
       (!FLAGS_report.empty() && !CheckReportFolder(FLAGS_report, &error))) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitOutputError;
   }
-  Board board;
-  if (!LoadBoardFile(FLAGS_board, &board, &error)) {
+  if (!LoadBoardFile(FLAGS_board, &request->board, &error) ||
+      !ListImages(FLAGS_images, &request->listing, &error)) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitBadInput;
   }
-  ImageListing listing;
-  if (!ListImages(FLAGS_images, &listing, &error)) {
-    std::cerr << "puzzlecal calibrate: " << error << "\n";
-    return kExitBadInput;
-  }
-  const Verbosity verbosity = ConsoleVerbosity();
-  if (verbosity == Verbosity::kVerbose) {
-    for (const std::string& skipped : listing.skipped) {
+  request->verbosity = ConsoleVerbosity();
+  if (request->verbosity == Verbosity::kVerbose) {
+    for (const std::string& skipped : request->listing.skipped) {
       std::cerr << "skipped " << skipped << "\n";
     }
   }
+  return kExitOk;
+}
 
-  // Detection, grid and decode on all images, in parallel over images; each
-  // worker holds one image at a time. OpenCV's own threads stay off so the
-  // workers do not oversubscribe the cores.
-  PipelineOptions pipeline_options;
-  const int threads =
-      FLAGS_threads > 0
-          ? FLAGS_threads
-          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+// Detection, grid and decode on all images, in parallel over images (each
+// worker holds one image at a time; OpenCV's own threads stay off so the
+// workers do not oversubscribe the cores), then the calibration views.
+// Returns kExitOk or kExitBadInput when no image could be read.
+int DetectAll(const CalibrateRequest& request, CalibrationRun* run) {
   cv::setNumThreads(1);
-  Progress progress(listing.images.size(), verbosity);
-  std::vector<ImageResult> images = ProcessImageFiles(
-      listing.images, board, pipeline_options, threads,
+  Progress progress(request.listing.images.size(), request.verbosity);
+  run->images = ProcessImageFiles(
+      request.listing.images, request.board, PipelineOptions(), request.threads,
       [&](size_t, const ImageResult& result) { progress.Done(result); });
-
-  int width = 0, height = 0;
-  std::vector<int> view_of_image;
-  const std::vector<CalibrationView> views =
-      MakeCalibrationViews(board, &images, &view_of_image, &width, &height);
-  double seconds_load = 0, seconds_detect = 0, seconds_grid_decode = 0;
-  for (const ImageResult& image : images) {
-    seconds_load += image.seconds_load;
-    seconds_detect += image.seconds_detect;
-    seconds_grid_decode += image.seconds_grid_decode;
+  run->views = MakeCalibrationViews(request.board, &run->images, &run->width,
+                                    &run->height);
+  for (const ImageResult& image : run->images) {
+    run->seconds_load += image.seconds_load;
+    run->seconds_detect += image.seconds_detect;
+    run->seconds_grid_decode += image.seconds_grid_decode;
   }
-
-  const bool any_readable =
-      std::any_of(images.begin(), images.end(), [](const ImageResult& r) {
+  const bool any_readable = std::any_of(
+      run->images.begin(), run->images.end(), [](const ImageResult& r) {
         return r.outcome != ImageOutcome::kUnreadable;
       });
-  if (!any_readable) {
-    for (const ImageResult& image : images) std::cerr << image.reason << "\n";
-    std::cerr << "puzzlecal calibrate: none of the " << images.size()
-              << " image files in " << FLAGS_images
-              << " could be read; no calibration written.\n";
-    return kExitBadInput;
+  if (any_readable) return kExitOk;
+  for (const ImageResult& image : run->images) {
+    std::cerr << image.reason << "\n";
   }
+  std::cerr << "puzzlecal calibrate: none of the " << run->images.size()
+            << " image files in " << FLAGS_images
+            << " could be read; no calibration written.\n";
+  return kExitBadInput;
+}
 
-  const Timer calib_timer;
-  calibration_options.num_threads = threads;  // same result for any count
-  // --model auto: the candidate with the lowest held-out error
-  // (calib/model_selection.h).
-  ModelSelection selection;
-  if (auto_model) {
-    if (!SelectModel(views, width, height, calibration_options,
-                     ModelSelectionOptions(), &selection, &error)) {
-      std::cerr << selection.Table() << "puzzlecal calibrate: " << error
-                << "\n";
-      return kExitNoResult;
-    }
-    std::cout << selection.Table();
-    model = selection.candidates[selection.chosen].model;
-    // The chosen model must fit the format (Kalibr's radtan has no k3).
-    if (!CameraFormatFixedParams(format, model,
-                                 &calibration_options.fixed_params, &error)) {
-      std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
-                << error << "; choose --model explicitly.\n";
-      return kExitUsage;
-    }
-  }
-  CalibrationResult result;
-  std::string calibration_error;
-  const std::string mismatch = BoardMismatchMessage(images, board, FLAGS_board);
-  bool calibrated = false;
-  if (views.empty()) {
-    calibration_error = "no image gave a view";
-  } else {
-    calibrated = Calibrate(views, model, width, height, calibration_options,
-                           &result, &calibration_error);
-  }
-  if (!calibrated && !mismatch.empty()) calibration_error = mismatch;
-  const double seconds_calibrate = calib_timer.Seconds();
-  // Evidence (halves, uncertainty, binned residuals) and the verdict made
-  // from it (calib/evidence.h, calib/verdict.h).
-  const EvidenceOptions evidence_options;
-  Evidence evidence;
-  Verdict verdict;
-  if (calibrated) {
-    evidence =
-        ComputeEvidence(views, result, calibration_options, evidence_options);
-    verdict = MakeVerdict(result, evidence, evidence_options, VerdictOptions());
-  }
-
-  const std::vector<ReportImage> report_images =
-      ReportLines(images, view_of_image, calibrated ? &result : nullptr);
-  PrintImageProblems(report_images);
-
-  // The camera file first: a failing report or Ctrl-C does not lose it.
-  if (calibrated) {
-    CameraFileNames names;
-    names.camera_name = FLAGS_camera_name;
-    names.rostopic = FLAGS_rostopic;
-    std::vector<std::string> view_files(views.size());
-    for (size_t i = 0; i < images.size(); ++i) {
-      if (view_of_image[i] >= 0) view_files[view_of_image[i]] = images[i].file;
-    }
-    CameraFileStats stats =
-        CameraFileStatsOfResult(result, view_files, board.Point(board.origin));
-    stats.verdict = verdict.Line();
-    const CalibrationRange range = MeasureCalibrationRange(views, result);
-    stats.closest_board_distance_m = range.closest_board_distance_m;
-    stats.max_field_angle_deg = range.max_field_angle_deg;
-    std::string format_note;
-    if (!WriteCameraFile(FLAGS_out, format, result.camera, stats, &error,
-                         &format_note, names)) {
-      std::cerr << "puzzlecal calibrate: " << error << "\n";
-      return kExitOutputError;
-    }
-    if (!format_note.empty() && verbosity != Verbosity::kQuiet) {
-      std::cout << "note: " << FLAGS_out << ": " << format_note << "\n";
-    }
-    g_camera_written = 1;
-  }
-
-  // The report is written also for a failed calibration: it shows why.
-  if (!FLAGS_report.empty()) {
-    ReportInput input;
-    input.board = board;
-    input.result = &result;
-    input.views = &views;
-    input.calibration_ok = calibrated;
-    input.calibration_error = calibration_error;
-    input.images = report_images;
-    input.seconds_load = seconds_load;
-    input.seconds_detect = seconds_detect + seconds_grid_decode;
-    input.seconds_calibrate = seconds_calibrate;
-    input.seconds_total = run_timer.Seconds();
-    input.threads = threads;
-    if (calibrated) {
-      input.evidence = &evidence;
-      input.verdict = &verdict;
-    }
-    if (auto_model) input.model_selection = selection.Table();
-    if (!WriteReportInPlace(FLAGS_report, input, &error)) {
-      std::cerr << "puzzlecal calibrate: report not written: " << error
-                << (calibrated
-                        ? "\n(the camera file " + FLAGS_out + " was written)"
-                        : "")
-                << "\n";
-      // A failed calibration stays the outcome that matters.
-      if (calibrated) return kExitOutputError;
-    }
-  }
-  if (!calibrated) {
-    std::cerr << "puzzlecal calibrate: no calibration written. "
-              << calibration_error << "\n";
+// --model auto: the candidate with the lowest held-out error
+// (calib/model_selection.h), which must fit the format. Returns kExitOk or
+// the exit code.
+int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
+  std::string error;
+  if (!SelectModel(run->views, run->width, run->height,
+                   request->calibration_options, ModelSelectionOptions(),
+                   &run->selection, &error)) {
+    std::cerr << run->selection.Table() << "puzzlecal calibrate: " << error
+              << "\n";
     return kExitNoResult;
   }
+  std::cout << run->selection.Table();
+  request->model = run->selection.candidates[run->selection.chosen].model;
+  if (!CameraFormatFixedParams(request->format, request->model,
+                               &request->calibration_options.fixed_params,
+                               &error)) {
+    std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
+              << error << "; choose --model explicitly.\n";
+    return kExitUsage;
+  }
+  return kExitOk;
+}
 
-  const double seconds_total = run_timer.Seconds();
-  if (verbosity != Verbosity::kQuiet) {
+// The model (--model auto chooses it), the calibration, its evidence
+// (halves, uncertainty, binned residuals) and the verdict made from it
+// (calib/evidence.h, calib/verdict.h). A failed calibration is kept in
+// run->calibration_error (the report shows it); returns kExitOk or the exit
+// code of a failed model selection.
+int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
+  const Timer calib_timer;
+  if (request_in->auto_model) {
+    if (const int code = SelectModelOf(request_in, run); code != kExitOk) {
+      return code;
+    }
+  }
+  const CalibrateRequest& request = *request_in;
+  const std::string mismatch =
+      BoardMismatchMessage(run->images, request.board, FLAGS_board);
+  if (run->views.empty()) {
+    run->calibration_error = "no image gave a view";
+  } else {
+    run->calibrated = Calibrate(run->views, request.model, run->width,
+                                run->height, request.calibration_options,
+                                &run->result, &run->calibration_error);
+  }
+  if (!run->calibrated && !mismatch.empty()) run->calibration_error = mismatch;
+  run->seconds_calibrate = calib_timer.Seconds();
+  if (!run->calibrated) return kExitOk;
+  const EvidenceOptions evidence_options;
+  run->evidence = ComputeEvidence(
+      run->views, run->result, request.calibration_options, evidence_options);
+  run->verdict = MakeVerdict(run->result, run->evidence, evidence_options,
+                             VerdictOptions());
+  return kExitOk;
+}
+
+// The camera file, written first so that a failing report or Ctrl-C does
+// not lose it. Returns kExitOk or kExitOutputError.
+int WriteCameraOf(const CalibrateRequest& request, const CalibrationRun& run) {
+  CameraFileNames names;
+  names.camera_name = FLAGS_camera_name;
+  names.rostopic = FLAGS_rostopic;
+  CameraFileStats stats = CameraFileStatsOfResult(
+      run.result, ViewFiles(run.images, run.views.size()),
+      request.board.Point(request.board.origin));
+  stats.verdict = run.verdict.Line();
+  const CalibrationRange range = MeasureCalibrationRange(run.views, run.result);
+  stats.closest_board_distance_m = range.closest_board_distance_m;
+  stats.max_field_angle_deg = range.max_field_angle_deg;
+  std::string error, format_note;
+  if (!WriteCameraFile(FLAGS_out, request.format, run.result.camera, stats,
+                       &error, &format_note, names)) {
+    std::cerr << "puzzlecal calibrate: " << error << "\n";
+    return kExitOutputError;
+  }
+  if (!format_note.empty() && request.verbosity != Verbosity::kQuiet) {
+    std::cout << "note: " << FLAGS_out << ": " << format_note << "\n";
+  }
+  g_camera_written = 1;
+  return kExitOk;
+}
+
+// The report, written also for a failed calibration (it shows why). False
+// when it could not be written (said on stderr).
+bool WriteReportOf(const CalibrateRequest& request, const CalibrationRun& run,
+                   const std::vector<ReportImage>& report_images,
+                   double seconds_total) {
+  ReportInput input;
+  input.board = request.board;
+  input.result = &run.result;
+  input.views = &run.views;
+  input.calibration_ok = run.calibrated;
+  input.calibration_error = run.calibration_error;
+  input.images = report_images;
+  input.seconds_load = run.seconds_load;
+  input.seconds_detect = run.seconds_detect + run.seconds_grid_decode;
+  input.seconds_calibrate = run.seconds_calibrate;
+  input.seconds_total = seconds_total;
+  input.threads = request.threads;
+  if (run.calibrated) {
+    input.evidence = &run.evidence;
+    input.verdict = &run.verdict;
+  }
+  if (request.auto_model) input.model_selection = run.selection.Table();
+  std::string error;
+  if (WriteReportInPlace(FLAGS_report, input, &error)) return true;
+  std::cerr << "puzzlecal calibrate: report not written: " << error
+            << (run.calibrated
+                    ? "\n(the camera file " + FLAGS_out + " was written)"
+                    : "")
+            << "\n";
+  return false;
+}
+
+// The closing lines on stdout: the calibration, counts, timings (verbose),
+// the verdict and what was written.
+void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
+                  double seconds_total) {
+  const CalibrationResult& result = run.result;
+  if (request.verbosity != Verbosity::kQuiet) {
     std::cout << CalibrationReport(result) << "\n";
     std::cout << "views used: " << result.num_views_used << " of "
-              << images.size()
+              << run.images.size()
               << " images; corners: " << result.num_corners_used << "; RMS "
               << std::setprecision(4) << result.rms_px << " px\n";
   }
-  if (verbosity == Verbosity::kVerbose) {
-    std::cout << EvidenceText(evidence) << std::setprecision(3)
-              << "evidence: " << evidence.seconds << " s (halves "
-              << evidence.cross_validation.seconds << " s)\n";
+  if (request.verbosity == Verbosity::kVerbose) {
+    std::cout << EvidenceText(run.evidence) << std::setprecision(3)
+              << "evidence: " << run.evidence.seconds << " s (halves "
+              << run.evidence.cross_validation.seconds << " s)\n";
     std::cout << std::setprecision(3) << "time: " << seconds_total
-              << " s wall clock on " << threads
-              << " threads; summed over images: image decoding " << seconds_load
-              << " s, detection " << seconds_detect << " s, grid and decode "
-              << seconds_grid_decode << " s; calibration " << seconds_calibrate
-              << " s\n";
+              << " s wall clock on " << request.threads
+              << " threads; summed over images: image decoding "
+              << run.seconds_load << " s, detection " << run.seconds_detect
+              << " s, grid and decode " << run.seconds_grid_decode
+              << " s; calibration " << run.seconds_calibrate << " s\n";
   }
-  std::cout << verdict.Line() << "\n";
+  std::cout << run.verdict.Line() << "\n";
   std::cout << "wrote " << FLAGS_out
             << (FLAGS_report.empty() ? "" : " and the report " + FLAGS_report)
             << "\n";
+}
+
+int RunCalibrate() {
+  std::signal(SIGINT, OnInterrupt);
+  const Timer run_timer;
+  CalibrateRequest request;
+  CalibrationRun run;
+  if (const int code = ParseRequest(&request); code != kExitOk) return code;
+  if (const int code = DetectAll(request, &run); code != kExitOk) return code;
+  request.calibration_options.num_threads = request.threads;  // same result
+  if (const int code = CalibrateAndJudge(&request, &run); code != kExitOk) {
+    return code;
+  }
+  const std::vector<ReportImage> report_images =
+      ReportLines(run.images, run.calibrated ? &run.result : nullptr);
+  PrintImageProblems(report_images);
+  if (run.calibrated) {
+    if (const int code = WriteCameraOf(request, run); code != kExitOk) {
+      return code;
+    }
+  }
+  if (!FLAGS_report.empty() &&
+      !WriteReportOf(request, run, report_images, run_timer.Seconds()) &&
+      run.calibrated) {
+    return kExitOutputError;  // a failed calibration stays what matters
+  }
+  if (!run.calibrated) {
+    std::cerr << "puzzlecal calibrate: no calibration written. "
+              << run.calibration_error << "\n";
+    return kExitNoResult;
+  }
+  PrintOutcome(request, run, run_timer.Seconds());
   return kExitOk;
 }
 

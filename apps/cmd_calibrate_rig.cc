@@ -138,8 +138,7 @@ int RunCalibrateRig() {
   // no k3), so it is settled before any image is read.
   std::vector<std::vector<std::string>> format_fixed(folders.size());
   for (size_t c = 0; c < folders.size(); ++c) {
-    if (!CameraFormatFixedParams(format, models[c], &format_fixed[c],
-                                 &error)) {
+    if (!CameraFormatFixedParams(format, models[c], &format_fixed[c], &error)) {
       std::cerr << kName << ": --format " << FLAGS_format << ", camera '"
                 << folders[c].filename().string() << "': " << error << ".\n";
       return kExitUsage;
@@ -183,15 +182,14 @@ int RunCalibrateRig() {
     input.frames.resize(num_frames);
     std::vector<ImageResult> images =
         ProcessImageFiles(listings[c].images, board, pipeline_options, threads);
-    std::vector<int> view_of_image;
-    std::vector<CalibrationView> views = MakeCalibrationViews(
-        board, &images, &view_of_image, &input.width, &input.height);
+    std::vector<CalibrationView> views =
+        MakeCalibrationViews(board, &images, &input.width, &input.height);
     int usable = 0;
     for (size_t i = 0; i < images.size(); ++i) {
       const std::string name = fs::path(images[i].file).filename().string();
       const int frame = frame_of_name[name];
       frame_files[c][frame] = images[i].file;
-      if (view_of_image[i] < 0) {
+      if (images[i].view_index < 0) {
         LOG(WARNING) << images[i].file << ": "
                      << ImageOutcomeName(images[i].outcome)
                      << (images[i].reason.empty()
@@ -199,7 +197,7 @@ int RunCalibrateRig() {
                              : " (" + images[i].reason + ")");
         continue;
       }
-      input.frames[frame] = std::move(views[view_of_image[i]]);
+      input.frames[frame] = std::move(views[images[i].view_index]);
       ++usable;
     }
     std::cerr << "camera '" << input.name << "': " << usable << " of "
@@ -250,10 +248,10 @@ int RunCalibrateRig() {
   for (size_t c = 0; c < result.cameras.size(); ++c) {
     const RigCameraResult& cam = result.cameras[c];
     const EvidenceOptions evidence_options;
-    const Evidence evidence = ComputeEvidence(
-        inputs[c].frames, cam.single, options.camera, evidence_options);
-    const Verdict verdict = MakeVerdict(cam.single, evidence, evidence_options,
-                                        VerdictOptions());
+    const Evidence evidence = ComputeEvidence(inputs[c].frames, cam.single,
+                                              options.camera, evidence_options);
+    const Verdict verdict =
+        MakeVerdict(cam.single, evidence, evidence_options, VerdictOptions());
     std::cout << cam.name << ": " << verdict.Line() << "\n";
   }
   std::cout << "time: " << run_timer.Seconds() << " s wall clock on " << threads

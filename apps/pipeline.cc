@@ -202,12 +202,12 @@ std::vector<ImageResult> ProcessImageFiles(
 }
 
 std::vector<CalibrationView> MakeCalibrationViews(
-    const Board& board, std::vector<ImageResult>* images,
-    std::vector<int>* view_of_image, int* width, int* height) {
+    const Board& board, std::vector<ImageResult>* images, int* width,
+    int* height) {
   *width = 0;
   *height = 0;
   std::vector<CalibrationView> views;
-  view_of_image->assign(images->size(), -1);
+  for (ImageResult& image : *images) image.view_index = -1;
   // The size most usable images have (the first of them on a tie).
   std::map<std::pair<int, int>, int> count;
   int best = 0;
@@ -238,10 +238,22 @@ std::vector<CalibrationView> MakeCalibrationViews(
       view.board_points.push_back(board.Point(observation.id[k]));
       view.image_points.push_back(observation.xy[k]);
     }
-    (*view_of_image)[i] = static_cast<int>(views.size());
+    image.view_index = static_cast<int>(views.size());
     views.push_back(std::move(view));
   }
   return views;
+}
+
+std::vector<std::string> ViewFiles(const std::vector<ImageResult>& images,
+                                   size_t num_views) {
+  std::vector<std::string> files(num_views);
+  for (const ImageResult& image : images) {
+    if (image.view_index >= 0 &&
+        static_cast<size_t>(image.view_index) < num_views) {
+      files[image.view_index] = image.file;
+    }
+  }
+  return files;
 }
 
 }  // namespace puzzlecal

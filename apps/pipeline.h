@@ -61,6 +61,9 @@ struct ImageResult {
   double seconds_load = 0;                // reading and decoding the file
   double seconds_detect = 0;              // corner detection
   double seconds_grid_decode = 0;         // grid + decode
+  // The index of the calibration view this image became
+  // (MakeCalibrationViews), -1 when it gave none.
+  int view_index = -1;
 };
 
 // Runs detection, grid and decode on a grey image (`board` is not read when
@@ -90,11 +93,15 @@ std::vector<ImageResult> ProcessImageFiles(
 
 // The calibration views of a run: one per usable image of the size most
 // usable images have (images of another size are marked kSizeMismatch).
-// `view_of_image[i]` is the view index of images[i] or -1; `width`/`height`
-// return the image size (0 when no image is usable).
+// Sets each image's view_index; `width`/`height` return the image size (0
+// when no image is usable).
 std::vector<CalibrationView> MakeCalibrationViews(
-    const Board& board, std::vector<ImageResult>* images,
-    std::vector<int>* view_of_image, int* width, int* height);
+    const Board& board, std::vector<ImageResult>* images, int* width,
+    int* height);
+
+// The image file of each of `num_views` views (by ImageResult::view_index).
+std::vector<std::string> ViewFiles(const std::vector<ImageResult>& images,
+                                   size_t num_views);
 
 }  // namespace puzzlecal
 

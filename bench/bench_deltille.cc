@@ -428,8 +428,10 @@ bool SetGridOption(const std::string& arg, GridOptions* o) {
   const std::string name = arg.substr(0, eq);
   const double value = std::atof(arg.c_str() + eq + 1);
   const std::map<std::string, double*> doubles = {
-      {"min_orientation_difference_deg", &o->candidates.min_orientation_difference_deg},
-      {"intensity_difference_fraction", &o->image_tests.intensity_difference_fraction},
+      {"min_orientation_difference_deg",
+       &o->candidates.min_orientation_difference_deg},
+      {"intensity_difference_fraction",
+       &o->image_tests.intensity_difference_fraction},
       {"penalty_factor", &o->image_tests.penalty_factor},
       {"neighbor_weight_ratio", &o->merge.neighbor_weight_ratio},
       {"tree_mean_weight_ratio_min", &o->merge.tree_mean_weight_ratio_min},
@@ -572,9 +574,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "grid options: %s\n", why.c_str());
     return 2;
   }
-  const std::string dir = data_dir.empty()
-                              ? testing_data::DeltilleFolder()
-                              : data_dir + "/deltille/fisheye";
+  const std::string dir = data_dir.empty() ? testing_data::DeltilleFolder()
+                                           : data_dir + "/deltille/fisheye";
   const std::vector<std::string> files = testing_data::DeltillePhotoFiles(dir);
   if (files.empty()) {
     std::printf("{\"error\": \"no photos in %s\"}\n", dir.c_str());
@@ -588,10 +589,9 @@ int main(int argc, char** argv) {
   PipelineOptions options;
   std::vector<ImageResult> results =
       ProcessImageFiles(files, board, options, threads);
-  std::vector<int> view_of_image;
   int width = 0, height = 0;
   const std::vector<CalibrationView> views =
-      MakeCalibrationViews(board, &results, &view_of_image, &width, &height);
+      MakeCalibrationViews(board, &results, &width, &height);
   if (models_only) {
     std::printf("{\n  \"benchmark\": \"deltille_fisheye_models\",\n");
     PrintModelComparison(views, width, height);
@@ -625,7 +625,7 @@ int main(int argc, char** argv) {
     const ImageResult& result = results[i];
     const std::string photo = files[i].substr(files[i].size() - 8, 4);
     ++photos;
-    const int v = view_of_image[i];
+    const int v = result.view_index;
     Eigen::Isometry3d pose;
     bool have_pose = false;
     if (v >= 0 && calibration.view_used[v]) {

@@ -45,10 +45,8 @@ DeltilleRun CalibrateFiles(
   std::vector<ImageResult> images =
       ProcessImageFiles(files, board, PipelineOptions(), 0);
   run.images = static_cast<int>(images.size());
-  std::vector<int> view_of_image;
   int width = 0, height = 0;
-  run.views =
-      MakeCalibrationViews(board, &images, &view_of_image, &width, &height);
+  run.views = MakeCalibrationViews(board, &images, &width, &height);
   run.ok = Calibrate(run.views, model, width, height, CalibrationOptions(),
                      &run.result, &run.error);
   return run;

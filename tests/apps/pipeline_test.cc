@@ -193,14 +193,19 @@ TEST(MakeCalibrationViewsTest, UsesTheSizeMostImagesHave) {
     }
   }
   images[3].outcome = ImageOutcome::kNoGrid;  // not usable: not counted
-  std::vector<int> view_of_image;
   int width = 0, height = 0;
   const std::vector<CalibrationView> views =
-      MakeCalibrationViews(board, &images, &view_of_image, &width, &height);
+      MakeCalibrationViews(board, &images, &width, &height);
   EXPECT_EQ(width, 640);
   EXPECT_EQ(height, 480);
   ASSERT_EQ(views.size(), 3u);
-  EXPECT_EQ(view_of_image, (std::vector<int>{-1, 0, 1, -1, 2}));
+  std::vector<int> view_index;
+  for (const ImageResult& image : images)
+    view_index.push_back(image.view_index);
+  EXPECT_EQ(view_index, (std::vector<int>{-1, 0, 1, -1, 2}));
+  EXPECT_EQ(ViewFiles(images, views.size()),
+            (std::vector<std::string>{images[1].file, images[2].file,
+                                      images[4].file}));
   EXPECT_EQ(images[0].outcome, ImageOutcome::kSizeMismatch);
   EXPECT_NE(images[0].reason.find("800x600 differs from the 640x480"),
             std::string::npos)
