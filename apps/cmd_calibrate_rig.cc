@@ -79,25 +79,22 @@ bool ListCameraFolders(const std::string& root, std::vector<fs::path>* folders,
   return true;
 }
 
-int RunCalibrateRig() {
-  const Timer run_timer;
-  const char* kName = "puzzlecal calibrate-rig";
-  if (FLAGS_images.empty() || FLAGS_board.empty() || FLAGS_out.empty()) {
-    std::cerr << kName << ": --images, --board and --out are required. Run "
-              << "`puzzlecal calibrate-rig --help`.\n";
-    return kExitUsage;
-  }
-  CameraFileFormat format;
-  if (!CameraFileFormatFromName(FLAGS_format, &format)) {
-    std::cerr << kName << ": unknown format '" << FLAGS_format
-              << "'; choose one of puzzlecal, opencv, ros, kalibr.\n";
-    return kExitUsage;
-  }
-  if (FLAGS_threads < 0) {
-    std::cerr << kName << ": --threads must be >= 0.\n";
-    return kExitUsage;
-  }
-  std::vector<CameraModelId> models;
+constexpr const char* kName = "puzzlecal calibrate-rig";
+
+// What the command line asks for, checked before any image is read.
+struct RigRequest {
+  CameraFileFormat format = CameraFileFormat::kPuzzlecal;
+  std::vector<fs::path> folders;      // one per camera, sorted
+  std::vector<CameraModelId> models;  // one per camera
+  // Per camera, the parameters the format holds fixed (Kalibr's radtan has
+  // no k3).
+  std::vector<std::vector<std::string>> format_fixed;
+  Board board;
+  int threads = 1;
+};
+
+// The models of --model (one for all cameras or one per camera).
+int ParseModelNames(std::vector<CameraModelId>* models) {
   for (const std::string& name : SplitCommas(FLAGS_model)) {
     CameraModelId id;
     if (!CameraModelIdFromName(name, &id)) {
@@ -105,25 +102,16 @@ int RunCalibrateRig() {
                 << CameraModelNames() << ".\n";
       return kExitUsage;
     }
-    models.push_back(id);
+    models->push_back(id);
   }
-  std::string error;
-  Board board;
-  if (!LoadBoardFile(FLAGS_board, &board, &error)) {
-    std::cerr << kName << ": " << error << "\n";
-    return kExitBadInput;
-  }
-  if (!CheckOutputPath(FLAGS_out, &error)) {
-    std::cerr << kName << ": " << error << "\n";
-    return kExitOutputError;
-  }
-  std::vector<fs::path> folders;
-  if (!ListCameraFolders(FLAGS_images, &folders, &error)) {
-    std::cerr << kName << ": " << error << "\n";
-    return kExitBadInput;
-  }
-  if (models.size() != 1 && models.size() != folders.size()) {
-    std::cerr << kName << ": " << models.size() << " models for "
+  return kExitOk;
+}
+
+// One model for all cameras becomes one per camera, in folder order.
+int MatchModelsToFolders(const std::vector<fs::path>& folders,
+                         std::vector<CameraModelId>* models) {
+  if (models->size() != 1 && models->size() != folders.size()) {
+    std::cerr << kName << ": " << models->size() << " models for "
               << folders.size()
               << " cameras; give one model for all or one per camera ("
               << FLAGS_images << " holds";
@@ -133,91 +121,184 @@ int RunCalibrateRig() {
     std::cerr << ").\n";
     return kExitUsage;
   }
-  models.resize(folders.size(), models[0]);
-  // The format decides each camera's free parameters (Kalibr's radtan has
-  // no k3), so it is settled before any image is read.
-  std::vector<std::vector<std::string>> format_fixed(folders.size());
-  for (size_t c = 0; c < folders.size(); ++c) {
-    if (!CameraFormatFixedParams(format, models[c], &format_fixed[c], &error)) {
+  models->resize(folders.size(), (*models)[0]);
+  return kExitOk;
+}
+
+// Flags, the board file, the output and the camera folders. Returns
+// kExitOk or the exit code, having said why.
+int ParseRigRequest(RigRequest* request) {
+  if (FLAGS_images.empty() || FLAGS_board.empty() || FLAGS_out.empty()) {
+    std::cerr << kName << ": --images, --board and --out are required. Run "
+              << "`puzzlecal calibrate-rig --help`.\n";
+    return kExitUsage;
+  }
+  if (!CameraFileFormatFromName(FLAGS_format, &request->format)) {
+    std::cerr << kName << ": unknown format '" << FLAGS_format
+              << "'; choose one of puzzlecal, opencv, ros, kalibr.\n";
+    return kExitUsage;
+  }
+  if (FLAGS_threads < 0) {
+    std::cerr << kName << ": --threads must be >= 0.\n";
+    return kExitUsage;
+  }
+  if (const int code = ParseModelNames(&request->models); code != kExitOk) {
+    return code;
+  }
+  std::string error;
+  if (!LoadBoardFile(FLAGS_board, &request->board, &error)) {
+    std::cerr << kName << ": " << error << "\n";
+    return kExitBadInput;
+  }
+  if (!CheckOutputPath(FLAGS_out, &error)) {
+    std::cerr << kName << ": " << error << "\n";
+    return kExitOutputError;
+  }
+  if (!ListCameraFolders(FLAGS_images, &request->folders, &error)) {
+    std::cerr << kName << ": " << error << "\n";
+    return kExitBadInput;
+  }
+  if (const int code = MatchModelsToFolders(request->folders, &request->models);
+      code != kExitOk) {
+    return code;
+  }
+  request->format_fixed.resize(request->folders.size());
+  for (size_t c = 0; c < request->folders.size(); ++c) {
+    if (!CameraFormatFixedParams(request->format, request->models[c],
+                                 &request->format_fixed[c], &error)) {
       std::cerr << kName << ": --format " << FLAGS_format << ", camera '"
-                << folders[c].filename().string() << "': " << error << ".\n";
+                << request->folders[c].filename().string() << "': " << error
+                << ".\n";
       return kExitUsage;
     }
   }
-
-  // Every camera's images; the frames are the file names of all folders.
-  std::vector<ImageListing> listings(folders.size());
-  std::map<std::string, int> frame_of_name;
-  for (size_t c = 0; c < folders.size(); ++c) {
-    if (!ListImages(folders[c].string(), &listings[c], &error)) {
-      std::cerr << kName << ": camera '" << folders[c].filename().string()
-                << "': " << error << "\n";
-      return kExitBadInput;
-    }
-    for (const std::string& skipped : listings[c].skipped) {
-      LOG(INFO) << "skipped " << skipped;
-    }
-    for (const std::string& file : listings[c].images) {
-      frame_of_name.emplace(fs::path(file).filename().string(), 0);
-    }
-  }
-  int num_frames = 0;
-  for (auto& [name, index] : frame_of_name) index = num_frames++;
-
-  const int threads =
+  request->threads =
       FLAGS_threads > 0
           ? FLAGS_threads
           : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return kExitOk;
+}
+
+// Every camera's images; the frames are the file names of all folders, in
+// sorted order (`frame_of_name`).
+int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
+               std::map<std::string, int>* frame_of_name) {
+  listings->resize(request.folders.size());
+  for (size_t c = 0; c < request.folders.size(); ++c) {
+    std::string error;
+    if (!ListImages(request.folders[c].string(), &(*listings)[c], &error)) {
+      std::cerr << kName << ": camera '"
+                << request.folders[c].filename().string() << "': " << error
+                << "\n";
+      return kExitBadInput;
+    }
+    for (const std::string& skipped : (*listings)[c].skipped) {
+      LOG(INFO) << "skipped " << skipped;
+    }
+    for (const std::string& file : (*listings)[c].images) {
+      frame_of_name->emplace(fs::path(file).filename().string(), 0);
+    }
+  }
+  int num_frames = 0;
+  for (auto& [name, index] : *frame_of_name) index = num_frames++;
+  return kExitOk;
+}
+
+// Detection, grid and decode of one camera's images into its rig input:
+// one (possibly empty) view per frame; `frame_files` receives the image
+// file of each frame ("" where the camera has none).
+int DetectCamera(const RigRequest& request, size_t c,
+                 const ImageListing& listing,
+                 const std::map<std::string, int>& frame_of_name,
+                 RigCameraInput* input, std::vector<std::string>* frame_files) {
+  const int num_frames = static_cast<int>(frame_of_name.size());
+  input->name = request.folders[c].filename().string();
+  input->model = request.models[c];
+  input->fixed_params = request.format_fixed[c];
+  input->frames.resize(num_frames);
+  frame_files->assign(num_frames, "");
+  std::vector<ImageResult> images = ProcessImageFiles(
+      listing.images, request.board, PipelineOptions(), request.threads);
+  std::vector<CalibrationView> views = MakeCalibrationViews(
+      request.board, &images, &input->width, &input->height);
+  int usable = 0;
+  for (const ImageResult& image : images) {
+    const std::string name = fs::path(image.file).filename().string();
+    const int frame = frame_of_name.at(name);
+    (*frame_files)[frame] = image.file;
+    if (image.view_index < 0) {
+      LOG(WARNING) << image.file << ": " << ImageOutcomeName(image.outcome)
+                   << (image.reason.empty() ? "" : " (" + image.reason + ")");
+      continue;
+    }
+    input->frames[frame] = std::move(views[image.view_index]);
+    ++usable;
+  }
+  std::cerr << "camera '" << input->name << "': " << usable << " of "
+            << images.size() << " images usable\n";
+  if (usable > 0) return kExitOk;
+  std::cerr << kName << ": camera '" << input->name << "' ("
+            << request.folders[c].string()
+            << "): no image shows the board; no calibration written.\n";
+  return kExitBadInput;
+}
+
+// The rig's figures, each camera's own calibration judged as `calibrate`
+// judges one camera (halves, uncertainty, binned residuals;
+// calib/verdict.h), the time and what was written.
+void PrintRigOutcome(const std::vector<RigCameraInput>& inputs,
+                     const RigCalibrationOptions& options,
+                     const RigCalibrationResult& result, int threads,
+                     double seconds_images, double seconds_total,
+                     const std::vector<std::string>& written) {
+  std::cout << RigCalibrationReport(result);
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    const RigCameraResult& cam = result.cameras[c];
+    const EvidenceOptions evidence_options;
+    const Evidence evidence = ComputeEvidence(inputs[c].frames, cam.single,
+                                              options.camera, evidence_options);
+    const Verdict verdict =
+        MakeVerdict(cam.single, evidence, evidence_options, VerdictOptions());
+    std::cout << cam.name << ": " << verdict.Line() << "\n";
+  }
+  std::cout << "time: " << seconds_total << " s wall clock on " << threads
+            << " threads (images " << seconds_images << " s, calibration "
+            << result.seconds_single + result.seconds_joint << " s)\n";
+  for (const std::string& path : written) std::cout << "wrote " << path << "\n";
+}
+
+int RunCalibrateRig() {
+  const Timer run_timer;
+  RigRequest request;
+  if (const int code = ParseRigRequest(&request); code != kExitOk) {
+    return code;
+  }
+  std::vector<ImageListing> listings;
+  std::map<std::string, int> frame_of_name;
+  if (const int code = ListFrames(request, &listings, &frame_of_name);
+      code != kExitOk) {
+    return code;
+  }
   cv::setNumThreads(1);
   const Timer images_timer;
-  std::vector<RigCameraInput> inputs(folders.size());
-  std::vector<std::vector<std::string>> frame_files(
-      folders.size(), std::vector<std::string>(num_frames));
-  PipelineOptions pipeline_options;
-  for (size_t c = 0; c < folders.size(); ++c) {
-    RigCameraInput& input = inputs[c];
-    input.name = folders[c].filename().string();
-    input.model = models[c];
-    input.fixed_params = format_fixed[c];
-    input.frames.resize(num_frames);
-    std::vector<ImageResult> images =
-        ProcessImageFiles(listings[c].images, board, pipeline_options, threads);
-    std::vector<CalibrationView> views =
-        MakeCalibrationViews(board, &images, &input.width, &input.height);
-    int usable = 0;
-    for (size_t i = 0; i < images.size(); ++i) {
-      const std::string name = fs::path(images[i].file).filename().string();
-      const int frame = frame_of_name[name];
-      frame_files[c][frame] = images[i].file;
-      if (images[i].view_index < 0) {
-        LOG(WARNING) << images[i].file << ": "
-                     << ImageOutcomeName(images[i].outcome)
-                     << (images[i].reason.empty()
-                             ? ""
-                             : " (" + images[i].reason + ")");
-        continue;
-      }
-      input.frames[frame] = std::move(views[images[i].view_index]);
-      ++usable;
-    }
-    std::cerr << "camera '" << input.name << "': " << usable << " of "
-              << images.size() << " images usable\n";
-    if (usable == 0) {
-      std::cerr << kName << ": camera '" << input.name << "' ("
-                << folders[c].string()
-                << "): no image shows the board; no calibration written.\n";
-      return kExitBadInput;
+  const size_t num_cameras = request.folders.size();
+  std::vector<RigCameraInput> inputs(num_cameras);
+  std::vector<std::vector<std::string>> frame_files(num_cameras);
+  for (size_t c = 0; c < num_cameras; ++c) {
+    if (const int code = DetectCamera(request, c, listings[c], frame_of_name,
+                                      &inputs[c], &frame_files[c]);
+        code != kExitOk) {
+      return code;
     }
   }
   const double seconds_images = images_timer.Seconds();
 
   RigCalibrationOptions options;
-  options.camera.num_threads = threads;
+  options.camera.num_threads = request.threads;
   RigCalibrationResult result;
-  std::string calibration_error;
+  std::string calibration_error, error;
   const bool calibrated =
       CalibrateRig(inputs, options, &result, &calibration_error);
-
   if (!FLAGS_report.empty()) {
     RigReportInput report;
     report.result = &result;
@@ -226,7 +307,7 @@ int RunCalibrateRig() {
     report.files = frame_files;
     report.seconds_images = seconds_images;
     report.seconds_total = run_timer.Seconds();
-    report.threads = threads;
+    report.threads = request.threads;
     if (!WriteRigReport(FLAGS_report, report, RigReportOptions(), &error)) {
       std::cerr << kName << ": report not written: " << error << "\n";
       if (calibrated) return kExitOutputError;
@@ -238,26 +319,12 @@ int RunCalibrateRig() {
     return kExitNoResult;
   }
   std::vector<std::string> written;
-  if (!WriteRigFiles(FLAGS_out, format, result, &written, &error)) {
+  if (!WriteRigFiles(FLAGS_out, request.format, result, &written, &error)) {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
   }
-  std::cout << RigCalibrationReport(result);
-  // Each camera's own calibration judged as `calibrate` judges one camera
-  // (halves, uncertainty, binned residuals; calib/verdict.h).
-  for (size_t c = 0; c < result.cameras.size(); ++c) {
-    const RigCameraResult& cam = result.cameras[c];
-    const EvidenceOptions evidence_options;
-    const Evidence evidence = ComputeEvidence(inputs[c].frames, cam.single,
-                                              options.camera, evidence_options);
-    const Verdict verdict =
-        MakeVerdict(cam.single, evidence, evidence_options, VerdictOptions());
-    std::cout << cam.name << ": " << verdict.Line() << "\n";
-  }
-  std::cout << "time: " << run_timer.Seconds() << " s wall clock on " << threads
-            << " threads (images " << seconds_images << " s, calibration "
-            << result.seconds_single + result.seconds_joint << " s)\n";
-  for (const std::string& path : written) std::cout << "wrote " << path << "\n";
+  PrintRigOutcome(inputs, options, result, request.threads, seconds_images,
+                  run_timer.Seconds(), written);
   return kExitOk;
 }
 
