@@ -222,6 +222,73 @@ TEST_F(ConfigIoTest, BuiltInScenesRoundTripThroughTheirRecipes) {
   EXPECT_FALSE(MakeBuiltInScene("wide_pinhol", 0, 0, &unknown));
 }
 
+// A scene with every field the recipe writes away from its default (the
+// built-ins leave some at theirs), so a field the writer forgot would show.
+TEST_F(ConfigIoTest, EveryRecipeFieldRoundTrips) {
+  SceneSpec scene = WidePinholeScene(96, 72);
+  scene.name = "every: \"field\" #";
+  scene.board.origin = Eigen::Vector2i(11, 13);
+  RenderOptions& o = scene.render;
+  o.supersampling = 3;
+  o.blur_sigma_px = 0.9;
+  o.black_level = 0.11;
+  o.white_level = 0.87;
+  o.background_level = 0.31;
+  o.paper_margin_tiles = 0.6;
+  o.lighting_gradient = 0.2;
+  o.vignetting = 0.25;
+  o.gamma = 1.7;
+  o.noise_sigma = 0.01;
+  o.seed = 12345678901234ull;
+  o.field_of_view_deg = 120.0 / 7.0 * 7.0 + 1.0 / 3.0;
+  o.occluders = {{Eigen::Vector2d(10.1, 20.2), 3.3, 0.25}};
+  o.variant.random_code_seed = 99;
+  o.variant.mirrored = true;
+  o.variant.inverted = true;
+  SceneViewSpec view;
+  view.name = "explicit";
+  view.cam_from_board.linear() =
+      Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  view.cam_from_board.translation() = Eigen::Vector3d(-0.3, -0.2, 0.9);
+  view.occluders = {{Eigen::Vector2d(40.0 / 3.0, 7.0), 5.0, 0.75}};
+  scene.views = {view};
+  RandomViews& rv = scene.random_views;
+  rv.count = 2;
+  rv.seed = 77;
+  rv.min_distance_m = 0.7;
+  rv.max_distance_m = 1.1;
+  rv.min_view_angle_deg = 50;
+  rv.max_view_angle_deg = 80;
+  rv.max_roll_deg = 25;
+  rv.max_off_axis_deg = 10;
+  rv.target_margin_tiles = 1.5;
+  rv.occluders_per_view = 2;
+  rv.min_occluder_radius_px = 3;
+  rv.max_occluder_radius_px = 6;
+  scene.tilt_series = {{90, 70}, 0.95, 30};
+  scene.tile_size_series = {{6, 9}, 80, 12};
+  ASSERT_TRUE(scene.Check());
+
+  const std::string text = SceneRecipeYaml(scene);
+  SceneSpec loaded;
+  std::string error;
+  ASSERT_TRUE(LoadSceneFile(Write("every.yaml", text), &loaded, &error))
+      << error << "\n"
+      << text;
+  ExpectSameScene(loaded, scene, 0.0, "every field");
+  EXPECT_EQ(loaded.tilt_series.view_angles_deg,
+            scene.tilt_series.view_angles_deg);
+  EXPECT_EQ(loaded.tile_size_series.tile_px, scene.tile_size_series.tile_px);
+  const size_t n = SceneViewSpecs(scene).size();
+  ASSERT_EQ(n, 7u);
+  for (size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(cv::norm(RenderOneView(scene, i), RenderOneView(loaded, i),
+                       cv::NORM_INF),
+              0)
+        << "view " << i;
+  }
+}
+
 // By name: a built-in at its own size or another; otherwise a recipe file,
 // whose size is its own.
 TEST_F(ConfigIoTest, LoadSceneTakesANameOrARecipe) {
