@@ -1,15 +1,13 @@
 // `puzzlecal compare`: a calibrated camera file next to the truth of a
 // rendered set (truth.yaml of `puzzlecal render`).
 
-#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
-
 #include "apps/common_flags.h"
+#include "apps/config_io.h"
 #include "apps/subcommand.h"
 #include "calib/camera_models.h"
 #include "calib/camera_yaml.h"
@@ -31,31 +29,23 @@ int RunCompare() {
     std::cerr << "puzzlecal compare: " << error << "\n";
     return kExitBadInput;
   }
-  std::vector<double> truth;
-  std::string truth_model;
-  try {
-    const YAML::Node root = YAML::LoadFile(FLAGS_truth);
-    truth_model = root["camera"]["model"].as<std::string>();
-    truth = root["camera"]["params"].as<std::vector<double>>();
-  } catch (const YAML::Exception& e) {
-    std::cerr << "puzzlecal compare: " << FLAGS_truth
-              << ": field 'camera/model' or 'camera/params' missing or "
-                 "invalid ("
-              << e.what() << ")\n";
+  SceneTruth truth;
+  if (!ReadSceneTruthFile(FLAGS_truth, &truth, &error)) {
+    std::cerr << "puzzlecal compare: " << error << "\n";
     return kExitBadInput;
   }
-  if (truth_model != CameraModelName(camera.model) ||
-      truth.size() != camera.params.size()) {
+  if (truth.camera.model != camera.model) {
     std::cerr << "puzzlecal compare: " << FLAGS_camera << " holds a "
               << CameraModelName(camera.model) << " camera, " << FLAGS_truth
-              << " a " << truth_model << " camera.\n";
+              << " a " << CameraModelName(truth.camera.model) << " camera.\n";
     return kExitBadInput;
   }
   const std::vector<std::string> names = CameraModelParamNames(camera.model);
   std::printf("%-4s %16s %16s %14s\n", "", "calibrated", "truth", "difference");
   for (size_t i = 0; i < names.size(); ++i) {
     std::printf("%-4s %16.6f %16.6f %14.6f\n", names[i].c_str(),
-                camera.params[i], truth[i], camera.params[i] - truth[i]);
+                camera.params[i], truth.camera.params[i],
+                camera.params[i] - truth.camera.params[i]);
   }
   return kExitOk;
 }

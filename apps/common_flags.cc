@@ -16,7 +16,9 @@ DEFINE_string(format, "puzzlecal",
               "Camera file format: puzzlecal, opencv, ros or kalibr.");
 DEFINE_string(report, "", "Folder for the calibration report (optional).");
 DEFINE_string(draw, "", "Folder for detection overlays (optional).");
-DEFINE_string(scene, "", "Scene recipe YAML (see configs/scenes/).");
+DEFINE_string(scene, "",
+              "A built-in scene by name (e.g. wide_pinhole) or a scene "
+              "recipe YAML (see configs/scenes/README.md).");
 DEFINE_int32(threads, 0, "Worker threads; 0 = all cores.");
 DEFINE_int32(dpi, 300, "Resolution of PNG board output, dots per inch.");
 DEFINE_string(rostopic, "/cam0/image_raw",

@@ -2,196 +2,20 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include <limits>
 #include <set>
-#include <sstream>
+
+#include "calib/yaml_emit.h"
+#include "calib/yaml_fields.h"
+#include "util/failure.h"
 
 namespace puzzlecal {
 namespace {
 
-// Reads typed fields out of one YAML file and records the first error as
-// "FILE: field 'PATH': PROBLEM".
-class FieldReader {
- public:
-  FieldReader(std::string file, std::string* error)
-      : file_(std::move(file)), error_(error) {}
-
-  bool ok() const { return ok_; }
-
-  bool Fail(const std::string& field, const std::string& problem) {
-    if (ok_ && error_ != nullptr) {
-      *error_ = field.empty() ? file_ + ": " + problem
-                              : file_ + ": field '" + field + "': " + problem;
-    }
-    ok_ = false;
-    return false;
-  }
-
-  // Fails on keys of `map` outside `allowed`.
-  bool OnlyKeys(const YAML::Node& map, const std::string& path,
-                const std::set<std::string>& allowed) {
-    if (!map.IsMap()) {
-      return Fail(path, "must be a map of fields");
-    }
-    for (auto it = map.begin(); it != map.end(); ++it) {
-      const std::string key = it->first.Scalar();
-      if (allowed.count(key) == 0) {
-        std::string names;
-        for (const std::string& name : allowed) {
-          names += (names.empty() ? "" : ", ") + name;
-        }
-        return Fail(Join(path, key),
-                    "unknown field (expected one of: " + names + ")");
-      }
-    }
-    return true;
-  }
-
-  static std::string Join(const std::string& path, const std::string& key) {
-    return path.empty() ? key : path + "." + key;
-  }
-
-  // Scalars. `required` fields must be present; others keep *out.
-  bool Int(const YAML::Node& map, const std::string& path,
-           const std::string& key, bool required, int* out) {
-    const YAML::Node node = map[key];
-    if (!node) return required ? Fail(Join(path, key), "missing") : true;
-    try {
-      if (!node.IsScalar()) throw YAML::Exception(YAML::Mark(), "");
-      *out = node.as<int>();
-    } catch (const YAML::Exception&) {
-      return Fail(Join(path, key),
-                  "must be an integer, got '" + Text(node) + "'");
-    }
-    return true;
-  }
-
-  bool Uint64(const YAML::Node& map, const std::string& path,
-              const std::string& key, bool required, uint64_t* out) {
-    const YAML::Node node = map[key];
-    if (!node) return required ? Fail(Join(path, key), "missing") : true;
-    try {
-      if (!node.IsScalar() || node.Scalar().find('-') != std::string::npos) {
-        throw YAML::Exception(YAML::Mark(), "");
-      }
-      *out = node.as<uint64_t>();
-    } catch (const YAML::Exception&) {
-      return Fail(Join(path, key),
-                  "must be a non-negative integer, got '" + Text(node) + "'");
-    }
-    return true;
-  }
-
-  bool Double(const YAML::Node& map, const std::string& path,
-              const std::string& key, bool required, double* out) {
-    const YAML::Node node = map[key];
-    if (!node) return required ? Fail(Join(path, key), "missing") : true;
-    double value = 0;
-    try {
-      if (!node.IsScalar()) throw YAML::Exception(YAML::Mark(), "");
-      value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      return Fail(Join(path, key),
-                  "must be a number, got '" + Text(node) + "'");
-    }
-    if (!std::isfinite(value)) {
-      return Fail(Join(path, key), "must be a finite number");
-    }
-    *out = value;
-    return true;
-  }
-
-  bool Bool(const YAML::Node& map, const std::string& path,
-            const std::string& key, bool* out) {
-    const YAML::Node node = map[key];
-    if (!node) return true;
-    try {
-      if (!node.IsScalar()) throw YAML::Exception(YAML::Mark(), "");
-      *out = node.as<bool>();
-    } catch (const YAML::Exception&) {
-      return Fail(Join(path, key),
-                  "must be true or false, got '" + Text(node) + "'");
-    }
-    return true;
-  }
-
-  bool String(const YAML::Node& map, const std::string& path,
-              const std::string& key, bool required, std::string* out) {
-    const YAML::Node node = map[key];
-    if (!node) return required ? Fail(Join(path, key), "missing") : true;
-    if (!node.IsScalar()) return Fail(Join(path, key), "must be a string");
-    *out = node.Scalar();
-    return true;
-  }
-
-  // A list of numbers; `size` >= 0 demands that many.
-  bool Doubles(const YAML::Node& map, const std::string& path,
-               const std::string& key, bool required, int size,
-               std::vector<double>* out) {
-    const YAML::Node node = map[key];
-    if (!node) return required ? Fail(Join(path, key), "missing") : true;
-    if (!node.IsSequence()) {
-      return Fail(Join(path, key), "must be a list of numbers like [1, 2]");
-    }
-    if (size >= 0 && static_cast<int>(node.size()) != size) {
-      return Fail(Join(path, key), "must hold " + std::to_string(size) +
-                                       " numbers, got " +
-                                       std::to_string(node.size()));
-    }
-    std::vector<double> values;
-    for (size_t i = 0; i < node.size(); ++i) {
-      double value = 0;
-      try {
-        if (!node[i].IsScalar()) throw YAML::Exception(YAML::Mark(), "");
-        value = node[i].as<double>();
-      } catch (const YAML::Exception&) {
-        return Fail(Join(path, key) + "[" + std::to_string(i) + "]",
-                    "must be a number, got '" + Text(node[i]) + "'");
-      }
-      if (!std::isfinite(value)) {
-        return Fail(Join(path, key) + "[" + std::to_string(i) + "]",
-                    "must be finite");
-      }
-      values.push_back(value);
-    }
-    *out = values;
-    return true;
-  }
-
- private:
-  static std::string Text(const YAML::Node& node) {
-    if (node.IsScalar()) return node.Scalar();
-    if (node.IsSequence()) return "a list";
-    if (node.IsMap()) return "a map";
-    return "nothing";
-  }
-
-  std::string file_;
-  std::string* error_;
-  bool ok_ = true;
-};
-
-bool LoadYaml(const std::string& path, YAML::Node* root, std::string* error) {
-  try {
-    *root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    if (error != nullptr) *error = path + ": cannot open the file";
-    return false;
-  } catch (const YAML::Exception& e) {
-    if (error != nullptr) {
-      *error = path + ": not valid YAML (line " +
-               std::to_string(e.mark.line + 1) + "): " + e.msg;
-    }
-    return false;
-  }
-  if (!root->IsMap()) {
-    if (error != nullptr) *error = path + ": must be a map of fields";
-    return false;
-  }
-  return true;
-}
+constexpr Presence kRequired = Presence::kRequired;
+constexpr Presence kOptional = Presence::kOptional;
 
 bool ParseBoard(const YAML::Node& node, const std::string& path, FieldReader* r,
                 Board* board) {
@@ -201,18 +25,18 @@ bool ParseBoard(const YAML::Node& node, const std::string& path, FieldReader* r,
   }
   Board b;
   std::string type;
-  if (!r->String(node, path, "type", true, &type)) return false;
+  if (!r->String(node, path, "type", kRequired, &type)) return false;
   if (!BoardTypeFromName(type, &b.type)) {
     return r->Fail(FieldReader::Join(path, "type"),
                    "must be puzzleboard or checkerboard, got '" + type + "'");
   }
-  if (!r->Int(node, path, "cols", true, &b.cols) ||
-      !r->Int(node, path, "rows", true, &b.rows) ||
-      !r->Double(node, path, "tile_size_m", true, &b.tile_size_m)) {
+  if (!r->Int(node, path, "cols", kRequired, &b.cols) ||
+      !r->Int(node, path, "rows", kRequired, &b.rows) ||
+      !r->Double(node, path, "tile_size_m", kRequired, &b.tile_size_m)) {
     return false;
   }
   std::vector<double> origin = {0, 0};
-  if (!r->Doubles(node, path, "origin", false, 2, &origin)) return false;
+  if (!r->Doubles(node, path, "origin", kOptional, 2, &origin)) return false;
   for (int i = 0; i < 2; ++i) {
     if (origin[i] != std::floor(origin[i]) || std::abs(origin[i]) > 1e6) {
       return r->Fail(FieldReader::Join(path, "origin"),
@@ -247,13 +71,13 @@ bool ParseCamera(const YAML::Node& node, FieldReader* r, Camera* camera) {
   std::string model_name;
   CameraModelId model;
   int width = 0, height = 0;
-  if (!r->String(node, path, "model", true, &model_name)) return false;
+  if (!r->String(node, path, "model", kRequired, &model_name)) return false;
   if (!CameraModelIdFromName(model_name, &model)) {
     return r->Fail("camera.model", "unknown model '" + model_name +
                                        "' (known: " + CameraModelNames() + ")");
   }
-  if (!r->Int(node, path, "width", true, &width) ||
-      !r->Int(node, path, "height", true, &height)) {
+  if (!r->Int(node, path, "width", kRequired, &width) ||
+      !r->Int(node, path, "height", kRequired, &height)) {
     return false;
   }
   if (width < 1 || height < 1 || width > 20000 || height > 20000) {
@@ -261,8 +85,8 @@ bool ParseCamera(const YAML::Node& node, FieldReader* r, Camera* camera) {
   }
   if (node["params"]) {
     std::vector<double> params;
-    if (!r->Doubles(node, path, "params", true, CameraModelNumParams(model),
-                    &params)) {
+    if (!r->Doubles(node, path, "params", kRequired,
+                    CameraModelNumParams(model), &params)) {
       return false;
     }
     camera->model = model;
@@ -271,8 +95,8 @@ bool ParseCamera(const YAML::Node& node, FieldReader* r, Camera* camera) {
     camera->height = height;
   } else if (model == CameraModelId::kKannalaBrandt) {
     double fov = 190, circle = 0.96;
-    if (!r->Double(node, path, "fov_deg", false, &fov) ||
-        !r->Double(node, path, "circle_fraction", false, &circle)) {
+    if (!r->Double(node, path, "fov_deg", kOptional, &fov) ||
+        !r->Double(node, path, "circle_fraction", kOptional, &circle)) {
       return false;
     }
     if (!(fov > 1 && fov < 360)) {
@@ -284,8 +108,8 @@ bool ParseCamera(const YAML::Node& node, FieldReader* r, Camera* camera) {
     *camera = FisheyeLensCamera(width, height, fov, circle);
   } else if (model == CameraModelId::kPinholeRadtan) {
     double hfov = 100, k1 = -0.25;
-    if (!r->Double(node, path, "hfov_deg", false, &hfov) ||
-        !r->Double(node, path, "k1", false, &k1)) {
+    if (!r->Double(node, path, "hfov_deg", kOptional, &hfov) ||
+        !r->Double(node, path, "k1", kOptional, &k1)) {
       return false;
     }
     if (!(hfov > 1 && hfov < 179)) {
@@ -313,9 +137,9 @@ bool ParseOccluders(const YAML::Node& map, const std::string& path,
     }
     Occluder o;
     std::vector<double> center;
-    if (!r->Doubles(list[i], item, "center_px", true, 2, &center) ||
-        !r->Double(list[i], item, "radius_px", true, &o.radius_px) ||
-        !r->Double(list[i], item, "grey", false, &o.grey)) {
+    if (!r->Doubles(list[i], item, "center_px", kRequired, 2, &center) ||
+        !r->Double(list[i], item, "radius_px", kRequired, &o.radius_px) ||
+        !r->Double(list[i], item, "grey", kOptional, &o.grey)) {
       return false;
     }
     o.center_px = Eigen::Vector2d(center[0], center[1]);
@@ -335,20 +159,21 @@ bool ParseRender(const YAML::Node& node, FieldReader* r,
     return false;
   }
   RenderOptions& o = *options;
-  if (!r->Int(node, path, "supersampling", false, &o.supersampling) ||
-      !r->Double(node, path, "blur_sigma_px", false, &o.blur_sigma_px) ||
-      !r->Double(node, path, "black_level", false, &o.black_level) ||
-      !r->Double(node, path, "white_level", false, &o.white_level) ||
-      !r->Double(node, path, "background_level", false, &o.background_level) ||
-      !r->Double(node, path, "paper_margin_tiles", false,
+  if (!r->Int(node, path, "supersampling", kOptional, &o.supersampling) ||
+      !r->Double(node, path, "blur_sigma_px", kOptional, &o.blur_sigma_px) ||
+      !r->Double(node, path, "black_level", kOptional, &o.black_level) ||
+      !r->Double(node, path, "white_level", kOptional, &o.white_level) ||
+      !r->Double(node, path, "background_level", kOptional,
+                 &o.background_level) ||
+      !r->Double(node, path, "paper_margin_tiles", kOptional,
                  &o.paper_margin_tiles) ||
-      !r->Double(node, path, "lighting_gradient", false,
+      !r->Double(node, path, "lighting_gradient", kOptional,
                  &o.lighting_gradient) ||
-      !r->Double(node, path, "vignetting", false, &o.vignetting) ||
-      !r->Double(node, path, "gamma", false, &o.gamma) ||
-      !r->Double(node, path, "noise_sigma", false, &o.noise_sigma) ||
-      !r->Uint64(node, path, "seed", false, &o.seed) ||
-      !r->Double(node, path, "field_of_view_deg", false,
+      !r->Double(node, path, "vignetting", kOptional, &o.vignetting) ||
+      !r->Double(node, path, "gamma", kOptional, &o.gamma) ||
+      !r->Double(node, path, "noise_sigma", kOptional, &o.noise_sigma) ||
+      !r->Uint64(node, path, "seed", kOptional, &o.seed) ||
+      !r->Double(node, path, "field_of_view_deg", kOptional,
                  &o.field_of_view_deg) ||
       !ParseOccluders(node, path, r, &o.occluders)) {
     return false;
@@ -357,10 +182,10 @@ bool ParseRender(const YAML::Node& node, FieldReader* r,
     const std::string vpath = "render.variant";
     if (!r->OnlyKeys(variant, vpath,
                      {"random_code_seed", "mirrored", "inverted"}) ||
-        !r->Uint64(variant, vpath, "random_code_seed", false,
+        !r->Uint64(variant, vpath, "random_code_seed", kOptional,
                    &o.variant.random_code_seed) ||
-        !r->Bool(variant, vpath, "mirrored", &o.variant.mirrored) ||
-        !r->Bool(variant, vpath, "inverted", &o.variant.inverted)) {
+        !r->Bool(variant, vpath, "mirrored", kOptional, &o.variant.mirrored) ||
+        !r->Bool(variant, vpath, "inverted", kOptional, &o.variant.inverted)) {
       return false;
     }
   }
@@ -381,14 +206,15 @@ bool ParseViewPose(const YAML::Node& node, const std::string& path,
     return false;
   }
   std::vector<double> target;
-  if (!r->Doubles(node, path, "target", true, 2, &target) ||
-      !r->Double(node, path, "distance_m", true, &view->distance_m) ||
-      !r->Double(node, path, "view_angle_deg", false, &view->view_angle_deg) ||
-      !r->Double(node, path, "tilt_direction_deg", false,
+  if (!r->Doubles(node, path, "target", kRequired, 2, &target) ||
+      !r->Double(node, path, "distance_m", kRequired, &view->distance_m) ||
+      !r->Double(node, path, "view_angle_deg", kOptional,
+                 &view->view_angle_deg) ||
+      !r->Double(node, path, "tilt_direction_deg", kOptional,
                  &view->tilt_direction_deg) ||
-      !r->Double(node, path, "roll_deg", false, &view->roll_deg) ||
-      !r->Double(node, path, "off_axis_deg", false, &view->off_axis_deg) ||
-      !r->Double(node, path, "off_axis_direction_deg", false,
+      !r->Double(node, path, "roll_deg", kOptional, &view->roll_deg) ||
+      !r->Double(node, path, "off_axis_deg", kOptional, &view->off_axis_deg) ||
+      !r->Double(node, path, "off_axis_direction_deg", kOptional,
                  &view->off_axis_direction_deg)) {
     return false;
   }
@@ -413,7 +239,7 @@ bool ParseViews(const YAML::Node& list, FieldReader* r, const Board& board,
       return false;
     }
     SceneViewSpec spec;
-    if (!r->String(node, path, "name", false, &spec.name)) return false;
+    if (!r->String(node, path, "name", kOptional, &spec.name)) return false;
     if (node["pose"]) {
       ViewPose view;
       if (!ParseViewPose(node["pose"], path + ".pose", r, &view)) {
@@ -424,8 +250,8 @@ bool ParseViews(const YAML::Node& list, FieldReader* r, const Board& board,
       const std::string ppath = path + ".cam_from_board";
       std::vector<double> rotation, translation;
       if (!r->OnlyKeys(pose, ppath, {"rotation", "translation"}) ||
-          !r->Doubles(pose, ppath, "rotation", true, 9, &rotation) ||
-          !r->Doubles(pose, ppath, "translation", true, 3, &translation)) {
+          !r->Doubles(pose, ppath, "rotation", kRequired, 9, &rotation) ||
+          !r->Doubles(pose, ppath, "translation", kRequired, 3, &translation)) {
         return false;
       }
       Eigen::Matrix3d rot;
@@ -456,35 +282,27 @@ bool ParseRandomViews(const YAML::Node& node, FieldReader* r, RandomViews* rv) {
               "min_view_angle_deg", "max_view_angle_deg", "max_roll_deg",
               "max_off_axis_deg", "target_margin_tiles", "occluders_per_view",
               "min_occluder_radius_px", "max_occluder_radius_px"}) &&
-         r->Int(node, path, "count", true, &rv->count) &&
-         r->Uint64(node, path, "seed", true, &rv->seed) &&
-         r->Double(node, path, "min_distance_m", false, &rv->min_distance_m) &&
-         r->Double(node, path, "max_distance_m", false, &rv->max_distance_m) &&
-         r->Double(node, path, "min_view_angle_deg", false,
+         r->Int(node, path, "count", kRequired, &rv->count) &&
+         r->Uint64(node, path, "seed", kRequired, &rv->seed) &&
+         r->Double(node, path, "min_distance_m", kOptional,
+                   &rv->min_distance_m) &&
+         r->Double(node, path, "max_distance_m", kOptional,
+                   &rv->max_distance_m) &&
+         r->Double(node, path, "min_view_angle_deg", kOptional,
                    &rv->min_view_angle_deg) &&
-         r->Double(node, path, "max_view_angle_deg", false,
+         r->Double(node, path, "max_view_angle_deg", kOptional,
                    &rv->max_view_angle_deg) &&
-         r->Double(node, path, "max_roll_deg", false, &rv->max_roll_deg) &&
-         r->Double(node, path, "max_off_axis_deg", false,
+         r->Double(node, path, "max_roll_deg", kOptional, &rv->max_roll_deg) &&
+         r->Double(node, path, "max_off_axis_deg", kOptional,
                    &rv->max_off_axis_deg) &&
-         r->Double(node, path, "target_margin_tiles", false,
+         r->Double(node, path, "target_margin_tiles", kOptional,
                    &rv->target_margin_tiles) &&
-         r->Int(node, path, "occluders_per_view", false,
+         r->Int(node, path, "occluders_per_view", kOptional,
                 &rv->occluders_per_view) &&
-         r->Double(node, path, "min_occluder_radius_px", false,
+         r->Double(node, path, "min_occluder_radius_px", kOptional,
                    &rv->min_occluder_radius_px) &&
-         r->Double(node, path, "max_occluder_radius_px", false,
+         r->Double(node, path, "max_occluder_radius_px", kOptional,
                    &rv->max_occluder_radius_px);
-}
-
-void AppendDouble(std::ostringstream* out, double value) {
-  // The shortest of 15 or 17 digits that reads back exactly.
-  char text[40];
-  std::snprintf(text, sizeof(text), "%.15g", value);
-  if (std::strtod(text, nullptr) != value) {
-    std::snprintf(text, sizeof(text), "%.17g", value);
-  }
-  *out << text;
 }
 
 }  // namespace
@@ -507,7 +325,7 @@ bool LoadSceneFile(const std::string& path, SceneSpec* scene,
     return false;
   }
   SceneSpec s;
-  if (!r.String(root, "", "name", true, &s.name)) return false;
+  if (!r.String(root, "", "name", kRequired, &s.name)) return false;
   if (!root["camera"]) return r.Fail("camera", "missing");
   if (!ParseCamera(root["camera"], &r, &s.camera)) return false;
   const YAML::Node board = root["board"];
@@ -537,11 +355,11 @@ bool LoadSceneFile(const std::string& path, SceneSpec* scene,
   if (const YAML::Node tilt = root["tilt_series"]) {
     if (!r.OnlyKeys(tilt, "tilt_series",
                     {"view_angles_deg", "distance_m", "tilt_direction_deg"}) ||
-        !r.Doubles(tilt, "tilt_series", "view_angles_deg", true, -1,
+        !r.Doubles(tilt, "tilt_series", "view_angles_deg", kRequired, -1,
                    &s.tilt_series.view_angles_deg) ||
-        !r.Double(tilt, "tilt_series", "distance_m", true,
+        !r.Double(tilt, "tilt_series", "distance_m", kRequired,
                   &s.tilt_series.distance_m) ||
-        !r.Double(tilt, "tilt_series", "tilt_direction_deg", false,
+        !r.Double(tilt, "tilt_series", "tilt_direction_deg", kOptional,
                   &s.tilt_series.tilt_direction_deg)) {
       return false;
     }
@@ -549,11 +367,11 @@ bool LoadSceneFile(const std::string& path, SceneSpec* scene,
   if (const YAML::Node tiles = root["tile_size_series"]) {
     const std::string tpath = "tile_size_series";
     if (!r.OnlyKeys(tiles, tpath, {"tile_px", "view_angle_deg", "roll_deg"}) ||
-        !r.Doubles(tiles, tpath, "tile_px", true, -1,
+        !r.Doubles(tiles, tpath, "tile_px", kRequired, -1,
                    &s.tile_size_series.tile_px) ||
-        !r.Double(tiles, tpath, "view_angle_deg", false,
+        !r.Double(tiles, tpath, "view_angle_deg", kOptional,
                   &s.tile_size_series.view_angle_deg) ||
-        !r.Double(tiles, tpath, "roll_deg", false,
+        !r.Double(tiles, tpath, "roll_deg", kOptional,
                   &s.tile_size_series.roll_deg)) {
       return false;
     }
@@ -568,66 +386,315 @@ bool LoadSceneFile(const std::string& path, SceneSpec* scene,
   return true;
 }
 
+namespace {
+
+// The board as a map of its fields (the recipe's inline board and the
+// truth's board).
+void EmitBoard(YAML::Emitter& out, const Board& board) {
+  out << YAML::BeginMap;
+  out << YAML::Key << "type" << YAML::Value << BoardTypeName(board.type);
+  out << YAML::Key << "cols" << YAML::Value << board.cols;
+  out << YAML::Key << "rows" << YAML::Value << board.rows;
+  out << YAML::Key << "origin" << YAML::Value << YAML::Flow << YAML::BeginSeq
+      << board.origin.x() << board.origin.y() << YAML::EndSeq;
+  out << YAML::Key << "tile_size_m" << YAML::Value;
+  EmitExact(out, board.tile_size_m);
+  out << YAML::EndMap;
+}
+
+void EmitExactField(YAML::Emitter& out, const char* key, double value) {
+  out << YAML::Key << key << YAML::Value;
+  EmitExact(out, value);
+}
+
+void EmitOccluders(YAML::Emitter& out, const std::vector<Occluder>& list) {
+  out << YAML::Key << "occluders" << YAML::Value << YAML::BeginSeq;
+  for (const Occluder& o : list) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "center_px" << YAML::Value;
+    EmitExactFlow(out, {o.center_px.x(), o.center_px.y()});
+    EmitExactField(out, "radius_px", o.radius_px);
+    EmitExactField(out, "grey", o.grey);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+}
+
+void EmitRender(YAML::Emitter& out, const RenderOptions& o) {
+  out << YAML::Key << "render" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "supersampling" << YAML::Value << o.supersampling;
+  EmitExactField(out, "blur_sigma_px", o.blur_sigma_px);
+  EmitExactField(out, "black_level", o.black_level);
+  EmitExactField(out, "white_level", o.white_level);
+  EmitExactField(out, "background_level", o.background_level);
+  EmitExactField(out, "paper_margin_tiles", o.paper_margin_tiles);
+  EmitExactField(out, "lighting_gradient", o.lighting_gradient);
+  EmitExactField(out, "vignetting", o.vignetting);
+  EmitExactField(out, "gamma", o.gamma);
+  EmitExactField(out, "noise_sigma", o.noise_sigma);
+  out << YAML::Key << "seed" << YAML::Value << o.seed;
+  EmitExactField(out, "field_of_view_deg", o.field_of_view_deg);
+  if (!o.occluders.empty()) EmitOccluders(out, o.occluders);
+  out << YAML::Key << "variant" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  out << YAML::Key << "random_code_seed" << YAML::Value
+      << o.variant.random_code_seed;
+  out << YAML::Key << "mirrored" << YAML::Value << o.variant.mirrored;
+  out << YAML::Key << "inverted" << YAML::Value << o.variant.inverted;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+}
+
+// A pose as the recipe's views and the truth's views hold it.
+void EmitCamFromBoard(YAML::Emitter& out, const Eigen::Isometry3d& pose) {
+  out << YAML::Key << "cam_from_board" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "rotation" << YAML::Value;
+  EmitExactFlow(out, RowMajor(pose.linear()));
+  out << YAML::Key << "translation" << YAML::Value;
+  EmitExactFlow(out, RowMajor(pose.translation()));
+  out << YAML::EndMap;
+}
+
+void EmitRandomViews(YAML::Emitter& out, const RandomViews& rv) {
+  out << YAML::Key << "random_views" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "count" << YAML::Value << rv.count;
+  out << YAML::Key << "seed" << YAML::Value << rv.seed;
+  EmitExactField(out, "min_distance_m", rv.min_distance_m);
+  EmitExactField(out, "max_distance_m", rv.max_distance_m);
+  EmitExactField(out, "min_view_angle_deg", rv.min_view_angle_deg);
+  EmitExactField(out, "max_view_angle_deg", rv.max_view_angle_deg);
+  EmitExactField(out, "max_roll_deg", rv.max_roll_deg);
+  EmitExactField(out, "max_off_axis_deg", rv.max_off_axis_deg);
+  EmitExactField(out, "target_margin_tiles", rv.target_margin_tiles);
+  out << YAML::Key << "occluders_per_view" << YAML::Value
+      << rv.occluders_per_view;
+  EmitExactField(out, "min_occluder_radius_px", rv.min_occluder_radius_px);
+  EmitExactField(out, "max_occluder_radius_px", rv.max_occluder_radius_px);
+  out << YAML::EndMap;
+}
+
+// The camera of a truth file: model, size, parameter names and values.
+bool ParseTruthCamera(const YAML::Node& node, FieldReader& r, Camera* camera) {
+  const std::string path = "camera";
+  std::string model;
+  if (!r.String(node, path, "model", kRequired, &model)) return false;
+  if (!CameraModelIdFromName(model, &camera->model)) {
+    return r.Fail("camera.model", "unknown model '" + model +
+                                      "' (known: " + CameraModelNames() + ")");
+  }
+  return r.Int(node, path, "width", kRequired, &camera->width) &&
+         r.Int(node, path, "height", kRequired, &camera->height) &&
+         r.Doubles(node, path, "params", kRequired,
+                   CameraModelNumParams(camera->model), &camera->params);
+}
+
+// One view of a truth file.
+bool ParseTruthView(const YAML::Node& node, const std::string& path,
+                    FieldReader& r, SceneTruthView* view) {
+  const std::string pose_path = FieldReader::Join(path, "cam_from_board");
+  YAML::Node pose, corners;
+  std::vector<double> rotation, translation;
+  if (!r.String(node, path, "file", kRequired, &view->file) ||
+      !r.String(node, path, "name", kRequired, &view->name) ||
+      !r.Child(node, path, "cam_from_board", kRequired, &pose) ||
+      !r.Doubles(pose, pose_path, "rotation", kRequired, 9, &rotation) ||
+      !r.Doubles(pose, pose_path, "translation", kRequired, 3, &translation) ||
+      !r.List(node, path, "corners", kRequired, &corners)) {
+    return false;
+  }
+  Eigen::Matrix3d rot;
+  for (int k = 0; k < 9; ++k) rot(k / 3, k % 3) = rotation[k];
+  view->cam_from_board.linear() = rot;
+  view->cam_from_board.translation() =
+      Eigen::Vector3d(translation[0], translation[1], translation[2]);
+  const std::string corners_path = FieldReader::Join(path, "corners");
+  for (size_t i = 0; i < corners.size(); ++i) {
+    const std::string field = FieldReader::Index(corners_path, i);
+    std::vector<double> row;
+    if (!r.Numbers(corners[i], field, 5, &row, NonFinite::kAllow)) {
+      return false;
+    }
+    for (int k = 2; k < 5; ++k) {
+      if (!(std::abs(row[k]) <= 1e6 && row[k] == std::floor(row[k]))) {
+        return r.Fail(field, "col, row and visible must be whole numbers");
+      }
+    }
+    TruthCorner corner;
+    corner.xy = Eigen::Vector2d(row[0], row[1]);
+    corner.id =
+        Eigen::Vector2i(static_cast<int>(row[2]), static_cast<int>(row[3]));
+    corner.visible = row[4] != 0;
+    view->corners.push_back(corner);
+  }
+  return true;
+}
+
+}  // namespace
+
 std::string SceneTruthYaml(const SceneSpec& scene,
                            const std::vector<SceneView>& views,
                            const std::vector<std::string>& files) {
-  std::ostringstream out;
-  out << "# Exact geometry of the rendered views. Pixels: the centre of the\n"
-         "# top-left pixel is (0, 0). corners rows: [x, y, col, row, "
-         "visible]\n"
-         "# (x, y = .nan when the corner cannot be projected).\n";
-  out << "scene: \"" << scene.name << "\"\n";
-  out << "camera:\n  model: " << CameraModelName(scene.camera.model) << "\n";
-  out << "  width: " << scene.camera.width << "\n";
-  out << "  height: " << scene.camera.height << "\n";
-  out << "  param_names: [";
-  const std::vector<std::string> names =
-      CameraModelParamNames(scene.camera.model);
-  for (size_t i = 0; i < names.size(); ++i) {
-    out << (i ? ", " : "") << names[i];
-  }
-  out << "]\n  params: [";
-  for (size_t i = 0; i < scene.camera.params.size(); ++i) {
-    if (i) out << ", ";
-    AppendDouble(&out, scene.camera.params[i]);
-  }
-  out << "]\n";
-  out << "board:\n  type: " << BoardTypeName(scene.board.type) << "\n";
-  out << "  cols: " << scene.board.cols << "\n  rows: " << scene.board.rows
-      << "\n  origin: [" << scene.board.origin.x() << ", "
-      << scene.board.origin.y() << "]\n  tile_size_m: ";
-  AppendDouble(&out, scene.board.tile_size_m);
-  out << "\nviews:\n";
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  out << YAML::Key << "scene" << YAML::Value << scene.name;
+  out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "model" << YAML::Value
+      << CameraModelName(scene.camera.model);
+  out << YAML::Key << "width" << YAML::Value << scene.camera.width;
+  out << YAML::Key << "height" << YAML::Value << scene.camera.height;
+  out << YAML::Key << "param_names" << YAML::Value << YAML::Flow
+      << CameraModelParamNames(scene.camera.model);
+  out << YAML::Key << "params" << YAML::Value;
+  EmitExactFlow(out, scene.camera.params);
+  out << YAML::EndMap;
+  out << YAML::Key << "board" << YAML::Value;
+  EmitBoard(out, scene.board);
+  out << YAML::Key << "views" << YAML::Value << YAML::BeginSeq;
   for (size_t v = 0; v < views.size(); ++v) {
     const RenderTruth& truth = views[v].truth;
-    out << "  - file: \"" << (v < files.size() ? files[v] : views[v].name)
-        << "\"\n    name: \"" << views[v].name << "\"\n";
-    out << "    cam_from_board:\n      rotation: [";
-    const Eigen::Matrix3d rot = truth.cam_from_board.linear();
-    for (int k = 0; k < 9; ++k) {
-      if (k) out << ", ";
-      AppendDouble(&out, rot(k / 3, k % 3));
-    }
-    out << "]\n      translation: [";
-    for (int k = 0; k < 3; ++k) {
-      if (k) out << ", ";
-      AppendDouble(&out, truth.cam_from_board.translation()[k]);
-    }
-    out << "]\n    corners:\n";
+    out << YAML::BeginMap;
+    out << YAML::Key << "file" << YAML::Value
+        << (v < files.size() ? files[v] : views[v].name);
+    out << YAML::Key << "name" << YAML::Value << views[v].name;
+    EmitCamFromBoard(out, truth.cam_from_board);
+    out << YAML::Key << "corners" << YAML::Value << YAML::BeginSeq;
     for (const TruthCorner& c : truth.corners) {
-      out << "      - [";
-      if (c.xy.allFinite()) {
-        AppendDouble(&out, c.xy.x());
-        out << ", ";
-        AppendDouble(&out, c.xy.y());
-      } else {
-        out << ".nan, .nan";
-      }
-      out << ", " << c.id.x() << ", " << c.id.y() << ", " << (c.visible ? 1 : 0)
-          << "]\n";
+      out << YAML::Flow << YAML::BeginSeq;
+      // A corner that cannot be projected has no finite position.
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      EmitExact(out, c.xy.allFinite() ? c.xy.x() : nan);
+      EmitExact(out, c.xy.allFinite() ? c.xy.y() : nan);
+      out << c.id.x() << c.id.y() << (c.visible ? 1 : 0) << YAML::EndSeq;
+    }
+    out << YAML::EndSeq;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  return std::string(
+             "# Exact geometry of the rendered views. Pixels: the centre of "
+             "the\n# top-left pixel is (0, 0). corners rows: [x, y, col, row, "
+             "visible]\n# (x, y = .nan when the corner cannot be "
+             "projected).\n") +
+         out.c_str() + "\n";
+}
+
+bool ParseSceneTruth(const std::string& text, const std::string& source,
+                     SceneTruth* truth, std::string* error) {
+  YAML::Node root;
+  if (!ParseYaml(text, source, &root, error)) return false;
+  FieldReader r(source, error);
+  SceneTruth t;
+  YAML::Node camera, board, views;
+  if (!r.Map(root, "") || !r.String(root, "", "scene", kRequired, &t.scene) ||
+      !r.Child(root, "", "camera", kRequired, &camera) ||
+      !ParseTruthCamera(camera, r, &t.camera) ||
+      !r.Child(root, "", "board", kRequired, &board) ||
+      !ParseBoard(board, "board", &r, &t.board) ||
+      !r.List(root, "", "views", kRequired, &views)) {
+    return false;
+  }
+  t.views.resize(views.size());
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (!ParseTruthView(views[v], FieldReader::Index("views", v), r,
+                        &t.views[v])) {
+      return false;
     }
   }
-  return out.str();
+  *truth = t;
+  return true;
+}
+
+bool ReadSceneTruthFile(const std::string& path, SceneTruth* truth,
+                        std::string* error) {
+  std::string text;
+  if (!ReadTextFile(path, &text, error)) return false;
+  return ParseSceneTruth(text, path, truth, error);
+}
+
+std::string SceneRecipeYaml(const SceneSpec& scene) {
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << scene.name;
+  out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "model" << YAML::Value
+      << CameraModelName(scene.camera.model);
+  out << YAML::Key << "width" << YAML::Value << scene.camera.width;
+  out << YAML::Key << "height" << YAML::Value << scene.camera.height;
+  out << YAML::Key << "params" << YAML::Value;
+  EmitExactFlow(out, scene.camera.params);
+  std::string names;
+  for (const std::string& name : CameraModelParamNames(scene.camera.model)) {
+    names += (names.empty() ? "" : " ") + name;
+  }
+  out << YAML::Comment(names);
+  out << YAML::EndMap;
+  out << YAML::Key << "board" << YAML::Value;
+  EmitBoard(out, scene.board);
+  EmitRender(out, scene.render);
+  if (!scene.views.empty()) {
+    out << YAML::Key << "views" << YAML::Value << YAML::BeginSeq;
+    for (const SceneViewSpec& view : scene.views) {
+      out << YAML::BeginMap;
+      out << YAML::Key << "name" << YAML::Value << view.name;
+      EmitCamFromBoard(out, view.cam_from_board);
+      if (!view.occluders.empty()) EmitOccluders(out, view.occluders);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  if (scene.random_views.count > 0) EmitRandomViews(out, scene.random_views);
+  if (!scene.tilt_series.view_angles_deg.empty()) {
+    const TiltSeries& tilt = scene.tilt_series;
+    out << YAML::Key << "tilt_series" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "view_angles_deg" << YAML::Value;
+    EmitExactFlow(out, tilt.view_angles_deg);
+    EmitExactField(out, "distance_m", tilt.distance_m);
+    EmitExactField(out, "tilt_direction_deg", tilt.tilt_direction_deg);
+    out << YAML::EndMap;
+  }
+  if (!scene.tile_size_series.tile_px.empty()) {
+    const TileSizeSeries& tiles = scene.tile_size_series;
+    out << YAML::Key << "tile_size_series" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "tile_px" << YAML::Value;
+    EmitExactFlow(out, tiles.tile_px);
+    EmitExactField(out, "view_angle_deg", tiles.view_angle_deg);
+    EmitExactField(out, "roll_deg", tiles.roll_deg);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  return "# Scene recipe '" + scene.name +
+         "' (fields: configs/scenes/README.md).\n" + out.c_str() + "\n";
+}
+
+std::vector<std::string> BuiltInSceneNames() {
+  std::vector<std::string> names = StandardSceneNames();
+  names.push_back(kSampleSceneName);
+  return names;
+}
+
+bool MakeBuiltInScene(const std::string& name, int width, int height,
+                      SceneSpec* scene) {
+  if (name == kSampleSceneName) {
+    *scene =
+        width > 0 && height > 0 ? SampleScene(width, height) : SampleScene();
+    return true;
+  }
+  return MakeStandardScene(name, width, height, scene);
+}
+
+bool LoadScene(const std::string& name_or_path, int width, int height,
+               SceneSpec* scene, std::string* error) {
+  const std::vector<std::string> names = BuiltInSceneNames();
+  if (std::find(names.begin(), names.end(), name_or_path) != names.end()) {
+    return MakeBuiltInScene(name_or_path, width, height, scene);
+  }
+  if (width > 0 || height > 0) {
+    return Fail(name_or_path +
+                    ": an image size is for built-in scenes only (a recipe "
+                    "file sets camera.width and camera.height)",
+                error);
+  }
+  return LoadSceneFile(name_or_path, scene, error);
 }
 
 }  // namespace puzzlecal

@@ -5,10 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <limits>
-#include <sstream>
 
+#include "calib/yaml_emit.h"
 #include "util/atomic_file.h"
 #include "util/enum_names.h"
 #include "util/failure.h"
@@ -17,23 +16,6 @@ namespace puzzlecal {
 namespace {
 
 constexpr const char* kPuzzlecalFormatTag = "puzzlecal-camera";
-
-
-YAML::Emitter& Flow(YAML::Emitter& out, const std::vector<double>& values) {
-  out << YAML::Flow << YAML::BeginSeq;
-  for (double v : values) out << v;
-  out << YAML::EndSeq;
-  return out;
-}
-
-std::vector<double> CameraMatrix(const Camera& c) {
-  return {c.params[0], 0, c.params[2], 0, c.params[1], c.params[3], 0, 0, 1};
-}
-
-std::vector<double> Distortion(const Camera& c) {
-  return std::vector<double>(c.params.begin() + kDistortionBegin,
-                             c.params.end());
-}
 
 bool CheckCamera(const Camera& camera, std::string* error) {
   if (static_cast<int>(camera.params.size()) !=
@@ -59,13 +41,10 @@ void EmitView(const CameraFileView& view, YAML::Emitter& out) {
   out << YAML::BeginMap;
   out << YAML::Key << "file" << YAML::Value << view.file;
   out << YAML::Key << "cam_from_board" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "R" << YAML::Value << YAML::BeginSeq;
-  const Eigen::Matrix3d& r = view.cam_from_board.linear();
-  for (int i = 0; i < 3; ++i) Flow(out, {r(i, 0), r(i, 1), r(i, 2)});
-  out << YAML::EndSeq;
-  const Eigen::Vector3d& t = view.cam_from_board.translation();
+  out << YAML::Key << "R" << YAML::Value;
+  EmitRows(out, view.cam_from_board.linear());
   out << YAML::Key << "t" << YAML::Value;
-  Flow(out, {t.x(), t.y(), t.z()});
+  EmitFlow(out, RowMajor(view.cam_from_board.translation()));
   out << YAML::EndMap;
   out << YAML::Key << "rms_px" << YAML::Value << view.rms_px;
   out << YAML::Key << "corners" << YAML::Value << view.corners;
@@ -82,18 +61,10 @@ std::string FormatPuzzlecal(const Camera& camera,
   out << YAML::Key << "model" << YAML::Value << CameraModelName(camera.model);
   out << YAML::Key << "image_width" << YAML::Value << camera.width;
   out << YAML::Key << "image_height" << YAML::Value << camera.height;
-  out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
-  for (size_t k = 0; k < names.size(); ++k) {
-    out << YAML::Key << names[k] << YAML::Value << camera.params[k];
-  }
-  out << YAML::EndMap;
+  EmitNamedValues(out, "parameters", names, camera.params);
   if (stats.has_stats) {
     if (stats.param_stddev.size() == names.size()) {
-      out << YAML::Key << "parameter_stddev" << YAML::Value << YAML::BeginMap;
-      for (size_t k = 0; k < names.size(); ++k) {
-        out << YAML::Key << names[k] << YAML::Value << stats.param_stddev[k];
-      }
-      out << YAML::EndMap;
+      EmitNamedValues(out, "parameter_stddev", names, stats.param_stddev);
     }
     out << YAML::Key << "rms_px" << YAML::Value << stats.rms_px;
     out << YAML::Key << "views_used" << YAML::Value << stats.num_views_used;
@@ -119,23 +90,13 @@ constexpr char kOpenCvFisheyeKey[] = "fisheye_distortion_coefficients";
 std::string FormatOpenCv(const Camera& camera) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
-  auto matrix = [&](const char* key, int rows, int cols,
-                    const std::vector<double>& data) {
-    out << YAML::Key << key << YAML::Value
-        << YAML::SecondaryTag("opencv-matrix") << YAML::BeginMap;
-    out << YAML::Key << "rows" << YAML::Value << rows;
-    out << YAML::Key << "cols" << YAML::Value << cols;
-    out << YAML::Key << "dt" << YAML::Value << "d";
-    out << YAML::Key << "data" << YAML::Value;
-    Flow(out, data);
-    out << YAML::EndMap;
-  };
   out << YAML::BeginMap;
   out << YAML::Key << "model" << YAML::Value << CameraModelName(camera.model);
   out << YAML::Key << "image_width" << YAML::Value << camera.width;
   out << YAML::Key << "image_height" << YAML::Value << camera.height;
-  matrix("camera_matrix", 3, 3, CameraMatrix(camera));
-  const std::vector<double> distortion = Distortion(camera);
+  EmitOpenCvMatrix(out, "camera_matrix", 3, 3,
+                   RowMajor(CameraMatrixOf(camera)));
+  const std::vector<double> distortion = DistortionOf(camera);
   // A fisheye's k1..k4 under OpenCV's usual key would be read as pinhole
   // k1 k2 p1 p2 by cv::undistort and friends; its own key (the D of
   // cv::fisheye) makes pinhole readers fail loudly instead.
@@ -143,8 +104,8 @@ std::string FormatOpenCv(const Camera& camera) {
   if (fisheye) {
     out << YAML::Key << "distortion_model" << YAML::Value << "fisheye";
   }
-  matrix(fisheye ? kOpenCvFisheyeKey : "distortion_coefficients", 1,
-         static_cast<int>(distortion.size()), distortion);
+  EmitOpenCvMatrix(out, fisheye ? kOpenCvFisheyeKey : "distortion_coefficients",
+                   1, static_cast<int>(distortion.size()), distortion);
   out << YAML::EndMap;
   return std::string("%YAML:1.0\n---\n") + out.c_str() + "\n";
 }
@@ -152,29 +113,20 @@ std::string FormatOpenCv(const Camera& camera) {
 std::string FormatRos(const Camera& camera, const std::string& camera_name) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
-  auto matrix = [&](const char* key, int rows, int cols,
-                    const std::vector<double>& data) {
-    out << YAML::Key << key << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "rows" << YAML::Value << rows;
-    out << YAML::Key << "cols" << YAML::Value << cols;
-    out << YAML::Key << "data" << YAML::Value;
-    Flow(out, data);
-    out << YAML::EndMap;
-  };
   const auto& p = camera.params;
   out << YAML::BeginMap;
   out << YAML::Key << "image_width" << YAML::Value << camera.width;
   out << YAML::Key << "image_height" << YAML::Value << camera.height;
   out << YAML::Key << "camera_name" << YAML::Value << camera_name;
-  matrix("camera_matrix", 3, 3, CameraMatrix(camera));
+  EmitRosMatrix(out, "camera_matrix", 3, 3, RowMajor(CameraMatrixOf(camera)));
   out << YAML::Key << "distortion_model" << YAML::Value
       << RosDistortionModel(camera.model);
-  const std::vector<double> distortion = Distortion(camera);
-  matrix("distortion_coefficients", 1, static_cast<int>(distortion.size()),
-         distortion);
-  matrix("rectification_matrix", 3, 3, {1, 0, 0, 0, 1, 0, 0, 0, 1});
-  matrix("projection_matrix", 3, 4,
-         {p[0], 0, p[2], 0, 0, p[1], p[3], 0, 0, 0, 1, 0});
+  const std::vector<double> distortion = DistortionOf(camera);
+  EmitRosMatrix(out, "distortion_coefficients", 1,
+                static_cast<int>(distortion.size()), distortion);
+  EmitRosMatrix(out, "rectification_matrix", 3, 3, {1, 0, 0, 0, 1, 0, 0, 0, 1});
+  EmitRosMatrix(out, "projection_matrix", 3, 4,
+                {p[0], 0, p[2], 0, 0, p[1], p[3], 0, 0, 0, 1, 0});
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
@@ -217,10 +169,10 @@ bool FormatKalibr(const Camera& camera, const std::string& rostopic,
   out << YAML::BeginMap << YAML::Key << "cam0" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "camera_model" << YAML::Value << "pinhole";
   out << YAML::Key << "intrinsics" << YAML::Value;
-  Flow(out, {p[0], p[1], p[2], p[3]});
+  EmitFlow(out, {p[0], p[1], p[2], p[3]});
   out << YAML::Key << "distortion_model" << YAML::Value << model;
   out << YAML::Key << "distortion_coeffs" << YAML::Value;
-  Flow(out, coeffs);
+  EmitFlow(out, coeffs);
   out << YAML::Key << "resolution" << YAML::Value << YAML::Flow
       << YAML::BeginSeq << camera.width << camera.height << YAML::EndSeq;
   out << YAML::Key << "rostopic" << YAML::Value << rostopic;
@@ -231,239 +183,147 @@ bool FormatKalibr(const Camera& camera, const std::string& rostopic,
 
 // ---- reading ----
 
-// Field access with messages that name the source and the field.
-class Reader {
- public:
-  Reader(const std::string& source, std::string* error)
-      : source_(source), error_(error) {}
-
-  bool Fail(const std::string& field, const std::string& what) {
-    if (error_ != nullptr) {
-      *error_ = source_ + ": field '" + field + "': " + what;
-    }
-    return false;
-  }
-
-  bool Get(const YAML::Node& node, const std::string& field, const char* key,
-           YAML::Node* child) {
-    if (!node.IsMap() || !node[key]) return Fail(field, "missing");
-    *child = node[key];
-    return true;
-  }
-
-  template <typename T>
-  bool Scalar(const YAML::Node& node, const std::string& field, T* value) {
-    if (!node.IsScalar()) return Fail(field, "expected a single value");
-    try {
-      *value = node.as<T>();
-    } catch (const YAML::Exception&) {
-      return Fail(field, "cannot read '" + node.Scalar() + "' as a number");
-    }
-    return true;
-  }
-
-  bool Numbers(const YAML::Node& node, const std::string& field,
-               std::vector<double>* values) {
-    if (!node.IsSequence()) return Fail(field, "expected a list of numbers");
-    values->clear();
-    for (size_t i = 0; i < node.size(); ++i) {
-      double v;
-      if (!Scalar(node[i], field + "[" + std::to_string(i) + "]", &v)) {
-        return false;
-      }
-      if (!std::isfinite(v)) {
-        return Fail(field + "[" + std::to_string(i) + "]", "not finite");
-      }
-      values->push_back(v);
-    }
-    return true;
-  }
-
-  // {rows, cols, data} as written by ROS and OpenCV.
-  bool Matrix(const YAML::Node& node, const std::string& field, int rows,
-              int cols, std::vector<double>* data) {
-    YAML::Node child;
-    if (!Get(node, field, "data", &child)) return false;
-    if (!Numbers(child, field + "/data", data)) return false;
-    if (rows > 0 && cols > 0 && static_cast<int>(data->size()) != rows * cols) {
-      return Fail(field + "/data", "expected " + std::to_string(rows * cols) +
-                                       " numbers, got " +
-                                       std::to_string(data->size()));
-    }
-    return true;
-  }
-
-  bool Size(const YAML::Node& root, Camera* camera) {
-    YAML::Node w, h;
-    if (!Get(root, "image_width", "image_width", &w) ||
-        !Scalar(w, "image_width", &camera->width)) {
-      return false;
-    }
-    if (!Get(root, "image_height", "image_height", &h) ||
-        !Scalar(h, "image_height", &camera->height)) {
-      return false;
-    }
-    if (camera->width <= 0) return Fail("image_width", "must be positive");
-    if (camera->height <= 0) return Fail("image_height", "must be positive");
-    return true;
-  }
-
-  // fx fy cx cy from a row-major 3x3 camera matrix.
-  bool Intrinsics(const std::vector<double>& k, const std::string& field,
-                  Camera* camera) {
-    if (k.size() != 9) return Fail(field, "expected 9 numbers");
-    if (k[1] != 0) return Fail(field, "skew is not supported");
-    if (!(k[0] > 0) || !(k[4] > 0)) {
-      return Fail(field, "focal lengths must be positive");
-    }
-    camera->params[0] = k[0];
-    camera->params[1] = k[4];
-    camera->params[2] = k[2];
-    camera->params[3] = k[5];
-    return true;
-  }
-
-  // Distortion coefficients into camera->params (zero-padded where the
-  // format allows shorter lists).
-  bool SetDistortion(const std::vector<double>& d, const std::string& field,
-                     size_t min_count, Camera* camera) {
-    const size_t count = camera->params.size() - kDistortionBegin;
-    if (d.size() < min_count || d.size() > count) {
-      return Fail(field,
-                  std::string("expected ") +
-                      (min_count == count ? std::to_string(count)
-                                          : std::to_string(min_count) + " to " +
-                                                std::to_string(count)) +
-                      " coefficients for " + CameraModelName(camera->model) +
-                      ", got " + std::to_string(d.size()));
-    }
-    for (size_t i = 0; i < d.size(); ++i) {
-      camera->params[kDistortionBegin + i] = d[i];
-    }
-    return true;
-  }
-
-  bool Model(const YAML::Node& node, const std::string& field,
-             CameraModelId* id) {
-    std::string name;
-    if (!Scalar(node, field, &name)) return false;
-    if (!CameraModelIdFromName(name, id)) {
-      return Fail(field, "unknown model '" + name +
-                             "' (known: " + CameraModelNames() + ")");
-    }
-    return true;
-  }
-
- private:
-  std::string source_;
-  std::string* error_;
-};
+constexpr Presence kRequired = Presence::kRequired;
 
 void ResetCamera(CameraModelId id, Camera* camera) {
   camera->model = id;
   camera->params.assign(CameraModelNumParams(id), 0.0);
 }
 
-bool ParsePuzzlecal(const YAML::Node& root, Reader& r, Camera* camera) {
-  YAML::Node node;
-  CameraModelId id;
-  if (!r.Get(root, "model", "model", &node) || !r.Model(node, "model", &id)) {
-    return false;
-  }
-  ResetCamera(id, camera);
-  if (!r.Size(root, camera)) return false;
-  YAML::Node params;
-  if (!r.Get(root, "parameters", "parameters", &params)) return false;
-  const std::vector<std::string> names = CameraModelParamNames(id);
-  for (size_t k = 0; k < names.size(); ++k) {
-    const std::string field = "parameters/" + names[k];
-    if (!r.Get(params, field, names[k].c_str(), &node) ||
-        !r.Scalar(node, field, &camera->params[k])) {
-      return false;
-    }
-    if (!std::isfinite(camera->params[k])) return r.Fail(field, "not finite");
-  }
-  if (!(camera->params[0] > 0) || !(camera->params[1] > 0)) {
-    return r.Fail("parameters/fx", "focal lengths must be positive");
+bool ReadModel(const YAML::Node& map, const std::string& path, FieldReader& r,
+               CameraModelId* id) {
+  std::string name;
+  if (!r.String(map, path, "model", kRequired, &name)) return false;
+  if (!CameraModelIdFromName(name, id)) {
+    return r.Fail(
+        FieldReader::Join(path, "model"),
+        "unknown model '" + name + "' (known: " + CameraModelNames() + ")");
   }
   return true;
 }
 
-bool ParseViews(const YAML::Node& root, Reader& r,
-                std::vector<CameraFileView>* views) {
-  views->clear();
-  if (!root["views"]) return true;
-  const YAML::Node list = root["views"];
-  if (!list.IsSequence()) return r.Fail("views", "expected a list");
-  for (size_t v = 0; v < list.size(); ++v) {
-    const std::string field = "views[" + std::to_string(v) + "]";
-    CameraFileView view;
-    YAML::Node node, pose, rows;
-    if (!r.Get(list[v], field + "/file", "file", &node) ||
-        !r.Scalar(node, field + "/file", &view.file) ||
-        !r.Get(list[v], field + "/cam_from_board", "cam_from_board", &pose) ||
-        !r.Get(pose, field + "/cam_from_board/R", "R", &rows)) {
+bool ReadImageSize(const YAML::Node& map, const std::string& path,
+                   FieldReader& r, Camera* camera) {
+  if (!r.Int(map, path, "image_width", kRequired, &camera->width) ||
+      !r.Int(map, path, "image_height", kRequired, &camera->height)) {
+    return false;
+  }
+  if (camera->width <= 0) {
+    return r.Fail(FieldReader::Join(path, "image_width"), "must be positive");
+  }
+  if (camera->height <= 0) {
+    return r.Fail(FieldReader::Join(path, "image_height"), "must be positive");
+  }
+  return true;
+}
+
+// fx fy cx cy from a row-major 3x3 camera matrix.
+bool SetIntrinsics(const std::vector<double>& k, const std::string& field,
+                   FieldReader& r, Camera* camera) {
+  if (k[1] != 0) return r.Fail(field, "skew is not supported");
+  if (!(k[0] > 0) || !(k[4] > 0)) {
+    return r.Fail(field, "focal lengths must be positive");
+  }
+  camera->params[0] = k[0];
+  camera->params[1] = k[4];
+  camera->params[2] = k[2];
+  camera->params[3] = k[5];
+  return true;
+}
+
+// Distortion coefficients into camera->params (zero-padded where the
+// format allows shorter lists).
+bool SetDistortion(const std::vector<double>& d, const std::string& field,
+                   size_t min_count, FieldReader& r, Camera* camera) {
+  const size_t count = camera->params.size() - kDistortionBegin;
+  if (d.size() < min_count || d.size() > count) {
+    return r.Fail(field,
+                  std::string("expected ") +
+                      (min_count == count ? std::to_string(count)
+                                          : std::to_string(min_count) + " to " +
+                                                std::to_string(count)) +
+                      " coefficients for " + CameraModelName(camera->model) +
+                      ", got " + std::to_string(d.size()));
+  }
+  for (size_t i = 0; i < d.size(); ++i) {
+    camera->params[kDistortionBegin + i] = d[i];
+  }
+  return true;
+}
+
+bool ParsePuzzlecal(const YAML::Node& map, const std::string& path,
+                    FieldReader& r, Camera* camera) {
+  CameraModelId id;
+  if (!ReadModel(map, path, r, &id)) return false;
+  ResetCamera(id, camera);
+  if (!ReadImageSize(map, path, r, camera)) return false;
+  YAML::Node params;
+  if (!r.Child(map, path, "parameters", kRequired, &params)) return false;
+  const std::string params_path = FieldReader::Join(path, "parameters");
+  const std::vector<std::string> names = CameraModelParamNames(id);
+  for (size_t k = 0; k < names.size(); ++k) {
+    if (!r.Double(params, params_path, names[k], kRequired,
+                  &camera->params[k])) {
       return false;
     }
-    if (!rows.IsSequence() || rows.size() != 3) {
-      return r.Fail(field + "/cam_from_board/R", "expected 3 rows");
-    }
+  }
+  if (!(camera->params[0] > 0) || !(camera->params[1] > 0)) {
+    return r.Fail(FieldReader::Join(params_path, "fx"),
+                  "focal lengths must be positive");
+  }
+  return true;
+}
+
+bool ParseViews(const YAML::Node& root, FieldReader& r,
+                std::vector<CameraFileView>* views) {
+  views->clear();
+  YAML::Node list;
+  if (!r.List(root, "", "views", Presence::kOptional, &list)) return false;
+  for (size_t v = 0; v < list.size(); ++v) {
+    const std::string path = FieldReader::Index("views", v);
+    const std::string pose_path = FieldReader::Join(path, "cam_from_board");
+    CameraFileView view;
+    YAML::Node pose;
     Eigen::Matrix3d rotation;
-    for (int i = 0; i < 3; ++i) {
-      std::vector<double> row;
-      const std::string row_field =
-          field + "/cam_from_board/R[" + std::to_string(i) + "]";
-      if (!r.Numbers(rows[i], row_field, &row)) return false;
-      if (row.size() != 3) return r.Fail(row_field, "expected 3 numbers");
-      for (int j = 0; j < 3; ++j) rotation(i, j) = row[j];
+    std::vector<double> t;
+    if (!r.String(list[v], path, "file", kRequired, &view.file) ||
+        !r.Child(list[v], path, "cam_from_board", kRequired, &pose) ||
+        !r.Rows3x3(pose, pose_path, "R", kRequired, &rotation)) {
+      return false;
     }
     if (!((rotation.transpose() * rotation - Eigen::Matrix3d::Identity())
               .cwiseAbs()
               .maxCoeff() < 1e-6) ||
         !(rotation.determinant() > 0)) {
-      return r.Fail(field + "/cam_from_board/R", "not a rotation matrix");
+      return r.Fail(FieldReader::Join(pose_path, "R"), "not a rotation matrix");
     }
-    std::vector<double> t;
-    if (!r.Get(pose, field + "/cam_from_board/t", "t", &node) ||
-        !r.Numbers(node, field + "/cam_from_board/t", &t)) {
+    if (!r.Doubles(pose, pose_path, "t", kRequired, 3, &t) ||
+        !r.Double(list[v], path, "rms_px", kRequired, &view.rms_px) ||
+        !r.Int(list[v], path, "corners", kRequired, &view.corners)) {
       return false;
-    }
-    if (t.size() != 3) {
-      return r.Fail(field + "/cam_from_board/t", "expected 3 numbers");
     }
     view.cam_from_board.linear() = rotation;
     view.cam_from_board.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
-    if (!r.Get(list[v], field + "/rms_px", "rms_px", &node) ||
-        !r.Scalar(node, field + "/rms_px", &view.rms_px) ||
-        !r.Get(list[v], field + "/corners", "corners", &node) ||
-        !r.Scalar(node, field + "/corners", &view.corners)) {
-      return false;
-    }
     views->push_back(view);
   }
   return true;
 }
 
-bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
-                      Camera* camera) {
+bool ParseOpenCvOrRos(const YAML::Node& map, const std::string& path, bool ros,
+                      FieldReader& r, Camera* camera) {
   CameraModelId id = CameraModelId::kPinholeRadtan;
-  YAML::Node node;
   std::vector<double> k, d;
-  if (!r.Get(root, "camera_matrix", "camera_matrix", &node) ||
-      !r.Matrix(node, "camera_matrix", 3, 3, &k)) {
+  if (!r.Matrix(map, path, "camera_matrix", kRequired, 3, 3, &k)) {
     return false;
   }
-  const char* distortion_key = !ros && root[kOpenCvFisheyeKey]
-                                   ? kOpenCvFisheyeKey
-                                   : "distortion_coefficients";
-  if (!r.Get(root, distortion_key, distortion_key, &node) ||
-      !r.Matrix(node, distortion_key, 0, 0, &d)) {
-    return false;
-  }
+  const std::string distortion_key = !ros && map[kOpenCvFisheyeKey]
+                                         ? kOpenCvFisheyeKey
+                                         : "distortion_coefficients";
+  const std::string distortion_field = FieldReader::Join(path, distortion_key);
+  if (!r.Matrix(map, path, distortion_key, kRequired, 0, 0, &d)) return false;
   if (ros) {
     std::string model;
-    if (!r.Get(root, "distortion_model", "distortion_model", &node) ||
-        !r.Scalar(node, "distortion_model", &model)) {
+    if (!r.String(map, path, "distortion_model", kRequired, &model)) {
       return false;
     }
     if (model == "plumb_bob") {
@@ -473,23 +333,22 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
     } else if (model == "equidistant" || model == "fisheye") {
       id = CameraModelId::kKannalaBrandt;
     } else {
-      return r.Fail("distortion_model",
+      return r.Fail(FieldReader::Join(path, "distortion_model"),
                     "unknown model '" + model +
                         "' (known: plumb_bob, rational_polynomial, "
                         "equidistant)");
     }
-  } else if (root["model"]) {
-    if (!r.Model(root["model"], "model", &id)) return false;
-    if (CameraModelIsFisheye(id) !=
-        (distortion_key == std::string(kOpenCvFisheyeKey))) {
+  } else if (map["model"]) {
+    if (!ReadModel(map, path, r, &id)) return false;
+    if (CameraModelIsFisheye(id) != (distortion_key == kOpenCvFisheyeKey)) {
       return r.Fail(
-          distortion_key,
+          distortion_field,
           std::string("model ") + CameraModelName(id) +
               (CameraModelIsFisheye(id) ? " keeps its coefficients under "
                                         : " cannot use ") +
               kOpenCvFisheyeKey);
     }
-  } else if (distortion_key == std::string(kOpenCvFisheyeKey)) {
+  } else if (distortion_key == kOpenCvFisheyeKey) {
     id = CameraModelId::kKannalaBrandt;
   } else {
     // OpenCV's own files carry no model: tell it by the number of
@@ -499,37 +358,40 @@ bool ParseOpenCvOrRos(const YAML::Node& root, Reader& r, bool ros,
     else if (d.size() == 4 || d.size() == 5)
       id = CameraModelId::kPinholeRadtan;
     else {
-      return r.Fail("distortion_coefficients",
+      return r.Fail(distortion_field,
                     std::to_string(d.size()) +
                         " coefficients without a 'model' field (expected 4, "
                         "5 or 8)");
     }
   }
   ResetCamera(id, camera);
-  if (!r.Size(root, camera)) return false;
-  if (!r.Intrinsics(k, "camera_matrix/data", camera)) return false;
+  if (!ReadImageSize(map, path, r, camera)) return false;
+  if (!SetIntrinsics(k, FieldReader::Join(path, "camera_matrix.data"), r,
+                     camera)) {
+    return false;
+  }
   const size_t count = camera->params.size() - kDistortionBegin;
   // plumb_bob may omit k3; the other models need all coefficients.
   const size_t min_count = id == CameraModelId::kPinholeRadtan ? 4 : count;
-  return r.SetDistortion(d, std::string(distortion_key) + "/data", min_count,
-                         camera);
+  return SetDistortion(d, FieldReader::Join(distortion_field, "data"),
+                       min_count, r, camera);
 }
 
-bool ParseKalibr(const YAML::Node& root, Reader& r, Camera* camera) {
+bool ParseKalibr(const YAML::Node& map, const std::string& path, FieldReader& r,
+                 Camera* camera) {
   YAML::Node cam;
-  if (!r.Get(root, "cam0", "cam0", &cam)) return false;
-  YAML::Node node;
+  if (!r.Child(map, path, "cam0", kRequired, &cam)) return false;
+  const std::string cam_path = FieldReader::Join(path, "cam0");
   std::string camera_model, distortion_model;
-  if (!r.Get(cam, "cam0/camera_model", "camera_model", &node) ||
-      !r.Scalar(node, "cam0/camera_model", &camera_model)) {
+  if (!r.String(cam, cam_path, "camera_model", kRequired, &camera_model)) {
     return false;
   }
   if (camera_model != "pinhole") {
-    return r.Fail("cam0/camera_model",
+    return r.Fail(FieldReader::Join(cam_path, "camera_model"),
                   "only 'pinhole' is supported, got '" + camera_model + "'");
   }
-  if (!r.Get(cam, "cam0/distortion_model", "distortion_model", &node) ||
-      !r.Scalar(node, "cam0/distortion_model", &distortion_model)) {
+  if (!r.String(cam, cam_path, "distortion_model", kRequired,
+                &distortion_model)) {
     return false;
   }
   CameraModelId id;
@@ -538,51 +400,83 @@ bool ParseKalibr(const YAML::Node& root, Reader& r, Camera* camera) {
   } else if (distortion_model == "equidistant") {
     id = CameraModelId::kKannalaBrandt;
   } else {
-    return r.Fail("cam0/distortion_model",
+    return r.Fail(FieldReader::Join(cam_path, "distortion_model"),
                   "unknown model '" + distortion_model +
                       "' (known: radtan, equidistant)");
   }
   ResetCamera(id, camera);
   std::vector<double> intrinsics, coeffs, resolution;
-  if (!r.Get(cam, "cam0/intrinsics", "intrinsics", &node) ||
-      !r.Numbers(node, "cam0/intrinsics", &intrinsics)) {
+  if (!r.Doubles(cam, cam_path, "intrinsics", kRequired, 4, &intrinsics)) {
     return false;
-  }
-  if (intrinsics.size() != 4) {
-    return r.Fail("cam0/intrinsics", "expected [fu, fv, pu, pv]");
   }
   if (!(intrinsics[0] > 0) || !(intrinsics[1] > 0)) {
-    return r.Fail("cam0/intrinsics", "focal lengths must be positive");
+    return r.Fail(FieldReader::Join(cam_path, "intrinsics"),
+                  "focal lengths must be positive");
   }
   for (int k = 0; k < 4; ++k) camera->params[k] = intrinsics[k];
-  if (!r.Get(cam, "cam0/distortion_coeffs", "distortion_coeffs", &node) ||
-      !r.Numbers(node, "cam0/distortion_coeffs", &coeffs)) {
+  if (!r.Doubles(cam, cam_path, "distortion_coeffs", kRequired, 4, &coeffs)) {
     return false;
   }
-  if (coeffs.size() != 4) {
-    return r.Fail("cam0/distortion_coeffs", "expected 4 coefficients, got " +
-                                                std::to_string(coeffs.size()));
-  }
   for (int k = 0; k < 4; ++k) camera->params[kDistortionBegin + k] = coeffs[k];
-  if (!r.Get(cam, "cam0/resolution", "resolution", &node) ||
-      !r.Numbers(node, "cam0/resolution", &resolution)) {
+  if (!r.Doubles(cam, cam_path, "resolution", kRequired, 2, &resolution)) {
     return false;
   }
   // Whole numbers in a sane range before the cast (a double beyond int's
   // range would make it undefined).
-  if (resolution.size() != 2 ||
-      !std::all_of(resolution.begin(), resolution.end(), [](double v) {
+  if (!std::all_of(resolution.begin(), resolution.end(), [](double v) {
         return v >= 1 && v <= 1e6 && v == std::floor(v);
       })) {
-    return r.Fail("cam0/resolution",
-                  "expected [width, height], whole numbers in [1, 1000000]");
+    return r.Fail(FieldReader::Join(cam_path, "resolution"),
+                  "must be [width, height], whole numbers in [1, 1000000]");
   }
   camera->width = static_cast<int>(resolution[0]);
   camera->height = static_cast<int>(resolution[1]);
   return true;
 }
 
+// The root of a camera file's text. yaml-cpp does not know OpenCV's
+// "%YAML:1.0" directive: it becomes a comment (so line numbers stay right),
+// and `opencv_header` says it was there.
+bool ParseCameraText(const std::string& text, const std::string& source,
+                     YAML::Node* root, bool* opencv_header,
+                     std::string* error) {
+  *opencv_header = text.rfind("%YAML:", 0) == 0;
+  return ParseYaml(*opencv_header ? "#" + text.substr(1) : text, source, root,
+                   error);
+}
+
 }  // namespace
+
+bool ParseCameraNode(const YAML::Node& node, const std::string& path,
+                     bool opencv_header, FieldReader* reader, Camera* camera,
+                     CameraFileFormat* format) {
+  FieldReader& r = *reader;
+  if (!r.Map(node, path)) return false;
+  Camera parsed;
+  CameraFileFormat found;
+  bool ok;
+  if (node["format"] || node["parameters"]) {
+    found = CameraFileFormat::kPuzzlecal;
+    ok = ParsePuzzlecal(node, path, r, &parsed);
+  } else if (node["cam0"]) {
+    found = CameraFileFormat::kKalibr;
+    ok = ParseKalibr(node, path, r, &parsed);
+  } else if (node["distortion_model"] && !opencv_header) {
+    found = CameraFileFormat::kRos;
+    ok = ParseOpenCvOrRos(node, path, /*ros=*/true, r, &parsed);
+  } else if (opencv_header || node["camera_matrix"]) {
+    found = CameraFileFormat::kOpenCv;
+    ok = ParseOpenCvOrRos(node, path, /*ros=*/false, r, &parsed);
+  } else {
+    return r.Fail(path,
+                  "not a camera file in any known format (puzzlecal, opencv, "
+                  "ros, kalibr): no 'parameters', 'camera_matrix' or 'cam0'");
+  }
+  if (!ok) return false;
+  *camera = parsed;
+  if (format != nullptr) *format = found;
+  return true;
+}
 
 const char* RosDistortionModel(CameraModelId id) {
   switch (id) {
@@ -852,74 +746,26 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
 bool ParseCameraFile(const std::string& text, const std::string& source,
                      Camera* camera, CameraFileFormat* format,
                      std::string* error) {
-  // yaml-cpp does not know OpenCV's "%YAML:1.0" directive.
-  std::string body = text;
-  bool opencv_header = false;
-  if (body.rfind("%YAML:", 0) == 0) {
-    opencv_header = true;
-    const size_t newline = body.find('\n');
-    body = newline == std::string::npos ? "" : body.substr(newline + 1);
-  }
   YAML::Node root;
-  try {
-    root = YAML::Load(body);
-  } catch (const YAML::Exception& e) {
-    return Fail(source + ": not valid YAML: " + e.what(), error);
+  bool opencv_header = false;
+  if (!ParseCameraText(text, source, &root, &opencv_header, error)) {
+    return false;
   }
   if (!root.IsMap()) {
     return Fail(source + ": not a camera file (expected a YAML map)", error);
   }
-  Reader reader(source, error);
-  Camera parsed;
-  CameraFileFormat found;
-  bool ok;
+  FieldReader reader(source, error);
   try {
-    if (root["format"] || root["parameters"]) {
-      found = CameraFileFormat::kPuzzlecal;
-      ok = ParsePuzzlecal(root, reader, &parsed);
-    } else if (root["cam0"]) {
-      found = CameraFileFormat::kKalibr;
-      ok = ParseKalibr(root, reader, &parsed);
-    } else if (root["distortion_model"] && !opencv_header) {
-      found = CameraFileFormat::kRos;
-      ok = ParseOpenCvOrRos(root, reader, /*ros=*/true, &parsed);
-    } else if (opencv_header || root["camera_matrix"]) {
-      found = CameraFileFormat::kOpenCv;
-      ok = ParseOpenCvOrRos(root, reader, /*ros=*/false, &parsed);
-    } else {
-      return Fail(source +
-                      ": not a camera file in any known format "
-                      "(puzzlecal, opencv, ros, kalibr): no 'parameters', "
-                      "'camera_matrix' or 'cam0'",
-                  error);
-    }
+    return ParseCameraNode(root, "", opencv_header, &reader, camera, format);
   } catch (const YAML::Exception& e) {
     return Fail(source + ": " + e.what(), error);
   }
-  if (!ok) return false;
-  *camera = parsed;
-  if (format != nullptr) *format = found;
-  return true;
 }
-
-namespace {
-
-bool ReadText(const std::string& path, std::string* text, std::string* error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Fail("cannot open '" + path + "'", error);
-  std::ostringstream contents;
-  contents << in.rdbuf();
-  if (in.bad()) return Fail("cannot read '" + path + "'", error);
-  *text = contents.str();
-  return true;
-}
-
-}  // namespace
 
 bool ReadCameraFile(const std::string& path, Camera* camera,
                     std::string* error) {
   std::string text;
-  if (!ReadText(path, &text, error)) return false;
+  if (!ReadTextFile(path, &text, error)) return false;
   return ParseCameraFile(text, path, camera, nullptr, error);
 }
 
@@ -927,12 +773,16 @@ bool ReadCameraFileViews(const std::string& path,
                          std::vector<CameraFileView>* views,
                          std::string* error) {
   std::string text;
-  if (!ReadText(path, &text, error)) return false;
+  YAML::Node root;
+  bool opencv_header = false;
+  if (!ReadTextFile(path, &text, error) ||
+      !ParseCameraText(text, path, &root, &opencv_header, error)) {
+    return false;
+  }
+  if (!root.IsMap()) return Fail(path + ": not a camera file", error);
+  FieldReader reader(path, error);
   try {
-    const YAML::Node root = YAML::Load(text);
-    Reader reader(path, error);
-    return root.IsMap() ? ParseViews(root, reader, views)
-                        : Fail(path + ": not a camera file", error);
+    return ParseViews(root, reader, views);
   } catch (const YAML::Exception& e) {
     return Fail(path + ": " + e.what(), error);
   }

@@ -21,6 +21,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/camera_models.h"
+#include "calib/yaml_fields.h"
 
 namespace puzzlecal {
 
@@ -158,6 +159,12 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
 bool ParseCameraFile(const std::string& text, const std::string& source,
                      Camera* camera, CameraFileFormat* format,
                      std::string* error);
+// The same for a camera held by a YAML map at `path` of a larger file ("":
+// the file's root; a rig file's "cameras[1]"), its messages through
+// `reader`. `opencv_header`: the file began with OpenCV's "%YAML:1.0".
+bool ParseCameraNode(const YAML::Node& node, const std::string& path,
+                     bool opencv_header, FieldReader* reader, Camera* camera,
+                     CameraFileFormat* format);
 // Reads a camera file in any of the four formats.
 bool ReadCameraFile(const std::string& path, Camera* camera,
                     std::string* error);

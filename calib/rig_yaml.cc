@@ -4,12 +4,12 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/core/eigen.hpp>
-#include <sstream>
 
+#include "calib/yaml_emit.h"
+#include "calib/yaml_fields.h"
 #include "util/atomic_file.h"
 #include "util/failure.h"
 
@@ -17,36 +17,6 @@ namespace puzzlecal {
 namespace {
 
 constexpr const char* kRigFormatTag = "puzzlecal-rig";
-
-YAML::Emitter& Flow(YAML::Emitter& out, const std::vector<double>& values) {
-  out << YAML::Flow << YAML::BeginSeq;
-  for (double v : values) out << v;
-  out << YAML::EndSeq;
-  return out;
-}
-
-template <typename Derived>
-std::vector<double> RowMajor(const Eigen::MatrixBase<Derived>& m) {
-  std::vector<double> values;
-  for (int r = 0; r < m.rows(); ++r) {
-    for (int c = 0; c < m.cols(); ++c) values.push_back(m(r, c));
-  }
-  return values;
-}
-
-Eigen::Matrix3d CameraMatrix(const Camera& camera) {
-  Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
-  k(0, 0) = camera.params[0];
-  k(1, 1) = camera.params[1];
-  k(0, 2) = camera.params[2];
-  k(1, 2) = camera.params[3];
-  return k;
-}
-
-std::vector<double> Distortion(const Camera& camera) {
-  return std::vector<double>(camera.params.begin() + kDistortionBegin,
-                             camera.params.end());
-}
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d s;
@@ -89,26 +59,15 @@ std::string FormatPuzzlecal(const RigCalibrationResult& result) {
         << CameraModelName(cam.camera.model);
     out << YAML::Key << "image_width" << YAML::Value << cam.camera.width;
     out << YAML::Key << "image_height" << YAML::Value << cam.camera.height;
-    out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
-    for (size_t k = 0; k < names.size(); ++k) {
-      out << YAML::Key << names[k] << YAML::Value << cam.camera.params[k];
-    }
-    out << YAML::EndMap;
+    EmitNamedValues(out, "parameters", names, cam.camera.params);
     if (result.covariance_ok && cam.param_stddev.size() == names.size()) {
-      out << YAML::Key << "parameter_stddev" << YAML::Value << YAML::BeginMap;
-      for (size_t k = 0; k < names.size(); ++k) {
-        out << YAML::Key << names[k] << YAML::Value << cam.param_stddev[k];
-      }
-      out << YAML::EndMap;
+      EmitNamedValues(out, "parameter_stddev", names, cam.param_stddev);
     }
     out << YAML::Key << "cam_from_rig" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "R" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-    for (int r = 0; r < 3; ++r) {
-      Flow(out, RowMajor(cam.cam_from_rig.linear().row(r)));
-    }
-    out << YAML::EndSeq;
+    out << YAML::Key << "R" << YAML::Value;
+    EmitRows(out, cam.cam_from_rig.linear(), YAML::Flow);
     out << YAML::Key << "t" << YAML::Value;
-    Flow(out, RowMajor(cam.cam_from_rig.translation().transpose()));
+    EmitFlow(out, RowMajor(cam.cam_from_rig.translation()));
     out << YAML::EndMap;
     if (result.covariance_ok) {
       out << YAML::Key << "cam_from_rig_stddev" << YAML::Value
@@ -116,7 +75,7 @@ std::string FormatPuzzlecal(const RigCalibrationResult& result) {
       out << YAML::Key << "rotation_deg" << YAML::Value
           << cam.rotation_stddev_deg;
       out << YAML::Key << "t" << YAML::Value;
-      Flow(out, RowMajor(cam.translation_stddev_m.transpose()));
+      EmitFlow(out, RowMajor(cam.translation_stddev_m));
       out << YAML::EndMap;
     }
     out << YAML::Key << "baseline_mm" << YAML::Value << 1000 * cam.baseline_m;
@@ -135,19 +94,6 @@ std::string FormatPuzzlecal(const RigCalibrationResult& result) {
   return std::string("# puzzlecal rig calibration\n") + out.c_str() + "\n";
 }
 
-// cv::FileStorage's matrix form.
-void OpenCvMatrix(YAML::Emitter& out, const std::string& key, int rows,
-                  int cols, const std::vector<double>& data) {
-  out << YAML::Key << key << YAML::Value << YAML::SecondaryTag("opencv-matrix")
-      << YAML::BeginMap;
-  out << YAML::Key << "rows" << YAML::Value << rows;
-  out << YAML::Key << "cols" << YAML::Value << cols;
-  out << YAML::Key << "dt" << YAML::Value << "d";
-  out << YAML::Key << "data" << YAML::Value;
-  Flow(out, data);
-  out << YAML::EndMap;
-}
-
 bool FormatOpenCv(const RigCalibrationResult& result, std::string* text,
                   std::string* error) {
   YAML::Emitter out;
@@ -163,9 +109,9 @@ bool FormatOpenCv(const RigCalibrationResult& result, std::string* text,
         << CameraModelName(cam.camera.model);
     out << YAML::Key << "image_width" + n << YAML::Value << cam.camera.width;
     out << YAML::Key << "image_height" + n << YAML::Value << cam.camera.height;
-    OpenCvMatrix(out, "K" + n, 3, 3, RowMajor(CameraMatrix(cam.camera)));
-    const std::vector<double> d = Distortion(cam.camera);
-    OpenCvMatrix(out, "D" + n, 1, static_cast<int>(d.size()), d);
+    EmitOpenCvMatrix(out, "K" + n, 3, 3, RowMajor(CameraMatrixOf(cam.camera)));
+    const std::vector<double> d = DistortionOf(cam.camera);
+    EmitOpenCvMatrix(out, "D" + n, 1, static_cast<int>(d.size()), d);
   }
   if (result.cameras.size() == 2) {
     const Camera& first = result.cameras[0].camera;
@@ -177,23 +123,23 @@ bool FormatOpenCv(const RigCalibrationResult& result, std::string* text,
     if (!StereoRectify(first, second, second_from_first, &rect, error)) {
       return false;
     }
-    OpenCvMatrix(out, "R", 3, 3, RowMajor(second_from_first.linear()));
-    OpenCvMatrix(out, "T", 3, 1, RowMajor(second_from_first.translation()));
-    OpenCvMatrix(out, "E", 3, 3, RowMajor(rect.essential));
-    OpenCvMatrix(out, "F", 3, 3, RowMajor(rect.fundamental));
-    OpenCvMatrix(out, "R1", 3, 3, RowMajor(rect.r1));
-    OpenCvMatrix(out, "R2", 3, 3, RowMajor(rect.r2));
-    OpenCvMatrix(out, "P1", 3, 4, RowMajor(rect.p1));
-    OpenCvMatrix(out, "P2", 3, 4, RowMajor(rect.p2));
-    OpenCvMatrix(out, "Q", 4, 4, RowMajor(rect.q));
+    EmitOpenCvMatrix(out, "R", 3, 3, RowMajor(second_from_first.linear()));
+    EmitOpenCvMatrix(out, "T", 3, 1, RowMajor(second_from_first.translation()));
+    EmitOpenCvMatrix(out, "E", 3, 3, RowMajor(rect.essential));
+    EmitOpenCvMatrix(out, "F", 3, 3, RowMajor(rect.fundamental));
+    EmitOpenCvMatrix(out, "R1", 3, 3, RowMajor(rect.r1));
+    EmitOpenCvMatrix(out, "R2", 3, 3, RowMajor(rect.r2));
+    EmitOpenCvMatrix(out, "P1", 3, 4, RowMajor(rect.p1));
+    EmitOpenCvMatrix(out, "P2", 3, 4, RowMajor(rect.p2));
+    EmitOpenCvMatrix(out, "Q", 4, 4, RowMajor(rect.q));
   } else {
     for (size_t c = 1; c < result.cameras.size(); ++c) {
       const Eigen::Isometry3d from_first =
           result.cameras[c].cam_from_rig *
           result.cameras[0].cam_from_rig.inverse();
       const std::string n = std::to_string(c + 1);
-      OpenCvMatrix(out, "R" + n, 3, 3, RowMajor(from_first.linear()));
-      OpenCvMatrix(out, "T" + n, 3, 1, RowMajor(from_first.translation()));
+      EmitOpenCvMatrix(out, "R" + n, 3, 3, RowMajor(from_first.linear()));
+      EmitOpenCvMatrix(out, "T" + n, 3, 1, RowMajor(from_first.translation()));
     }
   }
   out << YAML::EndMap;
@@ -206,26 +152,19 @@ std::string FormatRosCamera(const RigCameraResult& cam,
                             const Eigen::Matrix<double, 3, 4>& projection) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
-  auto matrix = [&](const char* key, int rows, int cols,
-                    const std::vector<double>& data) {
-    out << YAML::Key << key << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "rows" << YAML::Value << rows;
-    out << YAML::Key << "cols" << YAML::Value << cols;
-    out << YAML::Key << "data" << YAML::Value;
-    Flow(out, data);
-    out << YAML::EndMap;
-  };
   out << YAML::BeginMap;
   out << YAML::Key << "image_width" << YAML::Value << cam.camera.width;
   out << YAML::Key << "image_height" << YAML::Value << cam.camera.height;
   out << YAML::Key << "camera_name" << YAML::Value << cam.name;
-  matrix("camera_matrix", 3, 3, RowMajor(CameraMatrix(cam.camera)));
+  EmitRosMatrix(out, "camera_matrix", 3, 3,
+                RowMajor(CameraMatrixOf(cam.camera)));
   out << YAML::Key << "distortion_model" << YAML::Value
       << RosDistortionModel(cam.camera.model);
-  const std::vector<double> d = Distortion(cam.camera);
-  matrix("distortion_coefficients", 1, static_cast<int>(d.size()), d);
-  matrix("rectification_matrix", 3, 3, RowMajor(rectification));
-  matrix("projection_matrix", 3, 4, RowMajor(projection));
+  const std::vector<double> d = DistortionOf(cam.camera);
+  EmitRosMatrix(out, "distortion_coefficients", 1, static_cast<int>(d.size()),
+                d);
+  EmitRosMatrix(out, "rectification_matrix", 3, 3, RowMajor(rectification));
+  EmitRosMatrix(out, "projection_matrix", 3, 4, RowMajor(projection));
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
@@ -242,7 +181,7 @@ bool FormatRos(const RigCalibrationResult& result, const std::string& out_path,
   std::vector<Eigen::Matrix<double, 3, 4>> proj(result.cameras.size());
   for (size_t c = 0; c < result.cameras.size(); ++c) {
     proj[c].setZero();
-    proj[c].leftCols<3>() = CameraMatrix(result.cameras[c].camera);
+    proj[c].leftCols<3>() = CameraMatrixOf(result.cameras[c].camera);
   }
   if (result.cameras.size() == 2) {
     StereoRectification r;
@@ -288,9 +227,8 @@ bool FormatKalibr(const RigCalibrationResult& result, std::string* text,
       const Eigen::Matrix4d t =
           (cam.cam_from_rig * result.cameras[c - 1].cam_from_rig.inverse())
               .matrix();
-      out << YAML::Key << "T_cn_cnm1" << YAML::Value << YAML::BeginSeq;
-      for (int r = 0; r < 4; ++r) Flow(out, RowMajor(t.row(r)));
-      out << YAML::EndSeq;
+      out << YAML::Key << "T_cn_cnm1" << YAML::Value;
+      EmitRows(out, t);
     }
     out << YAML::Key << "cam_overlaps" << YAML::Value << YAML::Flow
         << YAML::BeginSeq;
@@ -300,12 +238,12 @@ bool FormatKalibr(const RigCalibrationResult& result, std::string* text,
     out << YAML::EndSeq;
     out << YAML::Key << "camera_model" << YAML::Value << "pinhole";
     out << YAML::Key << "intrinsics" << YAML::Value;
-    Flow(out, {p[0], p[1], p[2], p[3]});
+    EmitFlow(out, {p[0], p[1], p[2], p[3]});
     out << YAML::Key << "distortion_model" << YAML::Value
         << (cam.camera.model == CameraModelId::kKannalaBrandt ? "equidistant"
                                                               : "radtan");
     out << YAML::Key << "distortion_coeffs" << YAML::Value;
-    Flow(out, {p[4], p[5], p[6], p[7]});
+    EmitFlow(out, {p[4], p[5], p[6], p[7]});
     out << YAML::Key << "resolution" << YAML::Value << YAML::Flow
         << YAML::BeginSeq << cam.camera.width << cam.camera.height
         << YAML::EndSeq;
@@ -323,7 +261,7 @@ bool FormatKalibr(const RigCalibrationResult& result, std::string* text,
 bool StereoRectify(const Camera& first, const Camera& second,
                    const Eigen::Isometry3d& second_from_first,
                    StereoRectification* rect, std::string* error) {
-  const Eigen::Matrix3d k1 = CameraMatrix(first), k2 = CameraMatrix(second);
+  const Eigen::Matrix3d k1 = CameraMatrixOf(first), k2 = CameraMatrixOf(second);
   const Eigen::Matrix3d r = second_from_first.linear();
   const Eigen::Vector3d t = second_from_first.translation();
   if (!(t.norm() > 0)) {
@@ -345,8 +283,8 @@ bool StereoRectify(const Camera& first, const Camera& second,
   const bool fisheye2 = second.model == CameraModelId::kKannalaBrandt;
   // cv::Mat over a std::vector does not copy: the vectors must outlive the
   // calls.
-  const std::vector<double> distortion1 = Distortion(first);
-  const std::vector<double> distortion2 = Distortion(second);
+  const std::vector<double> distortion1 = DistortionOf(first);
+  const std::vector<double> distortion2 = DistortionOf(second);
   try {
     if (fisheye1 && fisheye2) {
       const cv::Mat d1(distortion1), d2(distortion2);
@@ -424,74 +362,57 @@ bool WriteRigFiles(const std::string& out_path, CameraFileFormat format,
   return true;
 }
 
+namespace {
+
+// One entry of a rig file's `cameras`: a camera as a camera file holds it,
+// its name and cam_from_rig.
+bool ParseRigCamera(const YAML::Node& node, const std::string& path,
+                    FieldReader& r, RigFileCamera* camera) {
+  const std::string pose_path = FieldReader::Join(path, "cam_from_rig");
+  YAML::Node pose;
+  Eigen::Matrix3d rotation;
+  std::vector<double> t;
+  if (!r.String(node, path, "name", Presence::kRequired, &camera->name) ||
+      !ParseCameraNode(node, path, /*opencv_header=*/false, &r, &camera->camera,
+                       nullptr) ||
+      !r.Child(node, path, "cam_from_rig", Presence::kRequired, &pose) ||
+      !r.Rows3x3(pose, pose_path, "R", Presence::kRequired, &rotation) ||
+      !r.Doubles(pose, pose_path, "t", Presence::kRequired, 3, &t)) {
+    return false;
+  }
+  if (!(rotation * rotation.transpose())
+           .isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
+      !(rotation.determinant() > 0)) {
+    return r.Fail(FieldReader::Join(pose_path, "R"), "not a rotation matrix");
+  }
+  camera->cam_from_rig.linear() = rotation;
+  camera->cam_from_rig.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+  return true;
+}
+
+}  // namespace
+
 bool ParseRigFile(const std::string& text, const std::string& source,
                   std::vector<RigFileCamera>* cameras, std::string* error) {
   YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    return Fail(source + ": not valid YAML: " + e.what(), error);
-  }
+  if (!ParseYaml(text, source, &root, error)) return false;
   if (!root.IsMap() || !root["cameras"]) {
     return Fail(source + ": not a puzzlecal rig file (no 'cameras' list)",
                 error);
   }
-  const YAML::Node list = root["cameras"];
-  if (!list.IsSequence() || list.size() < 2) {
-    return Fail(source + ": field 'cameras': expected a list of two or more",
-                error);
+  FieldReader r(source, error);
+  YAML::Node list;
+  if (!r.List(root, "", "cameras", Presence::kRequired, &list)) return false;
+  if (list.size() < 2) {
+    return r.Fail("cameras", "must list two or more cameras");
   }
-  std::vector<RigFileCamera> parsed;
+  std::vector<RigFileCamera> parsed(list.size());
   try {
     for (size_t c = 0; c < list.size(); ++c) {
-      const std::string field = "cameras[" + std::to_string(c) + "]";
-      const YAML::Node node = list[c];
-      RigFileCamera camera;
-      if (!node.IsMap() || !node["name"] || !node["name"].IsScalar()) {
-        return Fail(source + ": field '" + field + "/name': missing", error);
-      }
-      camera.name = node["name"].as<std::string>();
-      // The camera part is a single-camera file: its reader checks it.
-      YAML::Emitter single;
-      single << node;
-      if (!ParseCameraFile(single.c_str(), source + " " + field, &camera.camera,
-                           nullptr, error)) {
+      if (!ParseRigCamera(list[c], FieldReader::Index("cameras", c), r,
+                          &parsed[c])) {
         return false;
       }
-      const YAML::Node pose = node["cam_from_rig"];
-      if (!pose || !pose.IsMap() || !pose["R"] || !pose["t"]) {
-        return Fail(source + ": field '" + field +
-                        "/cam_from_rig': missing (needs R and t)",
-                    error);
-      }
-      const YAML::Node r = pose["R"], t = pose["t"];
-      if (!r.IsSequence() || r.size() != 3 || !t.IsSequence() ||
-          t.size() != 3) {
-        return Fail(source + ": field '" + field +
-                        "/cam_from_rig': R must be 3 rows of 3, t 3 numbers",
-                    error);
-      }
-      Eigen::Matrix3d rotation;
-      for (int i = 0; i < 3; ++i) {
-        if (!r[i].IsSequence() || r[i].size() != 3) {
-          return Fail(source + ": field '" + field + "/cam_from_rig/R[" +
-                          std::to_string(i) + "]': expected 3 numbers",
-                      error);
-        }
-        for (int j = 0; j < 3; ++j) rotation(i, j) = r[i][j].as<double>();
-        camera.cam_from_rig.translation()(i) = t[i].as<double>();
-      }
-      if (!rotation.allFinite() ||
-          !(rotation * rotation.transpose())
-               .isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
-          !(rotation.determinant() > 0) ||
-          !camera.cam_from_rig.translation().allFinite()) {
-        return Fail(source + ": field '" + field +
-                        "/cam_from_rig': R is not a rotation or t not finite",
-                    error);
-      }
-      camera.cam_from_rig.linear() = rotation;
-      parsed.push_back(camera);
     }
   } catch (const YAML::Exception& e) {
     return Fail(source + ": " + e.what(), error);
@@ -502,12 +423,9 @@ bool ParseRigFile(const std::string& text, const std::string& source,
 
 bool ReadRigFile(const std::string& path, std::vector<RigFileCamera>* cameras,
                  std::string* error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Fail("cannot open '" + path + "'", error);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return Fail("cannot read '" + path + "'", error);
-  return ParseRigFile(text.str(), path, cameras, error);
+  std::string text;
+  if (!ReadTextFile(path, &text, error)) return false;
+  return ParseRigFile(text, path, cameras, error);
 }
 
 }  // namespace puzzlecal

@@ -557,20 +557,24 @@ std::vector<std::string> StandardSceneNames() {
 
 bool MakeStandardScene(const std::string& name, int width, int height,
                        SceneSpec* scene) {
+  // Each factory's default arguments are its own size.
+  const bool sized = width > 0 && height > 0;
   if (name == "wide_pinhole") {
-    *scene = WidePinholeScene(width, height);
+    *scene = sized ? WidePinholeScene(width, height) : WidePinholeScene();
   } else if (name == "strong_fisheye") {
-    *scene = StrongFisheyeScene(width, height);
+    *scene = sized ? StrongFisheyeScene(width, height) : StrongFisheyeScene();
   } else if (name == "tilt_series") {
-    *scene = TiltSeriesScene(width, height);
+    *scene = sized ? TiltSeriesScene(width, height) : TiltSeriesScene();
   } else if (name == "small_tiles") {
-    *scene = SmallTilesScene(width, height);
+    *scene = sized ? SmallTilesScene(width, height) : SmallTilesScene();
   } else if (name == "fisheye_checkerboard") {
-    *scene = FisheyeCheckerboardScene(width, height);
+    *scene = sized ? FisheyeCheckerboardScene(width, height)
+                   : FisheyeCheckerboardScene();
   } else if (name == "dark_fisheye") {
-    *scene = DarkFisheyeScene(width, height);
+    *scene = sized ? DarkFisheyeScene(width, height) : DarkFisheyeScene();
   } else if (name == "noncentral_fisheye") {
-    *scene = NoncentralFisheyeScene(width, height);
+    *scene = sized ? NoncentralFisheyeScene(width, height)
+                   : NoncentralFisheyeScene();
   } else {
     return false;
   }

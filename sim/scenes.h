@@ -2,8 +2,8 @@
 #define PUZZLECAL_SIM_SCENES_H_
 
 // Synthetic scenes: a camera, a board and a set of views, rendered with exact
-// truth. The standard scenes (factories below) are what the tests and the
-// configs/scenes/ recipes use.
+// truth. The standard scenes (factories below) are what the tests use and
+// what `puzzlecal render --scene NAME` renders; they are defined only here.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -194,7 +194,8 @@ SceneSpec SampleScene(int width = 800, int height = 600);
 // "tilt_series", "small_tiles", "fisheye_checkerboard", "dark_fisheye",
 // "noncentral_fisheye").
 std::vector<std::string> StandardSceneNames();
-// The standard scene of that name at that size; false for unknown names.
+// The standard scene of that name at that size (0 x 0: the factory's own
+// default size); false for unknown names.
 bool MakeStandardScene(const std::string& name, int width, int height,
                        SceneSpec* scene);
 

@@ -483,23 +483,24 @@ TEST_F(CameraYamlTest, BadFilesGiveMessagesNamingFileAndField) {
       {"format: puzzlecal-camera\nmodel: kannala-brandt\nimage_width: 10\n"
        "image_height: 10\nparameters: {fx: 1, fy: 1, cx: 1, cy: 1, k1: 0, "
        "k2: 0, k3: 0}\n",
-       "field 'parameters/k4': missing"},
+       "field 'parameters.k4': missing"},
       {"format: puzzlecal-camera\nmodel: kannala-brandt\nimage_width: ten\n",
-       "field 'image_width': cannot read 'ten'"},
+       "field 'image_width': must be an integer, got 'ten'"},
       {"image_width: 640\nimage_height: 480\ncamera_name: c\n"
        "camera_matrix: {rows: 3, cols: 3, data: [1, 0, 1, 0, 1, 1]}\n"
        "distortion_model: plumb_bob\n"
        "distortion_coefficients: {rows: 1, cols: 5, data: [0, 0, 0, 0, 0]}\n",
-       "field 'camera_matrix/data': expected 9 numbers, got 6"},
+       "field 'camera_matrix.data': must hold 9 numbers, got 6"},
       {"image_width: 640\nimage_height: 480\n"
        "camera_matrix: {rows: 3, cols: 3, data: [1, 0, 1, 0, 1, 1, 0, 0, 1]}\n"
        "distortion_model: kb9\n"
        "distortion_coefficients: {rows: 1, cols: 5, data: [0, 0, 0, 0, 0]}\n",
        "field 'distortion_model': unknown model 'kb9'"},
-      {"cam0:\n  camera_model: omni\n", "field 'cam0/camera_model'"},
+      {"cam0:\n  camera_model: omni\n",
+       "field 'cam0.camera_model': only 'pinhole' is supported"},
       {"cam0:\n  camera_model: pinhole\n  distortion_model: radtan\n"
        "  intrinsics: [1, 1, 1, 1]\n  distortion_coeffs: [0, 0, 0]\n",
-       "field 'cam0/distortion_coeffs': expected 4 coefficients, got 3"},
+       "field 'cam0.distortion_coeffs': must hold 4 numbers, got 3"},
       {"just: a map\n", "not a camera file in any known format"},
       {"[1, 2\n", "not valid YAML"},
   };

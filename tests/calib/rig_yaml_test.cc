@@ -100,11 +100,22 @@ TEST(RigYamlTest, PuzzlecalReaderNamesTheBadField) {
   std::vector<RigFileCamera> cameras;
   EXPECT_FALSE(ParseRigFile(YAML::Dump(root), "bad.yaml", &cameras, &error));
   EXPECT_NE(error.find("bad.yaml"), std::string::npos) << error;
-  EXPECT_NE(error.find("cameras[1]/cam_from_rig"), std::string::npos) << error;
+  EXPECT_NE(error.find("field 'cameras[1].cam_from_rig.R': not a rotation"),
+            std::string::npos)
+      << error;
   root = YAML::Load(files[0].text);
   root["cameras"][0].remove("cam_from_rig");
   EXPECT_FALSE(ParseRigFile(YAML::Dump(root), "bad.yaml", &cameras, &error));
-  EXPECT_NE(error.find("cameras[0]/cam_from_rig"), std::string::npos) << error;
+  EXPECT_NE(error.find("field 'cameras[0].cam_from_rig': missing"),
+            std::string::npos)
+      << error;
+  // A camera's own fields are named under its entry.
+  root = YAML::Load(files[0].text);
+  root["cameras"][1]["parameters"].remove("fx");
+  EXPECT_FALSE(ParseRigFile(YAML::Dump(root), "bad.yaml", &cameras, &error));
+  EXPECT_NE(error.find("bad.yaml: field 'cameras[1].parameters.fx': missing"),
+            std::string::npos)
+      << error;
   EXPECT_FALSE(ParseRigFile("a: [", "broken.yaml", &cameras, &error));
   EXPECT_NE(error.find("broken.yaml"), std::string::npos) << error;
 }
