@@ -45,7 +45,6 @@ const Rgb kPalette[] = {
     {70, 70, 70},          // dark grey
     {30, 110, 180},        // blue
     {215, 40, 40},         // red
-    {40, 170, 60},         // green
     {240, 140, 20},        // orange
     {246, 246, 246},       // paper
     {170, 170, 170},       // no data
@@ -281,15 +280,6 @@ void Chart::CanvasText(double x, double y, const std::string& text,
   plptex(x, y - 0.5 * height, 1, 0, align, text.c_str());
   SetTextHeight(kTickHeight);
   s.AreaWindow();
-}
-
-void Chart::DataText(double x, double y, const std::string& text, double height,
-                     Colour colour) {
-  if (!state_->Drawing() || text.empty()) return;
-  SetTextHeight(height);
-  plcol0(Index(colour));
-  plptex(x, y, 1, 0, 0.5, text.c_str());
-  SetTextHeight(kTickHeight);
 }
 
 void Chart::Polyline(const std::vector<double>& x, const std::vector<double>& y,

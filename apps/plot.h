@@ -27,7 +27,6 @@ enum class Colour {
   kDarkGrey,
   kBlue,
   kRed,
-  kGreen,
   kOrange,
   kPaper,   // the background of image-shaped plot areas
   kNoData,  // areas without a value (no ray)
@@ -89,10 +88,6 @@ class Chart {
   // centred, 1 right.
   void CanvasText(double x, double y, const std::string& text, double height,
                   Colour colour, double align = 0);
-  // Text centred at data point (x, y) of the current area.
-  void DataText(double x, double y, const std::string& text, double height,
-                Colour colour);
-
   // Lines in data coordinates, `width` in canvas pixels.
   void Polyline(const std::vector<double>& x, const std::vector<double>& y,
                 Colour colour, double width, bool dashed = false);
