@@ -708,6 +708,27 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
 // ---------------------------------------------------------------------------
 // Evidence plots (calib/evidence.h).
 
+// The map at image pixel (x, y): bilinear between the four samples around
+// it, or the nearest of them when one has no value.
+double SampleMap(const PixelMap& map, double x, double y) {
+  const int step = std::max(1, map.step_px);
+  const double gx = x / step, gy = y / step;
+  const int i0 = std::clamp(static_cast<int>(std::floor(gx)), 0, map.cols - 1);
+  const int j0 = std::clamp(static_cast<int>(std::floor(gy)), 0, map.rows - 1);
+  const int i1 = std::min(i0 + 1, map.cols - 1);
+  const int j1 = std::min(j0 + 1, map.rows - 1);
+  const double fx = std::clamp(gx - i0, 0.0, 1.0);
+  const double fy = std::clamp(gy - j0, 0.0, 1.0);
+  const double v00 = map.At(i0, j0), v10 = map.At(i1, j0);
+  const double v01 = map.At(i0, j1), v11 = map.At(i1, j1);
+  if (std::isfinite(v00) && std::isfinite(v10) && std::isfinite(v01) &&
+      std::isfinite(v11)) {
+    return (1 - fy) * ((1 - fx) * v00 + fx * v10) +
+           fy * ((1 - fx) * v01 + fx * v11);
+  }
+  return map.At(fx < 0.5 ? i0 : i1, fy < 0.5 ? j0 : j1);
+}
+
 // A PixelMap drawn over the image rectangle (interpolated between samples,
 // grey where the map has no value), with a colour bar from 0 to `colour_max`
 // (0: the map's largest value).
@@ -731,11 +752,21 @@ cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
                    Colour::kNoData);
   if (map.cols > 0 && map.rows > 0 &&
       map.values.size() == static_cast<size_t>(map.cols) * map.rows) {
-    const int step = std::max(1, map.step_px);
-    const cv::Mat values(map.rows, map.cols, CV_64F,
-                         const_cast<double*>(map.values.data()));
-    chart.Shades(values, SamplePositions(map.cols, step, data.width),
-                 SamplePositions(map.rows, step, data.height), 0, colour_max);
+    // Resampled every kStep px so the bands follow the bilinear surface and
+    // a sample without a value only greys its own cell.
+    constexpr int kStep = 4;
+    const int nx = (data.width - 1 + kStep - 1) / kStep + 1;
+    const int ny = (data.height - 1 + kStep - 1) / kStep + 1;
+    cv::Mat values(ny, nx, CV_64F);
+    for (int j = 0; j < ny; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        values.at<double>(j, i) =
+            SampleMap(map, std::min(i * kStep, data.width - 1),
+                      std::min(j * kStep, data.height - 1));
+      }
+    }
+    chart.Shades(values, SamplePositions(nx, kStep, data.width),
+                 SamplePositions(ny, kStep, data.height), 0, colour_max);
   }
   chart.Axes("x (px)", "y (px)", false);
   chart.ColourBar(0, colour_max, bar_label);
