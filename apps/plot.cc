@@ -466,11 +466,17 @@ void Chart::ColourBar(double v_min, double v_max, const std::string& label) {
   const char* axis_opts[1] = {"bcvtmf"};
   PLFLT ticks[1] = {0};
   PLINT sub_ticks[1] = {0};
-  PLINT n_values[1] = {2};
-  PLFLT range[2] = {v_min, v_max};
-  const PLFLT* values[1] = {range};
+  // An image of the ramp, not PL_COLORBAR_GRADIENT: PLplot's cairo driver
+  // does not free the cairo pattern it draws a gradient with.
+  constexpr int kSteps = 256;
+  std::vector<PLFLT> ramp(kSteps);
+  for (int k = 0; k < kSteps; ++k) {
+    ramp[k] = v_min + (v_max - v_min) * k / (kSteps - 1);
+  }
+  PLINT n_values[1] = {kSteps};
+  const PLFLT* values[1] = {ramp.data()};
   PLFLT bar_width = 0, bar_height = 0;
-  plcolorbar(&bar_width, &bar_height, PL_COLORBAR_GRADIENT,
+  plcolorbar(&bar_width, &bar_height, PL_COLORBAR_IMAGE,
              PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT,
              20.0 / s.area.width, 0, 22.0 / s.area.width, 1.0,
              Index(Colour::kWhite), Index(Colour::kBlack), 1, 0, 0, 0, 0,

@@ -8,7 +8,9 @@
 // arguments the report needs. Everything else is PLplot's.
 //
 // PLplot keeps global state (the current stream): one Chart exists at a
-// time; a second one, from any thread, waits until the first is destroyed.
+// time. A Chart made on another thread waits until the first is destroyed;
+// two at once on one thread would wait for ever, so draw one chart, finish
+// it, then the next.
 
 #include <memory>
 #include <opencv2/core.hpp>

@@ -752,9 +752,10 @@ cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
                    Colour::kNoData);
   if (map.cols > 0 && map.rows > 0 &&
       map.values.size() == static_cast<size_t>(map.cols) * map.rows) {
-    // Resampled every kStep px so the bands follow the bilinear surface and
-    // a sample without a value only greys its own cell.
-    constexpr int kStep = 4;
+    // Resampled every kStep px (the distortion map's default grid) so the bands
+    // follow the bilinear surface and a sample without a value only greys its
+    // own cell.
+    constexpr int kStep = 8;
     const int nx = (data.width - 1 + kStep - 1) / kStep + 1;
     const int ny = (data.height - 1 + kStep - 1) / kStep + 1;
     cv::Mat values(ny, nx, CV_64F);
