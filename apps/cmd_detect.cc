@@ -8,7 +8,6 @@
 #include <filesystem>
 #include <iostream>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <string>
@@ -18,6 +17,7 @@
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
 #include "apps/image_io.h"
+#include "apps/overlay.h"
 #include "apps/pipeline.h"
 #include "apps/subcommand.h"
 #include "util/atomic_file.h"
@@ -84,11 +84,22 @@ cv::Scalar ComponentColour(int component) {
 // component's colour, unlabelled corners in red, and the label of every
 // corner whose col and row are multiples of 5.
 bool WriteOverlay(const cv::Mat& grey, const std::vector<LabelledCorner>& rows,
-                  const std::string& path) {
-  cv::Mat colour;
-  cv::cvtColor(grey, colour, cv::COLOR_GRAY2BGR);
+                  const std::string& path, std::string* error) {
   const double radius = std::max(3.0, std::max(grey.cols, grey.rows) / 400.0);
   const int thickness = std::max(1, static_cast<int>(radius / 4));
+  Overlay overlay;
+  auto mark = [&](OverlayMark::Kind kind, const Eigen::Vector2d& at,
+                  const Eigen::Vector2d& to, const cv::Scalar& colour) {
+    OverlayMark m;
+    m.kind = kind;
+    m.at = at;
+    m.to = to;
+    m.size = radius;
+    m.thickness = thickness;
+    m.colour = colour;
+    overlay.marks.push_back(m);
+    return &overlay.marks.back();
+  };
   // Lattice edges: sort labelled rows by (component, row, col) and look up
   // the right and lower neighbours by binary search.
   std::vector<int> order;
@@ -111,36 +122,26 @@ bool WriteOverlay(const cv::Mat& grey, const std::vector<LabelledCorner>& rows,
           std::lower_bound(order.begin(), order.end(), wanted,
                            [&](int m, const auto& w) { return key(m) < w; });
       if (it == order.end() || key(*it) != wanted) continue;
-      const LabelledCorner& b = rows[*it];
-      cv::line(colour, cv::Point2d(a.xy.x(), a.xy.y()),
-               cv::Point2d(b.xy.x(), b.xy.y()), ComponentColour(a.component),
-               thickness, cv::LINE_AA);
+      mark(OverlayMark::Kind::kLine, a.xy, rows[*it].xy,
+           ComponentColour(a.component));
     }
   }
   for (const LabelledCorner& c : rows) {
-    const cv::Point2d p(c.xy.x(), c.xy.y());
-    const cv::Point2d tick(std::cos(c.orientation), std::sin(c.orientation));
-    const cv::Scalar circle_colour = ComponentColour(c.component);
-    cv::circle(colour, p, static_cast<int>(radius), circle_colour, thickness,
-               cv::LINE_AA);
-    cv::line(colour, p - 2.0 * radius * tick, p + 2.0 * radius * tick,
-             cv::Scalar(0, 255, 0), thickness, cv::LINE_AA);
+    const Eigen::Vector2d tick(std::cos(c.orientation),
+                               std::sin(c.orientation));
+    mark(OverlayMark::Kind::kCircle, c.xy, c.xy, ComponentColour(c.component));
+    mark(OverlayMark::Kind::kLine, c.xy - 2.0 * radius * tick,
+         c.xy + 2.0 * radius * tick, cv::Scalar(0, 255, 0));
     if (c.component >= 0 && c.label.x() % 5 == 0 && c.label.y() % 5 == 0) {
-      cv::putText(
-          colour,
-          std::to_string(c.label.x()) + "," + std::to_string(c.label.y()),
-          p + cv::Point2d(radius, -radius), cv::FONT_HERSHEY_SIMPLEX,
-          radius / 10.0, cv::Scalar(255, 255, 0), thickness, cv::LINE_AA);
+      OverlayMark* label = mark(OverlayMark::Kind::kText,
+                                c.xy + Eigen::Vector2d(radius, -radius), c.xy,
+                                cv::Scalar(255, 255, 0));
+      label->size = 2.2 * radius;
+      label->text =
+          std::to_string(c.label.x()) + "," + std::to_string(c.label.y());
     }
   }
-  std::vector<uchar> png;
-  try {
-    if (!cv::imencode(".png", colour, png)) return false;
-  } catch (const cv::Exception&) {
-    return false;
-  }
-  std::string error;
-  return WriteFileAtomically(path, std::string(png.begin(), png.end()), &error);
+  return WritePng(path, DrawOverlay(grey, overlay, OverlayOptions()), error);
 }
 
 void EmitImage(const ImageResult& image, bool have_board, YAML::Emitter* out) {
@@ -292,8 +293,10 @@ int RunDetect() {
       }
       const std::string overlay =
           (fs::path(FLAGS_draw) / (stem + "_corners.png")).string();
-      if (!WriteOverlay(grey, LabelCorners(image, have_board), overlay)) {
-        std::cerr << "puzzlecal detect: cannot write overlay " << overlay
+      std::string overlay_error;
+      if (!WriteOverlay(grey, LabelCorners(image, have_board), overlay,
+                        &overlay_error)) {
+        std::cerr << "puzzlecal detect: cannot write overlay: " << overlay_error
                   << "\n";
       }
     }

@@ -1,10 +1,18 @@
 #ifndef PUZZLECAL_APPS_PLOT_H_
 #define PUZZLECAL_APPS_PLOT_H_
 
-// Small plotting helpers on top of OpenCV drawing: linear axes with ticks and
-// labels, titles, colour bars and legends, for the calibration report's PNGs.
-// Colours are BGR, canvases CV_8UC3.
+// The calibration report's charts, drawn by PLplot (its cairo memory
+// device) into an image the caller writes as PNG. A thin layer: the chart's
+// plot area placed by canvas pixels, the report's colours and text sizes,
+// and PLplot's axes, legends, colour bars and filled contours with the
+// arguments the report needs. Everything else is PLplot's.
+//
+// PLplot keeps global state (the current stream): one Chart exists at a
+// time. A Chart made on another thread waits until the first is destroyed;
+// two at once on one thread would wait for ever, so draw one chart, finish
+// it, then the next.
 
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -12,102 +20,132 @@
 namespace puzzlecal {
 namespace plot {
 
-// Frequently used colours (BGR).
-inline const cv::Scalar kBlack(0, 0, 0);
-inline const cv::Scalar kWhite(255, 255, 255);
-inline const cv::Scalar kGrey(128, 128, 128);
-inline const cv::Scalar kLightGrey(225, 225, 225);
-inline const cv::Scalar kBlue(180, 110, 30);
-inline const cv::Scalar kRed(40, 40, 215);
-inline const cv::Scalar kGreen(60, 170, 40);
-inline const cv::Scalar kOrange(20, 140, 240);
+// The colours every chart has (PLplot colour map 0).
+enum class Colour {
+  kWhite,
+  kBlack,
+  kGrey,
+  kLightGrey,
+  kDarkGrey,
+  kBlue,
+  kRed,
+  kOrange,
+  kPaper,   // the background of image-shaped plot areas
+  kNoData,  // areas without a value (no ray)
+  kFade,    // translucent white laid over extrapolated areas
+};
 
-// Text sizes (OpenCV Hershey scale factors) used throughout.
-inline constexpr double kTitleScale = 0.75;
-inline constexpr double kLabelScale = 0.55;
-inline constexpr double kTickScale = 0.45;
+// Text heights in canvas pixels.
+inline constexpr double kTitleHeight = 15;
+inline constexpr double kLabelHeight = 11;
+inline constexpr double kTickHeight = 10;
 
-enum class Align { kLeft, kCenter, kRight };
-
-// A rectangle of the canvas showing data coordinates [x_min, x_max] x
-// [y_min, y_max]; y grows upwards unless y_down (image coordinates).
-struct Frame {
-  cv::Rect area;
-  double x_min = 0, x_max = 1;
-  double y_min = 0, y_max = 1;
-  bool y_down = false;
-
-  // Canvas position (sub-pixel) of the data point (x, y).
-  cv::Point2d ToCanvas(double x, double y) const;
-  // Rounded to whole canvas pixels.
-  cv::Point ToCanvasPixel(double x, double y) const;
+// A legend line: a sample and its text.
+struct LegendEntry {
+  enum class Sample { kBox, kLine, kDashedLine, kCircle, kCross };
+  Sample sample = Sample::kBox;
+  Colour colour = Colour::kBlack;
+  std::string text;
 };
 
 // Rounds `value` > 0 to 1, 2 or 5 times a power of ten: the largest such
 // number <= value when `down`, otherwise the nearest one.
 double NiceNumber(double value, bool down);
 
-// Tick positions at a 1-2-5 step covering [lo, hi] with about `target` ticks
-// (only ticks inside [lo, hi]).
-std::vector<double> NiceTicks(double lo, double hi, int target);
+// True when PLplot and its cairo memory device can be used (the package
+// plplot-driver-cairo is installed); otherwise `why` says what is missing.
+bool ChartsAvailable(std::string* why);
 
-// A tick value printed with as many decimals as the step needs.
-std::string FormatTick(double value, double step);
+class Chart {
+ public:
+  // A white canvas of width x height pixels. Check ok() (false when PLplot
+  // or its cairo driver is missing). `antialias` false draws lines and
+  // fills without anti-aliasing (text keeps it): for maps, whose filled
+  // bands, drawn cell by cell, would otherwise show the cells' seams
+  // wherever they are translucent.
+  Chart(int width, int height, bool antialias = true);
+  ~Chart();
+  Chart(const Chart&) = delete;
+  Chart& operator=(const Chart&) = delete;
 
-// Width and height of `text` drawn at `scale`.
-cv::Size TextSize(const std::string& text, double scale, int thickness = 1);
+  bool ok() const;
+  int width() const;
+  int height() const;
 
-// Draws `text` with its baseline at `anchor.y`, aligned horizontally at
-// anchor.x. Anti-aliased Hershey simplex.
-void DrawText(cv::Mat* canvas, const std::string& text, cv::Point anchor,
-              double scale, const cv::Scalar& colour,
-              Align align = Align::kLeft, int thickness = 1);
+  // The plot area: canvas rectangle `area` shows data x in [x_min, x_max],
+  // y in [y_min, y_max], y upwards, or downwards when y_down (image
+  // coordinates). Drawing is clipped to it.
+  void SetArea(const cv::Rect& area, double x_min, double x_max, double y_min,
+               double y_max, bool y_down = false);
+  // Canvas position (pixels) of the data point (x, y) in the current area.
+  cv::Point2d ToCanvas(double x, double y) const;
 
-// Draws `text` rotated by 90 degrees (reading upwards), centred on `center`.
-void DrawVerticalText(cv::Mat* canvas, const std::string& text,
-                      cv::Point center, double scale, const cv::Scalar& colour);
+  // The frame, ticks with numbers (x_numbers false leaves x bare), light
+  // grid lines when `grid`, and the axis labels.
+  void Axes(const std::string& x_label, const std::string& y_label, bool grid,
+            bool x_numbers = true);
+  // Bold title and a subtitle line at the top left of the canvas.
+  void Title(const std::string& title, const std::string& subtitle);
+  // Text with its baseline at canvas pixel (x, y); `align` 0 left, 0.5
+  // centred, 1 right.
+  void CanvasText(double x, double y, const std::string& text, double height,
+                  Colour colour, double align = 0);
+  // Lines in data coordinates, `width` in canvas pixels.
+  void Polyline(const std::vector<double>& x, const std::vector<double>& y,
+                Colour colour, double width, bool dashed = false);
+  // An arrow from (x0, y0) to (x1, y1) whose head is `head` canvas pixels
+  // long (at most a third of the arrow).
+  void Arrow(double x0, double y0, double x1, double y1, Colour colour,
+             double head);
+  // The same from and to canvas pixels (anywhere on the canvas).
+  void CanvasArrow(const cv::Point2d& from, const cv::Point2d& to,
+                   Colour colour, double head);
+  // The frame of the plot area alone.
+  void Frame();
+  // A filled axis-aligned rectangle between two data corners.
+  void FilledRect(double x0, double y0, double x1, double y1, Colour colour);
+  // Markers centred at data points; `size` in canvas pixels.
+  void Markers(const std::vector<double>& x, const std::vector<double>& y,
+               LegendEntry::Sample shape, Colour colour, double size);
+  // Vertical error bars from y_lo to y_hi at x.
+  void ErrorBars(const std::vector<double>& x, const std::vector<double>& y_lo,
+                 const std::vector<double>& y_hi, Colour colour, double width);
 
-// A title (bold) and an optional subtitle line at the top of the canvas.
-void DrawTitle(cv::Mat* canvas, const std::string& title,
-               const std::string& subtitle);
+  // A field sampled at xs (columns) x ys (rows) of `values` (CV_64F, NaN
+  // where undefined, which stays unfilled), in viridis from v_min to v_max,
+  // as `levels` filled contour bands (values beyond the range are clamped).
+  void Shades(const cv::Mat& values, const std::vector<double>& xs,
+              const std::vector<double>& ys, double v_min, double v_max,
+              int levels = 64);
+  // Cells of a regular grid: cell (col, row) covers [x0 + col * dx, ...) x
+  // [y0 + row * dy, ...); values < v_min are left unfilled.
+  void Cells(const cv::Mat& values, double x0, double y0, double dx, double dy,
+             double v_min, double v_max);
+  // A translucent or plain fill over the part of the sampled field where
+  // lo <= value <= hi; `hatched` draws diagonal lines instead.
+  void FillWhere(const cv::Mat& values, const std::vector<double>& xs,
+                 const std::vector<double>& ys, double lo, double hi,
+                 Colour colour, bool hatched);
+  // Labelled contour lines of the sampled field at `levels`.
+  void Contours(const cv::Mat& values, const std::vector<double>& xs,
+                const std::vector<double>& ys,
+                const std::vector<double>& levels, Colour colour, double width);
+  // A viridis colour bar from v_min to v_max right of the plot area, with
+  // `label` along it.
+  void ColourBar(double v_min, double v_max, const std::string& label);
+  // A legend box inside a corner of the plot area.
+  enum class Corner { kTopRight, kTopLeft, kBottomLeft };
+  void Legend(const std::vector<LegendEntry>& entries,
+              Corner corner = Corner::kTopRight);
 
-// Frame border, ticks with labels, optional light grid lines, and the axis
-// labels below and left of the frame. x_ticks false leaves the x axis bare
-// (for charts that label their categories themselves).
-void DrawAxes(cv::Mat* canvas, const Frame& frame, const std::string& x_label,
-              const std::string& y_label, bool grid, bool x_ticks = true);
+  // Ends the PLplot stream and returns the canvas (CV_8UC3, BGR); empty
+  // when !ok(). Drawing after Finish does nothing.
+  cv::Mat Finish();
 
-// Colour of `t` in [0, 1] (clamped) under an OpenCV colour map
-// (cv::COLORMAP_*).
-cv::Scalar ColourMapValue(int colormap, double t);
-
-// A vertical colour bar in `bar` from v_min (bottom) to v_max (top) with tick
-// labels to its right and `label` rotated alongside them.
-void DrawColourBar(cv::Mat* canvas, const cv::Rect& bar, double v_min,
-                   double v_max, int colormap, const std::string& label);
-
-// One legend line: a marker sample and its text.
-struct LegendEntry {
-  enum class Marker { kLine, kDashedLine, kBox, kCircle, kCross, kArrow };
-  Marker marker = Marker::kBox;
-  cv::Scalar colour;
-  std::string text;
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
 };
-
-// A legend box with its top-left corner at `top_left` (white background,
-// grey border). Returns the box drawn.
-cv::Rect DrawLegend(cv::Mat* canvas, cv::Point top_left,
-                    const std::vector<LegendEntry>& entries);
-// The size DrawLegend would need.
-cv::Size LegendSize(const std::vector<LegendEntry>& entries);
-
-// A dashed straight line.
-void DrawDashedLine(cv::Mat* canvas, cv::Point2d from, cv::Point2d to,
-                    const cv::Scalar& colour, int thickness, double dash_px);
-
-// A cross marker (+) of half-size `radius` pixels.
-void DrawCross(cv::Mat* canvas, cv::Point2d center, int radius,
-               const cv::Scalar& colour, int thickness);
 
 }  // namespace plot
 }  // namespace puzzlecal

@@ -5,11 +5,11 @@
 #include <filesystem>
 #include <map>
 #include <numeric>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
 
+#include "apps/overlay.h"
 #include "apps/plot.h"
 #include "util/atomic_file.h"
 #include "util/string_format.h"
@@ -17,7 +17,7 @@
 namespace puzzlecal {
 namespace {
 
-using plot::Align;
+using plot::Colour;
 
 constexpr double kDeg = M_PI / 180.0;
 // Largest image side the report accepts (guards the plot sizes).
@@ -152,8 +152,8 @@ std::string Seconds(double s) {
 // bar and below for notes.
 
 struct ImageLayout {
-  cv::Mat canvas;
-  plot::Frame frame;
+  cv::Size canvas;
+  cv::Rect area;
   double scale = 1;  // canvas pixels per image pixel
   int notes_y = 0;   // baseline of the first note line below the axes
 };
@@ -166,30 +166,35 @@ ImageLayout MakeImageLayout(int plot_width, int width, int height,
   layout.scale = static_cast<double>(area_width) / width;
   const int area_height =
       std::max(1, static_cast<int>(std::lround(height * layout.scale)));
-  const int canvas_height = kTop + area_height + kBottom + 22 * note_lines;
-  layout.canvas = cv::Mat(canvas_height, kLeft + area_width + kRight, CV_8UC3,
-                          plot::kWhite);
-  layout.frame.area = cv::Rect(kLeft, kTop, area_width, area_height);
-  layout.frame.x_min = -0.5;
-  layout.frame.x_max = width - 0.5;
-  layout.frame.y_min = -0.5;
-  layout.frame.y_max = height - 0.5;
-  layout.frame.y_down = true;
+  layout.canvas = cv::Size(kLeft + area_width + kRight,
+                           kTop + area_height + kBottom + 22 * note_lines);
+  layout.area = cv::Rect(kLeft, kTop, area_width, area_height);
   layout.notes_y = kTop + area_height + kBottom;
   return layout;
 }
 
-void DrawNote(ImageLayout* layout, int line, const std::string& text) {
-  plot::DrawText(&layout->canvas, text,
-                 cv::Point(layout->frame.area.x, layout->notes_y + 22 * line),
-                 plot::kTickScale, cv::Scalar(60, 60, 60));
+// The plot area in image pixel coordinates (y down).
+void SetImageArea(const ImageLayout& layout, const ReportData& data,
+                  plot::Chart* chart) {
+  chart->SetArea(layout.area, -0.5, data.width - 0.5, -0.5, data.height - 0.5,
+                 /*y_down=*/true);
 }
 
-// Sub-pixel drawing in the plot area.
-constexpr int kShift = 4;
-cv::Point Fixed(cv::Point2d p) {
-  return cv::Point(static_cast<int>(std::lround(p.x * (1 << kShift))),
-                   static_cast<int>(std::lround(p.y * (1 << kShift))));
+void DrawNote(const ImageLayout& layout, int line, const std::string& text,
+              plot::Chart* chart) {
+  chart->CanvasText(layout.area.x, layout.notes_y + 22 * line, text,
+                    plot::kTickHeight, Colour::kDarkGrey);
+}
+
+// Sample positions of a field computed every `step` pixels (the last one
+// on the image's last pixel), the outer ones moved to the image's edges so
+// the field fills the image rectangle.
+std::vector<double> SamplePositions(int count, int step, int size) {
+  std::vector<double> positions(std::max(1, count));
+  for (int i = 0; i < count; ++i) positions[i] = std::min(i * step, size - 1);
+  positions.front() = -0.5;
+  if (count > 1) positions.back() = size - 0.5;
+  return positions;
 }
 
 // The factor residual arrows are drawn with (options or automatic: the 95th
@@ -208,51 +213,46 @@ double ResidualArrowScale(const ReportData& data, const ReportOptions& options,
 }
 
 cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
-  ImageLayout layout =
+  const ImageLayout layout =
       MakeImageLayout(options.image_plot_width, data.width, data.height, 3);
-  cv::Mat& canvas = layout.canvas;
-  const plot::Frame& frame = layout.frame;
-  canvas(frame.area).setTo(cv::Scalar(246, 246, 246));
-
+  plot::Chart chart(layout.canvas.width, layout.canvas.height);
+  SetImageArea(layout, data, &chart);
+  chart.FilledRect(-0.5, -0.5, data.width - 0.5, data.height - 0.5,
+                   Colour::kPaper);
   double p95 = 0;
   const double arrow_scale = ResidualArrowScale(data, options, &p95);
-  // Draw inside the plot area only: arrows of outliers may leave it.
-  cv::Mat area = canvas(frame.area);
-  const cv::Point2d origin(frame.area.x, frame.area.y);
   // Outliers can be off by tens of pixels: their arrows are cut to this
   // length (canvas pixels) so they do not hide the rest.
   const double outlier_cap =
       std::max(40.0, 3 * p95 * arrow_scale * layout.scale);
   int num_capped = 0;
-  auto draw = [&](const ResidualSample& s, const cv::Scalar& colour) {
-    const cv::Point2d from =
-        frame.ToCanvas(s.detected.x(), s.detected.y()) - origin;
-    const Eigen::Vector2d tip_image = s.detected + arrow_scale * s.residual;
-    cv::Point2d to = frame.ToCanvas(tip_image.x(), tip_image.y()) - origin;
-    double length = std::hypot(to.x - from.x, to.y - from.y);
+  std::vector<double> dot_x, dot_y;
+  auto draw = [&](const ResidualSample& s, Colour colour) {
+    Eigen::Vector2d arrow = arrow_scale * s.residual;
+    double length = arrow.norm() * layout.scale;
     if (!s.inlier && length > outlier_cap) {
-      to = from + (to - from) * (outlier_cap / length);
+      arrow *= outlier_cap / length;
       length = outlier_cap;
       ++num_capped;
     }
     if (length < 1.5) {
-      cv::circle(area, Fixed(from), 1 << kShift, colour, cv::FILLED,
-                 cv::LINE_AA, kShift);
+      dot_x.push_back(s.detected.x());
+      dot_y.push_back(s.detected.y());
       return;
     }
-    const double tip = std::min(0.35, 5.0 / length);
-    cv::arrowedLine(area, Fixed(from), Fixed(to), colour, 1, cv::LINE_AA,
-                    kShift, tip);
+    const Eigen::Vector2d tip = s.detected + arrow;
+    chart.Arrow(s.detected.x(), s.detected.y(), tip.x(), tip.y(), colour, 5);
   };
   for (const ResidualSample& s : data.samples) {
-    if (s.inlier) draw(s, plot::kBlue);
+    if (s.inlier) draw(s, Colour::kBlue);
   }
+  chart.Markers(dot_x, dot_y, plot::LegendEntry::Sample::kCircle, Colour::kBlue,
+                3);
   for (const ResidualSample& s : data.samples) {
-    if (!s.inlier) draw(s, plot::kRed);
+    if (!s.inlier) draw(s, Colour::kRed);
   }
-  plot::DrawAxes(&canvas, frame, "x (px)", "y (px)", false);
-  plot::DrawTitle(
-      &canvas,
+  chart.Axes("x (px)", "y (px)", false);
+  chart.Title(
       StringPrintf("Reprojection residuals, arrows %gx longer than the error",
                    arrow_scale),
       StringPrintf("%d corners used (blue), %d outliers (red) from %d views; "
@@ -262,96 +262,81 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
   // Scale reference: an arrow for a round residual near the 95th percentile.
   const double reference = plot::NiceNumber(p95 > 0 ? p95 : 1.0, false);
   const double reference_length = reference * arrow_scale * layout.scale;
-  const int y0 = layout.notes_y - 6;
-  const int x0 = frame.area.x;
-  cv::arrowedLine(canvas, Fixed(cv::Point2d(x0, y0)),
-                  Fixed(cv::Point2d(x0 + reference_length, y0)), plot::kBlue, 1,
-                  cv::LINE_AA, kShift,
-                  std::min(0.35, 5.0 / std::max(1.0, reference_length)));
-  plot::DrawText(
-      &canvas,
+  const cv::Point2d from(layout.area.x, layout.notes_y - 6);
+  chart.CanvasArrow(from, from + cv::Point2d(reference_length, 0),
+                    Colour::kBlue, 5);
+  chart.CanvasText(
+      from.x + reference_length + 10, layout.notes_y,
       StringPrintf("= %g px residual (scale x%g)", reference, arrow_scale),
-      {x0 + static_cast<int>(reference_length) + 10, y0 + 5}, plot::kTickScale,
-      plot::kBlack);
-  DrawNote(&layout, 1,
+      plot::kTickHeight, Colour::kBlack);
+  DrawNote(layout, 1,
            "Each arrow starts at a detected corner and points to where the "
            "calibrated model reprojects it." +
                (num_capped > 0
                     ? StringPrintf(" %d outlier arrows are cut to %.0f px.",
                                    num_capped, outlier_cap)
-                    : std::string()));
-  DrawNote(&layout, 2,
+                    : std::string()),
+           &chart);
+  DrawNote(layout, 2,
            "Random directions = noise; arrows aligned over a region = model "
-           "error there (try another model) or a bent board.");
-  return canvas;
+           "error there (try another model) or a bent board.",
+           &chart);
+  return chart.Finish();
 }
 
 cv::Mat PlotCoverage(const ReportData& data, const ReportOptions& options) {
-  ImageLayout layout =
+  const ImageLayout layout =
       MakeImageLayout(options.image_plot_width, data.width, data.height, 2);
-  cv::Mat& canvas = layout.canvas;
-  const plot::Frame& frame = layout.frame;
   const double cell =
       static_cast<double>(data.width) / options.coverage_cells_across;
   const int cols = options.coverage_cells_across;
   const int rows = std::max(1, static_cast<int>(std::ceil(data.height / cell)));
-  std::vector<int> counts(static_cast<size_t>(cols) * rows, 0);
+  cv::Mat counts(rows, cols, CV_64F, cv::Scalar(0));
   for (const ResidualSample& s : data.samples) {
     if (!s.inlier) continue;
     const int cx = static_cast<int>(std::floor((s.detected.x() + 0.5) / cell));
     const int cy = static_cast<int>(std::floor((s.detected.y() + 0.5) / cell));
     if (cx < 0 || cy < 0 || cx >= cols || cy >= rows) continue;
-    ++counts[static_cast<size_t>(cy) * cols + cx];
+    counts.at<double>(cy, cx) += 1;
   }
-  const int max_count = *std::max_element(counts.begin(), counts.end());
-  int empty = 0;
-  cv::Mat area = canvas(frame.area);
-  const cv::Point2d origin(frame.area.x, frame.area.y);
-  for (int cy = 0; cy < rows; ++cy) {
-    for (int cx = 0; cx < cols; ++cx) {
-      const int n = counts[static_cast<size_t>(cy) * cols + cx];
-      const double x0 = cx * cell - 0.5, y0 = cy * cell - 0.5;
-      const double x1 = std::min((cx + 1) * cell, 1.0 * data.width) - 0.5;
-      const double y1 = std::min((cy + 1) * cell, 1.0 * data.height) - 0.5;
-      const cv::Point a = frame.ToCanvasPixel(x0, y0) - cv::Point(origin);
-      const cv::Point b = frame.ToCanvasPixel(x1, y1) - cv::Point(origin);
-      if (n == 0) ++empty;
-      const cv::Scalar colour =
-          n == 0 ? plot::kWhite
-                 : plot::ColourMapValue(
-                       cv::COLORMAP_VIRIDIS,
-                       max_count > 1 ? (n - 1.0) / (max_count - 1) : 1.0);
-      cv::rectangle(area, cv::Rect(a, b), colour, cv::FILLED);
-      cv::rectangle(area, cv::Rect(a, b), plot::kLightGrey, 1);
-    }
+  double max_count = 0;
+  cv::minMaxLoc(counts, nullptr, &max_count);
+  const int empty = rows * cols - cv::countNonZero(counts);
+  plot::Chart chart(layout.canvas.width, layout.canvas.height);
+  SetImageArea(layout, data, &chart);
+  // Empty cells stay white.
+  const double colour_max = std::max(2.0, max_count);
+  chart.Cells(counts, -0.5, -0.5, cell, cell, 1, colour_max);
+  for (int cx = 1; cx < cols; ++cx) {
+    chart.Polyline({cx * cell - 0.5, cx * cell - 0.5},
+                   {-0.5, data.height - 0.5}, Colour::kLightGrey, 1);
   }
-  plot::DrawAxes(&canvas, frame, "x (px)", "y (px)", false);
-  const cv::Rect bar(frame.area.x + frame.area.width + 20, frame.area.y, 22,
-                     frame.area.height);
-  plot::DrawColourBar(&canvas, bar, 1, std::max(2, max_count),
-                      cv::COLORMAP_VIRIDIS, "used corners per cell (white: 0)");
-  plot::DrawTitle(
-      &canvas,
+  for (int cy = 1; cy < rows; ++cy) {
+    chart.Polyline({-0.5, data.width - 0.5}, {cy * cell - 0.5, cy * cell - 0.5},
+                   Colour::kLightGrey, 1);
+  }
+  chart.Axes("x (px)", "y (px)", false);
+  chart.ColourBar(1, colour_max, "used corners per cell (white: 0)");
+  chart.Title(
       StringPrintf("Coverage: used corners per %.0f x %.0f px cell", cell,
                    cell),
       StringPrintf("%d corners from %d views; %d of %d cells empty (white); "
                    "the calibration's coverage figure: %.0f %%",
                    data.num_inliers, data.result->num_views_used, empty,
                    rows * cols, 100.0 * data.result->coverage));
-  DrawNote(&layout, 0,
+  DrawNote(layout, 0,
            "The model is only trustworthy where corners were seen. Fill white "
-           "cells (image corners and edges matter most for distortion)");
-  DrawNote(&layout, 1, "by adding views that put the board there.");
-  return canvas;
+           "cells (image corners and edges matter most for distortion)",
+           &chart);
+  DrawNote(layout, 1, "by adding views that put the board there.", &chart);
+  return chart.Finish();
 }
 
 cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
   const Camera& camera = data.result->camera;
   const bool fisheye = !CameraModelIsPinhole(camera.model);
-  ImageLayout layout =
+  const ImageLayout layout =
       MakeImageLayout(options.image_plot_width, data.width, data.height, 4);
-  cv::Mat& canvas = layout.canvas;
-  const plot::Frame& frame = layout.frame;
 
   // The widest ray angle of any used corner: beyond it the model is
   // extrapolated.
@@ -368,6 +353,7 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
   const int ny = (data.height - 1 + step - 1) / step + 1;
   cv::Mat magnitude(ny, nx, CV_64F), theta(ny, nx, CV_64F);
   double max_magnitude = 0, max_theta = 0;
+  int num_without_ray = 0;
   for (int j = 0; j < ny; ++j) {
     for (int i = 0; i < nx; ++i) {
       const Eigen::Vector2d pixel(std::min(i * step, data.width - 1),
@@ -381,66 +367,30 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
         max_theta = std::max(max_theta, t);
       } else {
         m = t = std::nan("");
+        ++num_without_ray;
       }
       magnitude.at<double>(j, i) = m;
       theta.at<double>(j, i) = t;
     }
   }
   const double colour_max = max_magnitude > 0 ? max_magnitude : 1.0;
-  // Bilinear upsampling to the plot area; a cell with a missing corner value
-  // takes the nearest sample.
-  const cv::Rect& a = frame.area;
-  cv::Mat theta_plot(a.height, a.width, CV_64F);
-  cv::Mat lut(256, 1, CV_8UC1);
-  for (int i = 0; i < 256; ++i) lut.at<uint8_t>(i) = static_cast<uint8_t>(i);
-  cv::Mat lut_colour;
-  cv::applyColorMap(lut, lut_colour, cv::COLORMAP_VIRIDIS);
-  auto sample = [&](const cv::Mat& grid, double gx, double gy) {
-    const int i0 = std::clamp(static_cast<int>(std::floor(gx)), 0, nx - 1);
-    const int j0 = std::clamp(static_cast<int>(std::floor(gy)), 0, ny - 1);
-    const int i1 = std::min(i0 + 1, nx - 1), j1 = std::min(j0 + 1, ny - 1);
-    const double fx = std::clamp(gx - i0, 0.0, 1.0);
-    const double fy = std::clamp(gy - j0, 0.0, 1.0);
-    const double v00 = grid.at<double>(j0, i0), v10 = grid.at<double>(j0, i1);
-    const double v01 = grid.at<double>(j1, i0), v11 = grid.at<double>(j1, i1);
-    if (std::isfinite(v00) && std::isfinite(v10) && std::isfinite(v01) &&
-        std::isfinite(v11)) {
-      return (1 - fy) * ((1 - fx) * v00 + fx * v10) +
-             fy * ((1 - fx) * v01 + fx * v11);
-    }
-    return grid.at<double>(std::lround(fy) ? j1 : j0,
-                           std::lround(fx) ? i1 : i0);
-  };
-  int num_without_ray = 0;
-  for (int v = 0; v < a.height; ++v) {
-    for (int u = 0; u < a.width; ++u) {
-      const double x = (u + 0.5) / layout.scale - 0.5;
-      const double y = (v + 0.5) / layout.scale - 0.5;
-      const double gx = x / step, gy = y / step;
-      const double m = sample(magnitude, gx, gy);
-      const double t = sample(theta, gx, gy);
-      theta_plot.at<double>(v, u) = t;
-      cv::Vec3b colour(170, 170, 170);  // no ray
-      if (!std::isfinite(m)) ++num_without_ray;
-      if (std::isfinite(m)) {
-        const int index = static_cast<int>(
-            std::lround(std::clamp(m / colour_max, 0.0, 1.0) * 255));
-        colour = lut_colour.at<cv::Vec3b>(index);
-        // Fade the extrapolated field; hatch rays beyond 90 degrees.
-        if (have_observed && std::isfinite(t) && t > observed_theta) {
-          for (int c = 0; c < 3; ++c) {
-            colour[c] = static_cast<uint8_t>((2 * colour[c] + 3 * 255) / 5);
-          }
-        }
-        if (std::isfinite(t) && t > 90 && (u + v) % 10 < 2) {
-          colour = cv::Vec3b((colour[0] + 255) / 2, (colour[1] + 255) / 2,
-                             (colour[2] + 255) / 2);
-        }
-      }
-      canvas.at<cv::Vec3b>(a.y + v, a.x + u) = colour;
-    }
+  const std::vector<double> xs = SamplePositions(nx, step, data.width);
+  const std::vector<double> ys = SamplePositions(ny, step, data.height);
+
+  plot::Chart chart(layout.canvas.width, layout.canvas.height,
+                    /*antialias=*/false);
+  SetImageArea(layout, data, &chart);
+  chart.FilledRect(-0.5, -0.5, data.width - 0.5, data.height - 0.5,
+                   Colour::kNoData);
+  chart.Shades(magnitude, xs, ys, 0, colour_max);
+  // Fade the extrapolated field; hatch rays beyond 90 degrees.
+  if (have_observed && observed_theta < max_theta) {
+    chart.FillWhere(theta, xs, ys, observed_theta, 1e9, Colour::kFade, false);
   }
-  // Iso-angle lines: where the ray angle crosses a level between neighbours.
+  if (fisheye && max_theta > 90) {
+    chart.FillWhere(theta, xs, ys, 90, 1e9, Colour::kWhite, true);
+  }
+  // Iso-angle lines.
   const double level_step = max_theta > 75 ? 30 : 15;
   std::vector<double> levels;
   for (double level = level_step; level < max_theta; level += level_step) {
@@ -450,112 +400,65 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
       std::find(levels.begin(), levels.end(), 90.0) == levels.end()) {
     levels.push_back(90);
   }
+  chart.Contours(theta, xs, ys, levels, Colour::kWhite, 1);
   const Eigen::Vector2d principal(camera.params[2], camera.params[3]);
-  const int label_row = std::clamp(
-      static_cast<int>(std::lround(frame.ToCanvas(0, principal.y()).y)) - a.y,
-      0, a.height - 1);
-  for (double level : levels) {
-    const cv::Vec3b line_colour(255, 255, 255);
-    const int width = level == 90 ? 2 : 1;
-    int label_u = -1, label_v = -1;
-    for (int v = 0; v + 1 < a.height; ++v) {
-      for (int u = 0; u + 1 < a.width; ++u) {
-        const double t = theta_plot.at<double>(v, u);
-        const double tr = theta_plot.at<double>(v, u + 1);
-        const double td = theta_plot.at<double>(v + 1, u);
-        if (!std::isfinite(t)) continue;
-        const bool cross = (std::isfinite(tr) && (t < level) != (tr < level)) ||
-                           (std::isfinite(td) && (t < level) != (td < level));
-        if (!cross) continue;
-        for (int dv = 0; dv < width; ++dv) {
-          for (int du = 0; du < width; ++du) {
-            canvas.at<cv::Vec3b>(a.y + v + dv, a.x + u + du) = line_colour;
-          }
-        }
-        // Label where the line is nearest the principal point's row (the
-        // right-most such place).
-        if (label_v < 0 ||
-            std::abs(v - label_row) < std::abs(label_v - label_row) ||
-            (std::abs(v - label_row) == std::abs(label_v - label_row) &&
-             u > label_u)) {
-          label_u = u;
-          label_v = v;
-        }
-      }
-    }
-    if (label_u >= 0) {
-      const std::string text = StringPrintf("%.0f deg", level);
-      const cv::Size size = plot::TextSize(text, plot::kTickScale);
-      const cv::Point anchor(
-          a.x + std::clamp(label_u + 4, 2, a.width - size.width - 4),
-          a.y + std::clamp(label_v - 4, size.height + 4, a.height - 4));
-      plot::DrawText(&canvas, text, anchor, plot::kTickScale, plot::kBlack,
-                     Align::kLeft, 3);
-      plot::DrawText(&canvas, text, anchor, plot::kTickScale, plot::kWhite);
-    }
-  }
-  plot::DrawAxes(&canvas, frame, "x (px)", "y (px)", false);
-  const cv::Rect bar(a.x + a.width + 20, a.y, 22, a.height);
-  plot::DrawColourBar(&canvas, bar, 0, colour_max, cv::COLORMAP_VIRIDIS,
-                      "distortion (px)");
+  chart.Markers({principal.x()}, {principal.y()},
+                plot::LegendEntry::Sample::kCross, Colour::kRed, 18);
+  chart.Axes("x (px)", "y (px)", false);
+  chart.ColourBar(0, colour_max, "distortion (px)");
+  const std::string max_text = StringPrintf("max %.1f px", max_magnitude) +
+                               std::string(have_observed ? " where seen" : "");
   if (fisheye) {
-    plot::DrawTitle(
-        &canvas, "Distortion: shift from the equidistant fisheye r = f * theta",
-        StringPrintf(
-            "Pixels between where each pixel's ray lands with the model "
-            "and with k1..k4 = 0 (same fx fy cx cy); max %.1f px",
-            max_magnitude) +
-            std::string(have_observed ? " where seen" : ""));
+    chart.Title("Distortion: shift from the equidistant fisheye r = f * theta",
+                "Pixels between where each pixel's ray lands with the model "
+                "and with k1..k4 = 0 (same fx fy cx cy); " +
+                    max_text);
   } else {
-    plot::DrawTitle(
-        &canvas, "Distortion: shift from the distortion-free pinhole",
-        StringPrintf(
-            "Pixels between where each pixel's ray lands with the model "
-            "and with no distortion (same fx fy cx cy); max %.1f px",
-            max_magnitude) +
-            std::string(have_observed ? " where seen" : ""));
+    chart.Title("Distortion: shift from the distortion-free pinhole",
+                "Pixels between where each pixel's ray lands with the model "
+                "and with no distortion (same fx fy cx cy); " +
+                    max_text);
   }
-  DrawNote(&layout, 0,
+  DrawNote(layout, 0,
            StringPrintf(
                "White lines: angle of the pixel's ray from the optical axis "
-               "(every %.0f deg).%s",
+               "in deg (every %.0f deg).%s",
                level_step,
                fisheye ? " Hatched: rays more than 90 deg off the axis "
                          "(behind the image plane)."
-                       : ""));
+                       : ""),
+           &chart);
   DrawNote(
-      &layout, 1,
+      layout, 1,
       StringPrintf("Red cross: principal point (%.1f, %.1f). Computed every %d "
                    "px and interpolated.",
-                   principal.x(), principal.y(), step));
+                   principal.x(), principal.y(), step),
+      &chart);
   int line = 2;
   if (have_observed && observed_theta < max_theta) {
-    DrawNote(&layout, line++,
+    DrawNote(layout, line++,
              StringPrintf(
                  "Faded: rays beyond %.1f deg, the widest angle of any used "
                  "corner; the model is extrapolated there (colours scaled "
                  "to the rest).",
-                 observed_theta));
+                 observed_theta),
+             &chart);
   }
   if (num_without_ray > 0) {
-    DrawNote(&layout, line++,
+    DrawNote(layout, line++,
              "Grey: the model has no ray for these pixels (its distortion "
-             "folds back or cannot be inverted there).");
+             "folds back or cannot be inverted there).",
+             &chart);
   }
-  cv::drawMarker(canvas, frame.ToCanvasPixel(principal.x(), principal.y()),
-                 plot::kRed, cv::MARKER_CROSS, 14, 2, cv::LINE_AA);
-  return canvas;
+  return chart.Finish();
 }
 
 cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
-  cv::Mat canvas(options.chart_height, options.chart_width, CV_8UC3,
-                 plot::kWhite);
   // The histogram, and right of it one bar for everything beyond its range.
   constexpr int kOverflowWidth = 60;
-  plot::Frame frame;
-  frame.area =
-      cv::Rect(90, 80, options.chart_width - 90 - 30 - kOverflowWidth - 20,
-               options.chart_height - 80 - 70);
+  const cv::Rect area(90, 80,
+                      options.chart_width - 90 - 30 - kOverflowWidth - 20,
+                      options.chart_height - 80 - 70);
   std::vector<double> inlier_norms, outlier_norms;
   for (const ResidualSample& s : data.samples) {
     (s.inlier ? inlier_norms : outlier_norms).push_back(s.residual.norm());
@@ -594,90 +497,66 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   const double y_max =
       1.1 * std::max<double>(
                 highest, *std::max_element(expected.begin(), expected.end()));
-  frame.x_min = 0;
-  frame.x_max = range;
-  frame.y_min = 0;
-  frame.y_max = y_max;
-  plot::DrawAxes(&canvas, frame,
-                 "residual length |reprojected - detected| (px)",
-                 "corners per bin", true);
+
+  plot::Chart chart(options.chart_width, options.chart_height);
+  chart.SetArea(area, 0, range, 0, y_max);
+  chart.Axes("residual length |reprojected - detected| (px)", "corners per bin",
+             true);
+  // A pixel of white between the bars.
+  const double gap = range / area.width;
   for (int b = 0; b < bins; ++b) {
-    const cv::Point p0 = frame.ToCanvasPixel(b * width, 0);
-    const cv::Point p1 = frame.ToCanvasPixel((b + 1) * width, inliers[b]);
-    const cv::Point p2 =
-        frame.ToCanvasPixel((b + 1) * width, inliers[b] + outliers[b]);
     if (inliers[b] > 0) {
-      cv::rectangle(canvas,
-                    cv::Rect(p0.x + 1, p1.y, p1.x - p0.x - 1, p0.y - p1.y),
-                    plot::kBlue, cv::FILLED);
+      chart.FilledRect(b * width + gap, 0, (b + 1) * width, inliers[b],
+                       Colour::kBlue);
     }
     if (outliers[b] > 0) {
-      cv::rectangle(canvas,
-                    cv::Rect(p0.x + 1, p2.y, p1.x - p0.x - 1, p1.y - p2.y),
-                    plot::kRed, cv::FILLED);
+      chart.FilledRect(b * width + gap, inliers[b], (b + 1) * width,
+                       inliers[b] + outliers[b], Colour::kRed);
     }
   }
   if (sigma > 0) {
-    std::vector<cv::Point> curve;
-    for (int b = 0; b < bins; ++b) {
-      curve.push_back(frame.ToCanvasPixel((b + 0.5) * width, expected[b]));
-    }
-    cv::polylines(canvas, curve, false, plot::kOrange, 2, cv::LINE_AA);
+    std::vector<double> x(bins);
+    for (int b = 0; b < bins; ++b) x[b] = (b + 0.5) * width;
+    chart.Polyline(x, expected, Colour::kOrange, 2);
   }
-  cv::rectangle(canvas, frame.area, plot::kBlack, 1);
-  plot::DrawTitle(
-      &canvas, "Residual lengths",
+  chart.Legend(
+      {{plot::LegendEntry::Sample::kBox, Colour::kBlue, "used corners"},
+       {plot::LegendEntry::Sample::kBox, Colour::kRed, "outliers (dropped)"},
+       {plot::LegendEntry::Sample::kLine, Colour::kOrange,
+        "expected for Gaussian noise of sigma = RMS (Rayleigh)"}});
+  chart.Title(
+      "Residual lengths",
       StringPrintf(
           "%zu used corners, %zu outliers; RMS %.3f px per coordinate; "
           "median length %.3f px, 95 %% below %.3f px",
           inlier_norms.size(), outlier_norms.size(), sigma,
           Percentile(inlier_norms, 0.5), Percentile(inlier_norms, 0.95)));
   // The overflow bar, on the histogram's count scale.
-  const cv::Rect overflow(frame.area.x + frame.area.width + 20, frame.area.y,
-                          kOverflowWidth, frame.area.height);
-  cv::rectangle(canvas, overflow, plot::kBlack, 1);
-  const int base_y = overflow.y + overflow.height;
-  const int inlier_top = frame.ToCanvasPixel(0, inliers_beyond).y;
-  const int outlier_top =
-      frame.ToCanvasPixel(0, inliers_beyond + outliers_beyond).y;
+  const cv::Rect overflow(area.x + area.width + 20, area.y, kOverflowWidth,
+                          area.height);
+  chart.SetArea(overflow, 0, 1, 0, y_max);
+  chart.Frame();
   if (inliers_beyond > 0) {
-    cv::rectangle(canvas,
-                  cv::Rect(overflow.x + 10, inlier_top, overflow.width - 20,
-                           base_y - inlier_top),
-                  plot::kBlue, cv::FILLED);
+    chart.FilledRect(0.17, 0, 0.83, inliers_beyond, Colour::kBlue);
   }
   if (outliers_beyond > 0) {
-    cv::rectangle(canvas,
-                  cv::Rect(overflow.x + 10, outlier_top, overflow.width - 20,
-                           inlier_top - outlier_top),
-                  plot::kRed, cv::FILLED);
+    chart.FilledRect(0.17, inliers_beyond, 0.83,
+                     inliers_beyond + outliers_beyond, Colour::kRed);
   }
-  plot::DrawText(&canvas, StringPrintf("> %.3g", range),
-                 {overflow.x + overflow.width / 2, base_y + 21},
-                 plot::kTickScale, plot::kBlack, Align::kCenter);
-  plot::DrawText(&canvas, StringPrintf("%d", inliers_beyond + outliers_beyond),
-                 {overflow.x + overflow.width / 2, outlier_top - 6},
-                 plot::kTickScale, plot::kBlack, Align::kCenter);
-  const std::vector<plot::LegendEntry> legend = {
-      {plot::LegendEntry::Marker::kBox, plot::kBlue, "used corners"},
-      {plot::LegendEntry::Marker::kBox, plot::kRed, "outliers (dropped)"},
-      {plot::LegendEntry::Marker::kLine, plot::kOrange,
-       "expected for Gaussian noise of sigma = RMS (Rayleigh)"}};
-  const cv::Size legend_size = plot::LegendSize(legend);
-  plot::DrawLegend(&canvas,
-                   {frame.area.x + frame.area.width - legend_size.width - 10,
-                    frame.area.y + 10},
-                   legend);
-  return canvas;
+  chart.CanvasText(
+      overflow.x + overflow.width / 2.0, overflow.y + overflow.height + 21,
+      StringPrintf("> %.3g", range), plot::kTickHeight, Colour::kBlack, 0.5);
+  chart.CanvasText(overflow.x + overflow.width / 2.0,
+                   chart.ToCanvas(0, inliers_beyond + outliers_beyond).y - 6,
+                   StringPrintf("%d", inliers_beyond + outliers_beyond),
+                   plot::kTickHeight, Colour::kBlack, 0.5);
+  return chart.Finish();
 }
 
 cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
-  cv::Mat canvas(options.chart_height, options.chart_width, CV_8UC3,
-                 plot::kWhite);
   const int num_views = static_cast<int>(data.view_rms.size());
-  plot::Frame frame;
-  frame.area = cv::Rect(90, 80, options.chart_width - 90 - 30,
-                        options.chart_height - 80 - 70);
+  const cv::Rect area(90, 80, options.chart_width - 90 - 30,
+                      options.chart_height - 80 - 70);
   const double overall = data.result->rms_px;
   const double high = options.high_rms_factor * overall;
   double highest = high;
@@ -688,76 +567,59 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
       highest = std::max(highest, data.view_rms[v]);
     }
   }
-  frame.x_min = 0.5;
-  frame.x_max = std::max(1, num_views) + 0.5;
-  frame.y_min = 0;
-  frame.y_max = highest > 0 ? 1.12 * highest : 1;
-  plot::DrawAxes(&canvas, frame, "", "RMS per coordinate (px)", true,
-                 /*x_ticks=*/false);
-  const double bar_width =
-      std::max(1.0, 0.75 * frame.area.width / std::max(1, num_views));
+  const double x_max = std::max(1, num_views) + 0.5;
+  const double y_max = highest > 0 ? 1.12 * highest : 1;
+  plot::Chart chart(options.chart_width, options.chart_height);
+  chart.SetArea(area, 0.5, x_max, 0, y_max);
+  chart.Axes("", "RMS per coordinate (px)", true, /*x_numbers=*/false);
   const int label_every = std::max(1, (num_views + 29) / 30);
   const double bar_pitch =
-      static_cast<double>(frame.area.width) / std::max(1, num_views);
+      static_cast<double>(area.width) / std::max(1, num_views);
   int num_high = 0, num_unused = 0;
+  std::vector<double> unused_x, unused_y;
   for (int v = 0; v < num_views; ++v) {
-    const cv::Point2d base = frame.ToCanvas(v + 1, 0);
     if (std::isfinite(data.view_rms[v])) {
       const bool is_high = data.view_rms[v] > high;
       num_high += is_high;
-      const cv::Point2d top = frame.ToCanvas(v + 1, data.view_rms[v]);
-      cv::rectangle(
-          canvas,
-          cv::Point(static_cast<int>(std::lround(base.x - bar_width / 2)),
-                    static_cast<int>(std::lround(top.y))),
-          cv::Point(static_cast<int>(std::lround(base.x + bar_width / 2)) - 1,
-                    static_cast<int>(std::lround(base.y)) - 1),
-          is_high ? plot::kOrange : plot::kBlue, cv::FILLED);
+      chart.FilledRect(v + 1 - 0.375, 0, v + 1 + 0.375, data.view_rms[v],
+                       is_high ? Colour::kOrange : Colour::kBlue);
     } else {
       ++num_unused;
-      plot::DrawCross(&canvas, base - cv::Point2d(0, 8), 5, plot::kGrey, 2);
+      unused_x.push_back(v + 1);
+      unused_y.push_back(8 * y_max / area.height);
     }
     const bool crowds_worst =
         v != worst && worst >= 0 && std::abs(v - worst) * bar_pitch < 34;
     if ((v % label_every == 0 && !crowds_worst) || v == worst) {
-      plot::DrawText(&canvas, StringPrintf("%d", data.view_number[v]),
-                     {static_cast<int>(std::lround(base.x)),
-                      frame.area.y + frame.area.height + 20},
-                     plot::kTickScale, v == worst ? plot::kRed : plot::kBlack,
-                     Align::kCenter);
+      chart.CanvasText(chart.ToCanvas(v + 1, 0).x, area.y + area.height + 20,
+                       StringPrintf("%d", data.view_number[v]),
+                       plot::kTickHeight,
+                       v == worst ? Colour::kRed : Colour::kBlack, 0.5);
     }
   }
-  plot::DrawDashedLine(&canvas, frame.ToCanvas(0.5, overall),
-                       frame.ToCanvas(frame.x_max, overall), plot::kRed, 2, 8);
-  plot::DrawDashedLine(&canvas, frame.ToCanvas(0.5, high),
-                       frame.ToCanvas(frame.x_max, high), plot::kOrange, 1, 4);
-  cv::rectangle(canvas, frame.area, plot::kBlack, 1);
-  plot::DrawText(&canvas,
-                 "image number (as in summary.md; red: the worst view)",
-                 {frame.area.x + frame.area.width / 2,
-                  frame.area.y + frame.area.height + 46},
-                 plot::kLabelScale, plot::kBlack, Align::kCenter);
-  plot::DrawTitle(
-      &canvas, "Reprojection RMS per view",
+  chart.Markers(unused_x, unused_y, plot::LegendEntry::Sample::kCross,
+                Colour::kGrey, 14);
+  chart.Polyline({0.5, x_max}, {overall, overall}, Colour::kRed, 2, true);
+  chart.Polyline({0.5, x_max}, {high, high}, Colour::kOrange, 1, true);
+  chart.CanvasText(area.x + area.width / 2.0, area.y + area.height + 46,
+                   "image number (as in summary.md; red: the worst view)",
+                   plot::kLabelHeight, Colour::kBlack, 0.5);
+  chart.Title(
+      "Reprojection RMS per view",
       StringPrintf(
           "%d views: %d used, %d not used; %d above %.3gx the overall RMS",
           num_views, num_views - num_unused, num_unused, num_high,
           options.high_rms_factor));
-  const std::vector<plot::LegendEntry> legend = {
-      {plot::LegendEntry::Marker::kBox, plot::kBlue, "view RMS"},
-      {plot::LegendEntry::Marker::kBox, plot::kOrange,
-       StringPrintf("view RMS above %gx overall (dotted): check the image",
-                    options.high_rms_factor)},
-      {plot::LegendEntry::Marker::kDashedLine, plot::kRed,
-       StringPrintf("overall RMS %.3f px", overall)},
-      {plot::LegendEntry::Marker::kCross, plot::kGrey,
-       "view not used (reason in summary.md)"}};
-  const cv::Size legend_size = plot::LegendSize(legend);
-  plot::DrawLegend(&canvas,
-                   {frame.area.x + frame.area.width - legend_size.width - 10,
-                    frame.area.y + 10},
-                   legend);
-  return canvas;
+  chart.Legend(
+      {{plot::LegendEntry::Sample::kBox, Colour::kBlue, "view RMS"},
+       {plot::LegendEntry::Sample::kBox, Colour::kOrange,
+        StringPrintf("view RMS above %gx overall (dashed): check the image",
+                     options.high_rms_factor)},
+       {plot::LegendEntry::Sample::kDashedLine, Colour::kRed,
+        StringPrintf("overall RMS %.3f px", overall)},
+       {plot::LegendEntry::Sample::kCross, Colour::kGrey,
+        "view not used (reason in summary.md)"}});
+  return chart.Finish();
 }
 
 // The view image with the detected corners and their reprojections.
@@ -778,104 +640,96 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
         data.height);
   }
   const double scale = static_cast<double>(options.overlay_width) / grey.cols;
-  const cv::Size scaled_size(
-      options.overlay_width,
-      std::max(1, static_cast<int>(std::lround(grey.rows * scale))));
-  cv::Mat small;
-  cv::resize(grey, small, scaled_size, 0, 0,
-             scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
-  // Fade the photo so the markers stand out.
-  cv::Mat faded;
-  small.convertTo(faded, CV_8U, 0.6, 50);
-  constexpr int kHeader = 70, kFooter = 40;
-  cv::Mat canvas(small.rows + kHeader + kFooter, small.cols, CV_8UC3,
-                 plot::kWhite);
-  cv::cvtColor(faded, canvas(cv::Rect(0, kHeader, small.cols, small.rows)),
-               cv::COLOR_GRAY2BGR);
-  cv::Mat image_area = canvas(cv::Rect(0, kHeader, small.cols, small.rows));
-  auto to_canvas = [&](const Eigen::Vector2d& p) {
-    return cv::Point2d((p.x() + 0.5) * scale - 0.5,
-                       (p.y() + 0.5) * scale - 0.5);
-  };
-  const int radius = 6;
+  const cv::Scalar green(60, 170, 40), red(40, 40, 215), magenta(200, 0, 200);
+  const cv::Scalar yellow(0, 210, 255);
+  const double radius = 6;
   double p95 = 0;
   const double arrow_scale = ResidualArrowScale(data, options, &p95);
-  const cv::Scalar arrow_colour(0, 210, 255);  // yellow
   int inliers = 0, outliers = 0;
   const bool has_pose = v < static_cast<int>(result.cam_from_board.size());
   const Eigen::Isometry3d pose =
       has_pose ? result.cam_from_board[v] : Eigen::Isometry3d::Identity();
+  Overlay overlay;
   for (size_t i = 0; i < view.image_points.size(); ++i) {
     const Eigen::Vector2d& xy = view.image_points[i];
     if (!xy.allFinite()) continue;
     const bool inlier = result.inlier[v][i];
     (inlier ? inliers : outliers)++;
-    const cv::Point2d detected = to_canvas(xy);
-    cv::circle(image_area, Fixed(detected),
-               (inlier ? radius : radius + 3) << kShift,
-               inlier ? plot::kGreen : plot::kRed, 2, cv::LINE_AA, kShift);
+    OverlayMark circle;
+    circle.kind = OverlayMark::Kind::kCircle;
+    circle.at = xy;
+    circle.size = inlier ? radius : radius + 3;
+    circle.thickness = 2;
+    circle.colour = inlier ? green : red;
+    overlay.marks.push_back(circle);
     Eigen::Vector2d projected;
     if (data.camera_valid && has_pose &&
         result.camera.Project(pose * view.board_points[i], &projected) &&
         projected.allFinite()) {
-      // The residual magnified like in residuals.png (outliers cut), then
-      // the true reprojection.
+      // The residual magnified like in residuals.png (outliers cut, in
+      // overlay pixels), then the true reprojection.
       Eigen::Vector2d arrow = arrow_scale * (projected - xy);
-      const double cap = std::max(40.0, 3 * p95 * arrow_scale);
+      const double cap = std::max(40.0, 3 * p95 * arrow_scale) / scale;
       if (arrow.norm() > cap) arrow *= cap / arrow.norm();
-      const cv::Point2d tip = to_canvas(xy + arrow);
-      if (std::hypot(tip.x - detected.x, tip.y - detected.y) > 1.5) {
-        cv::arrowedLine(image_area, Fixed(detected), Fixed(tip),
-                        inlier ? arrow_colour : plot::kRed, 1, cv::LINE_AA,
-                        kShift, 0.25);
-      }
-      plot::DrawCross(&image_area, to_canvas(projected), radius - 2,
-                      cv::Scalar(200, 0, 200), 1);
+      OverlayMark residual;
+      residual.kind = OverlayMark::Kind::kArrow;
+      residual.at = xy;
+      residual.to = xy + arrow;
+      residual.colour = inlier ? yellow : red;
+      overlay.marks.push_back(residual);
+      OverlayMark cross;
+      cross.kind = OverlayMark::Kind::kCross;
+      cross.at = projected;
+      cross.size = radius - 2;
+      cross.colour = magenta;
+      overlay.marks.push_back(cross);
     }
   }
-  const std::string name = FileName(data.view_file[v]);
-  plot::DrawText(&canvas,
-                 StringPrintf("#%d %s  (%s)", data.view_number[v], name.c_str(),
-                              rank.c_str()),
-                 {12, 28}, plot::kTitleScale, plot::kBlack, Align::kLeft, 2);
-  plot::DrawText(
-      &canvas,
-      StringPrintf(
-          "view RMS %.3f px per coordinate (overall %.3f px); %d corners "
-          "used, %d outliers",
-          data.view_rms[v], result.rms_px, inliers, outliers),
-      {12, 56}, plot::kLabelScale, cv::Scalar(60, 60, 60));
-  // Legend line; each entry placed after the previous one's text.
-  const int y = canvas.rows - 15;
-  int x = 20;
-  cv::circle(canvas, {x, y - 5}, 5, plot::kGreen, 2, cv::LINE_AA);
-  x += 12;
-  const std::string used_text = "detected corner (used)";
-  plot::DrawText(&canvas, used_text, {x, y}, plot::kTickScale, plot::kBlack);
-  x += plot::TextSize(used_text, plot::kTickScale).width + 30;
-  cv::circle(canvas, {x, y - 5}, 5, plot::kRed, 2, cv::LINE_AA);
-  x += 12;
-  const std::string outlier_text = "outlier";
-  plot::DrawText(&canvas, outlier_text, {x, y}, plot::kTickScale, plot::kBlack);
-  x += plot::TextSize(outlier_text, plot::kTickScale).width + 30;
-  plot::DrawCross(&canvas, cv::Point2d(x, y - 5), 5, cv::Scalar(200, 0, 200),
-                  1);
-  x += 12;
-  const std::string cross_text = "reprojected by the calibrated model";
-  plot::DrawText(&canvas, cross_text, {x, y}, plot::kTickScale, plot::kBlack);
-  x += plot::TextSize(cross_text, plot::kTickScale).width + 30;
-  cv::arrowedLine(canvas, {x - 6, y - 5}, {x + 22, y - 5}, arrow_colour, 2,
-                  cv::LINE_AA, 0, 0.3);
-  plot::DrawText(
-      &canvas, StringPrintf("residual x%g (as in residuals.png)", arrow_scale),
-      {x + 30, y}, plot::kTickScale, plot::kBlack);
-  return canvas;
+  overlay.title =
+      StringPrintf("#%d %s  (%s)", data.view_number[v],
+                   FileName(data.view_file[v]).c_str(), rank.c_str());
+  overlay.subtitle = StringPrintf(
+      "view RMS %.3f px per coordinate (overall %.3f px); %d corners used, "
+      "%d outliers",
+      data.view_rms[v], result.rms_px, inliers, outliers);
+  overlay.legend = {
+      {OverlayMark::Kind::kCircle, green, "detected corner (used)"},
+      {OverlayMark::Kind::kCircle, red, "outlier"},
+      {OverlayMark::Kind::kCross, magenta,
+       "reprojected by the calibrated model"},
+      {OverlayMark::Kind::kArrow, yellow,
+       StringPrintf("residual x%g (as in residuals.png)", arrow_scale)}};
+  OverlayOptions overlay_options;
+  overlay_options.width = options.overlay_width;
+  overlay_options.fade = 0.6;  // the markers stand out on a faded photo
+  return DrawOverlay(grey, overlay, overlay_options);
 }
 
 // ---------------------------------------------------------------------------
 // Evidence plots (calib/evidence.h).
 
-// A PixelMap drawn over the image rectangle (bilinear between samples,
+// The map at image pixel (x, y): bilinear between the four samples around
+// it, or the nearest of them when one has no value.
+double SampleMap(const PixelMap& map, double x, double y) {
+  const int step = std::max(1, map.step_px);
+  const double gx = x / step, gy = y / step;
+  const int i0 = std::clamp(static_cast<int>(std::floor(gx)), 0, map.cols - 1);
+  const int j0 = std::clamp(static_cast<int>(std::floor(gy)), 0, map.rows - 1);
+  const int i1 = std::min(i0 + 1, map.cols - 1);
+  const int j1 = std::min(j0 + 1, map.rows - 1);
+  const double fx = std::clamp(gx - i0, 0.0, 1.0);
+  const double fy = std::clamp(gy - j0, 0.0, 1.0);
+  const double v00 = map.At(i0, j0), v10 = map.At(i1, j0);
+  const double v01 = map.At(i0, j1), v11 = map.At(i1, j1);
+  if (std::isfinite(v00) && std::isfinite(v10) && std::isfinite(v01) &&
+      std::isfinite(v11)) {
+    return (1 - fy) * ((1 - fx) * v00 + fx * v10) +
+           fy * ((1 - fx) * v01 + fx * v11);
+  }
+  return map.At(fx < 0.5 ? i0 : i1, fy < 0.5 ? j0 : j1);
+}
+
+// A PixelMap drawn over the image rectangle (interpolated between samples,
 // grey where the map has no value), with a colour bar from 0 to `colour_max`
 // (0: the map's largest value).
 cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
@@ -883,65 +737,45 @@ cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
                      const std::string& title, const std::string& subtitle,
                      const std::string& bar_label,
                      const std::vector<std::string>& notes) {
-  ImageLayout layout =
+  const ImageLayout layout =
       MakeImageLayout(options.image_plot_width, data.width, data.height,
                       static_cast<int>(notes.size()));
-  cv::Mat& canvas = layout.canvas;
-  const plot::Frame& frame = layout.frame;
   double largest = 0;
   for (double value : map.values) {
     if (std::isfinite(value)) largest = std::max(largest, value);
   }
   if (!(colour_max > 0)) colour_max = largest > 0 ? largest : 1.0;
-  const cv::Rect& a = frame.area;
-  const int step = std::max(1, map.step_px);
-  auto value_at = [&](double x, double y) {
-    const double gx = x / step, gy = y / step;
-    const int i0 =
-        std::clamp(static_cast<int>(std::floor(gx)), 0, map.cols - 1);
-    const int j0 =
-        std::clamp(static_cast<int>(std::floor(gy)), 0, map.rows - 1);
-    const int i1 = std::min(i0 + 1, map.cols - 1);
-    const int j1 = std::min(j0 + 1, map.rows - 1);
-    const double fx = std::clamp(gx - i0, 0.0, 1.0);
-    const double fy = std::clamp(gy - j0, 0.0, 1.0);
-    const double v00 = map.At(i0, j0), v10 = map.At(i1, j0);
-    const double v01 = map.At(i0, j1), v11 = map.At(i1, j1);
-    if (std::isfinite(v00) && std::isfinite(v10) && std::isfinite(v01) &&
-        std::isfinite(v11)) {
-      return (1 - fy) * ((1 - fx) * v00 + fx * v10) +
-             fy * ((1 - fx) * v01 + fx * v11);
-    }
-    return map.At(fx < 0.5 ? i0 : i1, fy < 0.5 ? j0 : j1);
-  };
-  cv::Mat lut(256, 1, CV_8UC1);
-  for (int i = 0; i < 256; ++i) lut.at<uint8_t>(i) = static_cast<uint8_t>(i);
-  cv::Mat lut_colour;
-  cv::applyColorMap(lut, lut_colour, cv::COLORMAP_VIRIDIS);
-  if (map.cols > 0 && map.rows > 0) {
-    for (int v = 0; v < a.height; ++v) {
-      for (int u = 0; u < a.width; ++u) {
-        const double x = (u + 0.5) / layout.scale - 0.5;
-        const double y = (v + 0.5) / layout.scale - 0.5;
-        const double value = value_at(x, y);
-        cv::Vec3b colour(170, 170, 170);
-        if (std::isfinite(value)) {
-          colour = lut_colour.at<cv::Vec3b>(static_cast<int>(
-              std::lround(std::clamp(value / colour_max, 0.0, 1.0) * 255)));
-        }
-        canvas.at<cv::Vec3b>(a.y + v, a.x + u) = colour;
+  plot::Chart chart(layout.canvas.width, layout.canvas.height,
+                    /*antialias=*/false);
+  SetImageArea(layout, data, &chart);
+  chart.FilledRect(-0.5, -0.5, data.width - 0.5, data.height - 0.5,
+                   Colour::kNoData);
+  if (map.cols > 0 && map.rows > 0 &&
+      map.values.size() == static_cast<size_t>(map.cols) * map.rows) {
+    // Resampled every kStep px (the distortion map's default grid) so the bands
+    // follow the bilinear surface and a sample without a value only greys its
+    // own cell.
+    constexpr int kStep = 8;
+    const int nx = (data.width - 1 + kStep - 1) / kStep + 1;
+    const int ny = (data.height - 1 + kStep - 1) / kStep + 1;
+    cv::Mat values(ny, nx, CV_64F);
+    for (int j = 0; j < ny; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        values.at<double>(j, i) =
+            SampleMap(map, std::min(i * kStep, data.width - 1),
+                      std::min(j * kStep, data.height - 1));
       }
     }
+    chart.Shades(values, SamplePositions(nx, kStep, data.width),
+                 SamplePositions(ny, kStep, data.height), 0, colour_max);
   }
-  plot::DrawAxes(&canvas, frame, "x (px)", "y (px)", false);
-  const cv::Rect bar(a.x + a.width + 20, a.y, 22, a.height);
-  plot::DrawColourBar(&canvas, bar, 0, colour_max, cv::COLORMAP_VIRIDIS,
-                      bar_label);
-  plot::DrawTitle(&canvas, title, subtitle);
+  chart.Axes("x (px)", "y (px)", false);
+  chart.ColourBar(0, colour_max, bar_label);
+  chart.Title(title, subtitle);
   for (size_t k = 0; k < notes.size(); ++k) {
-    DrawNote(&layout, static_cast<int>(k), notes[k]);
+    DrawNote(layout, static_cast<int>(k), notes[k], &chart);
   }
-  return canvas;
+  return chart.Finish();
 }
 
 cv::Mat PlotCrossValidation(const ReportData& data,
@@ -994,14 +828,12 @@ cv::Mat PlotUncertainty(const ReportData& data, const ReportOptions& options,
 cv::Mat PlotResidualBins(const ReportData& data, const ReportOptions& options,
                          const SystematicResiduals& residuals) {
   (void)data;
-  cv::Mat canvas(options.chart_height, options.chart_width, CV_8UC3,
-                 plot::kWhite);
+  plot::Chart chart(options.chart_width, options.chart_height);
   const int half = options.chart_width / 2;
   auto panel = [&](const std::vector<ResidualBin>& bins, int x0,
-                   const std::string& x_label) {
-    plot::Frame frame;
-    frame.area =
-        cv::Rect(x0 + 90, 90, half - 90 - 30, options.chart_height - 90 - 80);
+                   const std::string& x_label, bool legend) {
+    const cv::Rect area(x0 + 90, 90, half - 90 - 30,
+                        options.chart_height - 90 - 80);
     double lo = 0, hi = 1, extent = 0.05;
     if (!bins.empty()) {
       lo = bins.front().lo;
@@ -1013,46 +845,46 @@ cv::Mat PlotResidualBins(const ReportData& data, const ReportOptions& options,
           std::max({extent, std::abs(b.mean_radial_px) + 2 * b.se_radial_px,
                     std::abs(b.mean_tangential_px) + 2 * b.se_tangential_px});
     }
-    frame.x_min = lo;
-    frame.x_max = hi > lo ? hi : lo + 1;
-    frame.y_min = -1.1 * extent;
-    frame.y_max = 1.1 * extent;
-    plot::DrawAxes(&canvas, frame, x_label, "mean residual (px)", true);
-    plot::DrawDashedLine(&canvas, frame.ToCanvas(frame.x_min, 0),
-                         frame.ToCanvas(frame.x_max, 0), plot::kGrey, 1, 6);
+    chart.SetArea(area, lo, hi > lo ? hi : lo + 1, -1.1 * extent, 1.1 * extent);
+    chart.Axes(x_label, "mean residual (px)", true);
+    chart.Polyline({lo, hi > lo ? hi : lo + 1}, {0, 0}, Colour::kGrey, 1, true);
+    for (int c = 0; c < 2; ++c) {
+      std::vector<double> x, mean, y_lo, y_hi;
+      for (const ResidualBin& b : bins) {
+        if (b.count < 2) continue;
+        const double m = c == 0 ? b.mean_radial_px : b.mean_tangential_px;
+        const double se = c == 0 ? b.se_radial_px : b.se_tangential_px;
+        x.push_back(b.lo + (b.hi - b.lo) * (c == 0 ? 0.4 : 0.6));
+        mean.push_back(m);
+        y_lo.push_back(m - 2 * se);
+        y_hi.push_back(m + 2 * se);
+      }
+      const Colour colour = c == 0 ? Colour::kBlue : Colour::kOrange;
+      chart.ErrorBars(x, y_lo, y_hi, colour, 2);
+      chart.Markers(x, mean, plot::LegendEntry::Sample::kCircle, colour, 12);
+    }
     for (const ResidualBin& b : bins) {
       if (b.count < 2) continue;
-      const double width = b.hi - b.lo;
-      for (int c = 0; c < 2; ++c) {
-        const double mean = c == 0 ? b.mean_radial_px : b.mean_tangential_px;
-        const double se = c == 0 ? b.se_radial_px : b.se_tangential_px;
-        const double x = b.lo + width * (c == 0 ? 0.4 : 0.6);
-        const cv::Scalar colour = c == 0 ? plot::kBlue : plot::kOrange;
-        cv::line(canvas, frame.ToCanvasPixel(x, mean - 2 * se),
-                 frame.ToCanvasPixel(x, mean + 2 * se), colour, 2, cv::LINE_AA);
-        cv::circle(canvas, frame.ToCanvasPixel(x, mean), 5, colour, cv::FILLED,
-                   cv::LINE_AA);
-      }
-      plot::DrawText(&canvas, StringPrintf("%d", b.count),
-                     frame.ToCanvasPixel(b.lo + 0.5 * width, frame.y_max) +
-                         cv::Point(0, 14),
-                     plot::kTickScale, plot::kGrey, Align::kCenter);
+      chart.CanvasText(chart.ToCanvas(0.5 * (b.lo + b.hi), 0).x, area.y + 16,
+                       StringPrintf("%d", b.count), plot::kTickHeight,
+                       Colour::kGrey, 0.5);
     }
-    cv::rectangle(canvas, frame.area, plot::kBlack, 1);
+    if (legend) {
+      chart.Legend(
+          {{plot::LegendEntry::Sample::kCircle, Colour::kBlue,
+            "radial (> 0: projected farther out than seen)"},
+           {plot::LegendEntry::Sample::kCircle, Colour::kOrange, "tangential"}},
+          plot::Chart::Corner::kBottomLeft);
+    }
   };
-  panel(residuals.by_angle, 0, "field angle of the corner's ray (deg)");
+  panel(residuals.by_angle, 0, "field angle of the corner's ray (deg)", true);
   panel(residuals.by_distance, half,
-        "distance of the corner from the camera (m)");
-  plot::DrawTitle(
-      &canvas, "Binned residual means (radial and tangential, +- 2 SE)",
+        "distance of the corner from the camera (m)", false);
+  chart.Title(
+      "Binned residual means (radial and tangential, +- 2 SE)",
       "A right model leaves every mean near zero; grey numbers: corners "
       "per bin");
-  const std::vector<plot::LegendEntry> legend = {
-      {plot::LegendEntry::Marker::kCircle, plot::kBlue,
-       "radial (> 0: projected farther out than seen)"},
-      {plot::LegendEntry::Marker::kCircle, plot::kOrange, "tangential"}};
-  plot::DrawLegend(&canvas, {100, 100}, legend);
-  return canvas;
+  return chart.Finish();
 }
 
 std::string SafeStem(const std::string& file) {
@@ -1110,17 +942,6 @@ std::vector<std::pair<int, std::string>> PickOverlayViews(
          k == 0 ? "best view" : StringPrintf("%d. best view", k + 1));
   }
   return picked;
-}
-
-bool WritePng(const std::filesystem::path& path, const cv::Mat& image,
-              std::string* error) {
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", image, bytes)) {
-    *error = "cannot encode " + path.string() + " as PNG";
-    return false;
-  }
-  return WriteFileAtomically(path.string(),
-                             std::string(bytes.begin(), bytes.end()), error);
 }
 
 }  // namespace
@@ -1543,6 +1364,47 @@ std::string ReportMarkdown(const ReportInput& input,
   return md.str();
 }
 
+namespace {
+
+// The charts of the report, each passed to `write_png` (false: stop).
+template <typename WritePngFn>
+bool WriteCharts(const ReportData& data, const ReportOptions& options,
+                 const WritePngFn& write_png,
+                 std::vector<std::string>* warnings) {
+  if (!write_png("residuals.png", PlotResiduals(data, options)) ||
+      !write_png("residual_histogram.png", PlotHistogram(data, options)) ||
+      !write_png("view_rms.png", PlotViewRms(data, options)) ||
+      !write_png("coverage.png", PlotCoverage(data, options))) {
+    return false;
+  }
+  if (!data.camera_valid) {
+    warnings->push_back(
+        "no distortion map: the result's camera parameters are not valid");
+    return true;
+  }
+  if (!write_png("distortion.png", PlotDistortion(data, options))) {
+    return false;
+  }
+  if (data.input->evidence == nullptr) return true;
+  const Evidence& evidence = *data.input->evidence;
+  if (evidence.cross_validation.ok &&
+      !write_png(
+          "cross_validation.png",
+          PlotCrossValidation(data, options, evidence.cross_validation))) {
+    return false;
+  }
+  if (evidence.uncertainty.ok &&
+      !write_png("uncertainty.png",
+                 PlotUncertainty(data, options, evidence.uncertainty,
+                                 evidence.residuals.max_angle_deg))) {
+    return false;
+  }
+  return write_png("residual_bins.png",
+                   PlotResidualBins(data, options, evidence.residuals));
+}
+
+}  // namespace
+
 bool WriteReport(const std::string& dir, const ReportInput& input,
                  const ReportOptions& options, std::string* error,
                  ReportSummary* summary) {
@@ -1588,7 +1450,7 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
   const ReportData data = GatherData(input);
   std::vector<std::string> png_files;
   auto write_png = [&](const std::string& name, const cv::Mat& image) {
-    if (!WritePng(folder / name, image, error)) return false;
+    if (!WritePng((folder / name).string(), image, error)) return false;
     summary->files.push_back(name);
     png_files.push_back(name);
     return true;
@@ -1598,38 +1460,11 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
         StringPrintf("no plots: the result's image size %d x %d is not valid",
                      width, height));
   } else {
-    if (!write_png("residuals.png", PlotResiduals(data, options)) ||
-        !write_png("residual_histogram.png", PlotHistogram(data, options)) ||
-        !write_png("view_rms.png", PlotViewRms(data, options)) ||
-        !write_png("coverage.png", PlotCoverage(data, options))) {
+    std::string charts_why;
+    if (!plot::ChartsAvailable(&charts_why)) {
+      summary->warnings.push_back("no charts: " + charts_why);
+    } else if (!WriteCharts(data, options, write_png, &summary->warnings)) {
       return false;
-    }
-    if (data.camera_valid) {
-      if (!write_png("distortion.png", PlotDistortion(data, options))) {
-        return false;
-      }
-    } else {
-      summary->warnings.push_back(
-          "no distortion map: the result's camera parameters are not valid");
-    }
-    if (input.evidence != nullptr && data.camera_valid) {
-      const Evidence& evidence = *input.evidence;
-      if (evidence.cross_validation.ok &&
-          !write_png(
-              "cross_validation.png",
-              PlotCrossValidation(data, options, evidence.cross_validation))) {
-        return false;
-      }
-      if (evidence.uncertainty.ok &&
-          !write_png("uncertainty.png",
-                     PlotUncertainty(data, options, evidence.uncertainty,
-                                     evidence.residuals.max_angle_deg))) {
-        return false;
-      }
-      if (!write_png("residual_bins.png",
-                     PlotResidualBins(data, options, evidence.residuals))) {
-        return false;
-      }
     }
     std::set<std::string> taken;
     for (const auto& [v, rank] : PickOverlayViews(data, options.num_overlays)) {

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <vector>
 
 #include "apps/image_io.h"
+#include "apps/overlay.h"
 #include "util/atomic_file.h"
 #include "util/failure.h"
 
@@ -110,14 +110,17 @@ cv::Mat RectifiedPairImage(const cv::Mat& first, const cv::Mat& second,
       RectifyImage(second, second_camera, rect.r2, k2, rect.width, rect.height);
   cv::Mat pair;
   cv::hconcat(a, b, pair);
-  cv::Mat colour;
-  cv::cvtColor(pair, colour, cv::COLOR_GRAY2BGR);
-  for (int y = options.line_spacing_px / 2; y < colour.rows;
+  Overlay overlay;
+  for (int y = options.line_spacing_px / 2; y < pair.rows;
        y += options.line_spacing_px) {
-    cv::line(colour, cv::Point(0, y), cv::Point(colour.cols - 1, y),
-             cv::Scalar(0, 200, 0), 1);
+    OverlayMark line;
+    line.kind = OverlayMark::Kind::kLine;
+    line.at = Eigen::Vector2d(0, y);
+    line.to = Eigen::Vector2d(pair.cols - 1, y);
+    line.colour = cv::Scalar(0, 200, 0);
+    overlay.marks.push_back(line);
   }
-  return colour;
+  return DrawOverlay(pair, overlay, OverlayOptions());
 }
 
 bool WriteRigReport(const std::string& dir, const RigReportInput& input,
@@ -174,12 +177,7 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
   const cv::Mat pair =
       RectifiedPairImage(first, second, result.cameras[0].camera,
                          result.cameras[1].camera, rect, options);
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", pair, png)) {
-    return Fail("cannot encode the rectified pair", error);
-  }
-  return WriteFileAtomically((fs::path(dir) / "rectified_pair.png").string(),
-                             std::string(png.begin(), png.end()), error);
+  return WritePng((fs::path(dir) / "rectified_pair.png").string(), pair, error);
 }
 
 }  // namespace puzzlecal

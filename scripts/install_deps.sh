@@ -9,6 +9,7 @@ packages=(
   libgflags-dev libgoogle-glog-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcairo2-dev
+  libplplot-dev plplot-driver-cairo
   libdeflate-dev zlib1g-dev
   clang libclang-rt-14-dev
 )

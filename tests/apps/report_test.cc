@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -56,6 +57,14 @@ cv::Size PngSize(const fs::path& path) {
   EXPECT_FALSE(image.empty()) << path;
   EXPECT_EQ(image.type(), CV_8UC3) << path;
   return image.size();
+}
+
+// A chart that shows something: at least 2 % of its pixels are not white.
+void ExpectNotBlank(const fs::path& path) {
+  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(image.empty()) << path;
+  const int drawn = cv::countNonZero(image < 250);
+  EXPECT_GT(drawn, 0.02 * image.total()) << path;
 }
 
 Board CheckerBoard(double tile) {
@@ -174,23 +183,47 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   std::string error;
   ReportSummary summary;
   const fs::path report_dir = dir / "report" / "nested";
-  ASSERT_TRUE(
-      WriteReport(report_dir.string(), run.input, options, &error, &summary))
-      << error;
+  // The plotting library must not talk on the terminal.
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
+  const bool written =
+      WriteReport(report_dir.string(), run.input, options, &error, &summary);
+  EXPECT_EQ(::testing::internal::GetCapturedStdout(), "");
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  ASSERT_TRUE(written) << error;
   EXPECT_TRUE(summary.warnings.empty()) << summary.warnings.front();
 
   // Image-shaped plots keep the image's aspect ratio in their plot area.
-  for (const char* name : {"residuals.png", "coverage.png", "distortion.png"}) {
+  const std::vector<std::string> image_charts = {
+      "residuals.png", "coverage.png", "distortion.png"};
+  const std::vector<std::string> charts = {"residual_histogram.png",
+                                           "view_rms.png"};
+  for (const std::string& name : image_charts) {
+    ASSERT_NE(std::find(summary.files.begin(), summary.files.end(), name),
+              summary.files.end())
+        << name;
     const cv::Size size = PngSize(report_dir / name);
     EXPECT_EQ(size.width, options.image_plot_width) << name;
     const double area_height = (options.image_plot_width - 230) * 480.0 / 640;
     EXPECT_GT(size.height, area_height) << name;
     EXPECT_LT(size.height, area_height + 300) << name;
+    ExpectNotBlank(report_dir / name);
   }
-  for (const char* name : {"residual_histogram.png", "view_rms.png"}) {
+  for (const std::string& name : charts) {
+    ASSERT_NE(std::find(summary.files.begin(), summary.files.end(), name),
+              summary.files.end())
+        << name;
     EXPECT_EQ(PngSize(report_dir / name),
               cv::Size(options.chart_width, options.chart_height))
         << name;
+    ExpectNotBlank(report_dir / name);
+  }
+  // The same input gives the same bytes (no time stamps, no state carried
+  // over from the previous charts).
+  const fs::path again = dir / "again";
+  ASSERT_TRUE(WriteReport(again.string(), run.input, options, &error)) << error;
+  for (const std::string& file : summary.files) {
+    EXPECT_EQ(ReadText(again / file), ReadText(report_dir / file)) << file;
   }
 
   // Overlays: the worst view by RMS, the view with the most outliers, and
