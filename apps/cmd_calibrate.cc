@@ -19,15 +19,15 @@
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
-#include "apps/image_io.h"
-#include "apps/pipeline.h"
-#include "apps/report.h"
 #include "apps/subcommand.h"
 #include "calib/calibrate.h"
 #include "calib/camera_yaml.h"
 #include "calib/evidence.h"
 #include "calib/model_selection.h"
 #include "calib/verdict.h"
+#include "pipeline/image_io.h"
+#include "pipeline/pipeline.h"
+#include "report/report.h"
 #include "util/timer.h"
 
 namespace puzzlecal {

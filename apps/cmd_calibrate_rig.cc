@@ -15,15 +15,15 @@
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
-#include "apps/image_io.h"
-#include "apps/pipeline.h"
-#include "apps/rig_report.h"
 #include "apps/subcommand.h"
 #include "calib/camera_yaml.h"
 #include "calib/evidence.h"
 #include "calib/rig_calibration.h"
 #include "calib/rig_yaml.h"
 #include "calib/verdict.h"
+#include "pipeline/image_io.h"
+#include "pipeline/pipeline.h"
+#include "report/rig_report.h"
 #include "util/timer.h"
 
 namespace puzzlecal {

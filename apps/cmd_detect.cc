@@ -16,10 +16,10 @@
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
-#include "apps/image_io.h"
-#include "apps/overlay.h"
-#include "apps/pipeline.h"
 #include "apps/subcommand.h"
+#include "pipeline/image_io.h"
+#include "pipeline/pipeline.h"
+#include "report/overlay.h"
 #include "util/atomic_file.h"
 
 namespace puzzlecal {

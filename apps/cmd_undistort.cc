@@ -10,11 +10,11 @@
 #include <vector>
 
 #include "apps/common_flags.h"
-#include "apps/image_io.h"
 #include "apps/subcommand.h"
-#include "apps/undistort.h"
-#include "util/atomic_file.h"
 #include "calib/camera_yaml.h"
+#include "pipeline/image_io.h"
+#include "pipeline/undistort.h"
+#include "util/atomic_file.h"
 
 // Defined by `compare` (a camera file in any of the four formats).
 DECLARE_string(camera);

@@ -1,6 +1,7 @@
 // Grid coverage on the deltille fisheye photos (an 11 x 8 inner-corner
 // checkerboard, 20 mm tiles, strong fisheye) against pseudo-truth:
-//  1. every photo runs through detection -> grid -> decode (apps/pipeline.h);
+//  1. every photo runs through detection -> grid -> decode
+//  (pipeline/pipeline.h);
 //  2. the decoded checkerboard views calibrate a kannala-brandt camera;
 //  3. per photo, the board frame of its view (the labels of its largest
 //     component) is placed by the view's calibrated pose (PnP through the
@@ -46,10 +47,10 @@
 #include <string>
 #include <vector>
 
-#include "apps/pipeline.h"
 #include "calib/calibrate.h"
 #include "calib/camera_yaml.h"
 #include "calib/initialization.h"
+#include "pipeline/pipeline.h"
 #include "tests/grid/grid_test_util.h"
 #include "tests/support/deltille_data.h"
 

@@ -40,12 +40,12 @@
 #include <string>
 #include <vector>
 
-#include "apps/image_io.h"
-#include "apps/pipeline.h"
 #include "decode/board.h"
 #include "decode/decoder.h"
 #include "detection/detector.h"
 #include "grid/grid.h"
+#include "pipeline/image_io.h"
+#include "pipeline/pipeline.h"
 #include "tests/support/deltille_data.h"
 #include "util/statistics.h"
 

@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "apps/config_io.h"
-#include "apps/image_io.h"
-#include "apps/pipeline.h"
 #include "calib/calibrate.h"
 #include "calib/camera_yaml.h"
 #include "calib/evidence.h"
 #include "calib/verdict.h"
+#include "pipeline/image_io.h"
+#include "pipeline/pipeline.h"
 #include "tests/support/deltille_data.h"
 
 namespace puzzlecal {

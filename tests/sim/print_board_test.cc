@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "apps/config_io.h"
-#include "apps/pipeline.h"
 #include "decode/puzzleboard.h"
+#include "pipeline/pipeline.h"
 
 namespace puzzlecal {
 namespace {

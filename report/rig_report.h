@@ -1,5 +1,5 @@
-#ifndef PUZZLECAL_APPS_RIG_REPORT_H_
-#define PUZZLECAL_APPS_RIG_REPORT_H_
+#ifndef PUZZLECAL_REPORT_RIG_REPORT_H_
+#define PUZZLECAL_REPORT_RIG_REPORT_H_
 
 // The rig calibration report (`puzzlecal calibrate-rig --report DIR`): a
 // text summary (summary.txt) and, for the first two cameras, a rectified
@@ -70,4 +70,4 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
 
 }  // namespace puzzlecal
 
-#endif  // PUZZLECAL_APPS_RIG_REPORT_H_
+#endif  // PUZZLECAL_REPORT_RIG_REPORT_H_

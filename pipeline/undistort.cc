@@ -1,4 +1,4 @@
-#include "apps/undistort.h"
+#include "pipeline/undistort.h"
 
 #include <Eigen/Core>
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "apps/rig_report.h"
+#include "report/rig_report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <sstream>
 #include <vector>
 
-#include "apps/image_io.h"
-#include "apps/overlay.h"
+#include "pipeline/image_io.h"
+#include "report/overlay.h"
 #include "util/atomic_file.h"
 #include "util/failure.h"
 

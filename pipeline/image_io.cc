@@ -1,4 +1,4 @@
-#include "apps/image_io.h"
+#include "pipeline/image_io.h"
 
 #include <libdeflate.h>
 #include <unistd.h>

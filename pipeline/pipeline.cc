@@ -1,4 +1,4 @@
-#include "apps/pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include <glog/logging.h>
 

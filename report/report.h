@@ -1,5 +1,5 @@
-#ifndef PUZZLECAL_APPS_REPORT_H_
-#define PUZZLECAL_APPS_REPORT_H_
+#ifndef PUZZLECAL_REPORT_REPORT_H_
+#define PUZZLECAL_REPORT_REPORT_H_
 
 // The calibration report (`puzzlecal calibrate --report DIR`): a markdown
 // summary and PNG plots a user can judge the calibration by.
@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "apps/image_io.h"
 #include "calib/calibrate.h"
 #include "calib/calibration_view.h"
 #include "calib/evidence.h"
 #include "calib/verdict.h"
 #include "decode/board.h"
+#include "pipeline/image_io.h"
 
 namespace puzzlecal {
 
@@ -128,10 +128,11 @@ bool DistortionShift(const Camera& camera, const Eigen::Vector2d& pixel,
                      double* shift_px, double* ray_angle_deg);
 
 // A parameter value and its standard deviation as the summary prints them:
-// both rounded to three significant digits of sigma (sigma > 0), or the value to
-// 8 significant digits when sigma is unknown (<= 0 or not finite).
-std::string FormatWithSigma(double value, double sigma, std::string* sigma_text);
+// both rounded to three significant digits of sigma (sigma > 0), or the value
+// to 8 significant digits when sigma is unknown (<= 0 or not finite).
+std::string FormatWithSigma(double value, double sigma,
+                            std::string* sigma_text);
 
 }  // namespace puzzlecal
 
-#endif  // PUZZLECAL_APPS_REPORT_H_
+#endif  // PUZZLECAL_REPORT_REPORT_H_

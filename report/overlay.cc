@@ -1,4 +1,4 @@
-#include "apps/overlay.h"
+#include "report/overlay.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "apps/image_io.h"
+#include "pipeline/image_io.h"
 
 #include <gtest/gtest.h>
 #include <libdeflate.h>

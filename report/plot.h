@@ -1,5 +1,5 @@
-#ifndef PUZZLECAL_APPS_PLOT_H_
-#define PUZZLECAL_APPS_PLOT_H_
+#ifndef PUZZLECAL_REPORT_PLOT_H_
+#define PUZZLECAL_REPORT_PLOT_H_
 
 // The calibration report's charts, drawn by PLplot (its cairo memory
 // device) into an image the caller writes as PNG. A thin layer: the chart's
@@ -150,4 +150,4 @@ class Chart {
 }  // namespace plot
 }  // namespace puzzlecal
 
-#endif  // PUZZLECAL_APPS_PLOT_H_
+#endif  // PUZZLECAL_REPORT_PLOT_H_

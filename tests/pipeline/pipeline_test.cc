@@ -1,7 +1,7 @@
 // The per-image pipeline on rendered files: outcomes, ids against truth, and
 // results that do not depend on the number of threads.
 
-#include "apps/pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "apps/report.h"
 #include "calib/calibrate.h"
 #include "calib/evidence.h"
 #include "calib/verdict.h"
+#include "report/report.h"
 #include "tests/calib/synthetic_views.h"
 
 namespace puzzlecal {

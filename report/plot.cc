@@ -1,4 +1,4 @@
-#include "apps/plot.h"
+#include "report/plot.h"
 
 #include <plplot.h>
 

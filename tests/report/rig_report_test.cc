@@ -3,7 +3,7 @@
 // (kannala-brandt) for the same rotation and intrinsics, and the viewing
 // rectification puts every point on the same row in both views.
 
-#include "apps/rig_report.h"
+#include "report/rig_report.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
-#ifndef PUZZLECAL_APPS_UNDISTORT_H_
-#define PUZZLECAL_APPS_UNDISTORT_H_
+#ifndef PUZZLECAL_PIPELINE_UNDISTORT_H_
+#define PUZZLECAL_PIPELINE_UNDISTORT_H_
 
 // Undistortion to a pinhole camera without distortion: the target camera
 // (focal length and principal point chosen from the region of the image the
@@ -69,4 +69,4 @@ void MakeUndistortMaps(const Camera& source, const Camera& target,
 
 }  // namespace puzzlecal
 
-#endif  // PUZZLECAL_APPS_UNDISTORT_H_
+#endif  // PUZZLECAL_PIPELINE_UNDISTORT_H_

@@ -1,5 +1,5 @@
-#ifndef PUZZLECAL_APPS_IMAGE_IO_H_
-#define PUZZLECAL_APPS_IMAGE_IO_H_
+#ifndef PUZZLECAL_PIPELINE_IMAGE_IO_H_
+#define PUZZLECAL_PIPELINE_IMAGE_IO_H_
 
 // Finding and loading the photos of a calibration run.
 
@@ -34,8 +34,9 @@ struct ImageLoadOptions {
 // Loads one image as 8-bit grey (colour and alpha are converted, 16-bit is
 // scaled to 8 bits by its own maximum so dark 16-bit photos keep their
 // contrast; colour JPEGs give their luma channel). Pixels stay in the
-// sensor's frame: an EXIF orientation tag is not applied. False with a message naming the file and the reason (missing,
-// unreadable, not an image, truncated, too large, empty).
+// sensor's frame: an EXIF orientation tag is not applied. False with a message
+// naming the file and the reason (missing, unreadable, not an image, truncated,
+// too large, empty).
 bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
                    cv::Mat* grey, std::string* error);
 
@@ -46,4 +47,4 @@ bool CheckOutputPath(const std::string& path, std::string* error);
 
 }  // namespace puzzlecal
 
-#endif  // PUZZLECAL_APPS_IMAGE_IO_H_
+#endif  // PUZZLECAL_PIPELINE_IMAGE_IO_H_

@@ -1,5 +1,5 @@
-#ifndef PUZZLECAL_APPS_PIPELINE_H_
-#define PUZZLECAL_APPS_PIPELINE_H_
+#ifndef PUZZLECAL_PIPELINE_PIPELINE_H_
+#define PUZZLECAL_PIPELINE_PIPELINE_H_
 
 // One image through detection -> grid -> decode, and a folder of images in
 // parallel with a bounded number of images in memory.
@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "apps/image_io.h"
 #include "calib/calibration_view.h"
 #include "decode/board.h"
 #include "decode/decoder.h"
@@ -17,6 +16,7 @@
 #include "detection/detector.h"
 #include "grid/grid.h"
 #include "grid/grid_component.h"
+#include "pipeline/image_io.h"
 
 namespace puzzlecal {
 
@@ -105,4 +105,4 @@ std::vector<std::string> ViewFiles(const std::vector<ImageResult>& images,
 
 }  // namespace puzzlecal
 
-#endif  // PUZZLECAL_APPS_PIPELINE_H_
+#endif  // PUZZLECAL_PIPELINE_PIPELINE_H_

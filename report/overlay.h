@@ -1,5 +1,5 @@
-#ifndef PUZZLECAL_APPS_OVERLAY_H_
-#define PUZZLECAL_APPS_OVERLAY_H_
+#ifndef PUZZLECAL_REPORT_OVERLAY_H_
+#define PUZZLECAL_REPORT_OVERLAY_H_
 
 // Marks drawn on a photo (detected corners, reprojections, lattice edges,
 // epipolar rows) with OpenCV, and the one PNG writer of the program.
@@ -62,4 +62,4 @@ bool WritePng(const std::string& path, const cv::Mat& image,
 
 }  // namespace puzzlecal
 
-#endif  // PUZZLECAL_APPS_OVERLAY_H_
+#endif  // PUZZLECAL_REPORT_OVERLAY_H_

@@ -1,4 +1,4 @@
-#include "apps/report.h"
+#include "report/report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,8 +9,8 @@
 #include <set>
 #include <sstream>
 
-#include "apps/overlay.h"
-#include "apps/plot.h"
+#include "report/overlay.h"
+#include "report/plot.h"
 #include "util/atomic_file.h"
 #include "util/string_format.h"
 

@@ -4,7 +4,7 @@
 // sample camera's image corners) the target covers the invertible region
 // only, and every target pixel maps back to its own ray (no swirl).
 
-#include "apps/undistort.h"
+#include "pipeline/undistort.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "apps/pipeline.h"
 #include "calib/camera_yaml.h"
 #include "decode/board.h"
+#include "pipeline/pipeline.h"
 #include "sim/render.h"
 
 namespace puzzlecal {
