@@ -89,32 +89,6 @@ class Progress {
   Verbosity verbosity_;
 };
 
-// One line per input image for the log and the report.
-std::vector<ReportImage> ReportLines(const std::vector<ImageResult>& images,
-                                     const CalibrationResult* result) {
-  std::vector<ReportImage> lines;
-  for (const ImageResult& image : images) {
-    ReportImage line;
-    line.file = image.file;
-    line.outcome = ImageOutcomeName(image.outcome);
-    line.reason = image.reason;
-    line.corners_detected = static_cast<int>(image.corners.size());
-    line.view_index = image.view_index;
-    const int v = line.view_index;
-    if (v >= 0 && result != nullptr) {
-      if (!result->view_used[v]) {
-        line.outcome = "not used by the calibration";
-        line.reason = result->view_reason[v];
-      } else {
-        for (bool inlier : result->inlier[v]) line.corners_used += inlier;
-        line.outcome = "used";
-      }
-    }
-    lines.push_back(line);
-  }
-  return lines;
-}
-
 // ---- interruption ----
 
 // Set once the camera file is in place; read by the SIGINT handler.
@@ -245,13 +219,16 @@ void PrintImageProblems(const std::vector<ReportImage>& lines) {
   const Verbosity verbosity = ConsoleVerbosity();
   if (verbosity == Verbosity::kQuiet) return;
   for (const ReportImage& line : lines) {
-    if (line.outcome == "used" && verbosity != Verbosity::kVerbose) continue;
+    if (line.use == ViewUse::kUsed && verbosity != Verbosity::kVerbose) {
+      continue;
+    }
     // Loading messages start with the path; the line names the file already.
     std::string reason = line.reason;
     if (reason.rfind(line.file + ": ", 0) == 0) {
       reason.erase(0, line.file.size() + 2);
     }
-    std::cerr << fs::path(line.file).filename().string() << ": " << line.outcome
+    std::cerr << fs::path(line.file).filename().string() << ": "
+              << line.OutcomeText()
               << (reason.empty() ? "" : " (" + reason + ")") << "\n";
   }
 }
@@ -531,7 +508,7 @@ int RunCalibrate() {
     return code;
   }
   const std::vector<ReportImage> report_images =
-      ReportLines(run.images, run.calibrated ? &run.result : nullptr);
+      MakeReportImages(run.images, run.calibrated ? &run.result : nullptr);
   PrintImageProblems(report_images);
   if (run.calibrated) {
     if (const int code = WriteCameraOf(request, run); code != kExitOk) {

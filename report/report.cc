@@ -946,6 +946,43 @@ std::vector<std::pair<int, std::string>> PickOverlayViews(
 
 }  // namespace
 
+std::string ReportImage::OutcomeText() const {
+  switch (use) {
+    case ViewUse::kUsed:
+      return "used";
+    case ViewUse::kDropped:
+      return "not used by the calibration";
+    case ViewUse::kNoView:
+      break;
+  }
+  return ImageOutcomeName(outcome);
+}
+
+std::vector<ReportImage> MakeReportImages(
+    const std::vector<ImageResult>& images, const CalibrationResult* result) {
+  std::vector<ReportImage> lines;
+  for (const ImageResult& image : images) {
+    ReportImage line;
+    line.file = image.file;
+    line.outcome = image.outcome;
+    line.reason = image.reason;
+    line.corners_detected = static_cast<int>(image.corners.size());
+    line.view_index = image.view_index;
+    const int v = line.view_index;
+    if (v >= 0 && result != nullptr) {
+      if (!result->view_used[v]) {
+        line.use = ViewUse::kDropped;
+        line.reason = result->view_reason[v];
+      } else {
+        for (bool inlier : result->inlier[v]) line.corners_used += inlier;
+        line.use = ViewUse::kUsed;
+      }
+    }
+    lines.push_back(line);
+  }
+  return lines;
+}
+
 bool ReportOptions::Check(std::string* why) const {
   auto fail = [&](const std::string& message) {
     if (why) *why = message;
@@ -1264,7 +1301,7 @@ std::string ReportMarkdown(const ReportInput& input,
     const int v = image.view_index;
     const bool is_view = v >= 0 && v < static_cast<int>(data.view_rms.size());
     const bool used_view = is_view && std::isfinite(data.view_rms[v]);
-    std::string outcome = image.outcome;
+    const std::string outcome = image.OutcomeText();
     std::string reason = image.reason;
     // The calibration may drop a view the pipeline found usable.
     if (is_view && !used_view &&

@@ -13,18 +13,36 @@
 #include "calib/verdict.h"
 #include "decode/board.h"
 #include "pipeline/image_io.h"
+#include "pipeline/pipeline.h"
 
 namespace puzzlecal {
 
+// What the calibration made of an image's view.
+enum class ViewUse {
+  kNoView,   // the image gave no view (ReportImage::outcome says why)
+  kDropped,  // a view the calibration did not use (the reason says why)
+  kUsed,     // a view of the calibration
+};
+
 // One input image of the run, in input order.
 struct ReportImage {
-  std::string file;     // path as given
-  std::string outcome;  // "used", "unreadable", "no corners", ...
-  std::string reason;   // details (may be empty)
+  std::string file;                                  // path as given
+  ImageOutcome outcome = ImageOutcome::kUnreadable;  // of the pipeline
+  ViewUse use = ViewUse::kNoView;
+  std::string reason;  // details (may be empty)
   int corners_detected = 0;
   int corners_used = 0;  // inlier corners in the calibration
   int view_index = -1;   // index into the CalibrationView list, -1 if none
+
+  // "used", "not used by the calibration", or the pipeline's outcome
+  // ("unreadable", "no corners", ...).
+  std::string OutcomeText() const;
 };
+
+// The report's line of each image record of the pipeline, with what the
+// calibration (`result`, null when it failed) made of its view.
+std::vector<ReportImage> MakeReportImages(
+    const std::vector<ImageResult>& images, const CalibrationResult* result);
 
 struct ReportOptions {
   // Views drawn as overlays (the image with detected and reprojected

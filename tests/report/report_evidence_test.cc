@@ -59,7 +59,8 @@ TEST(ReportEvidence, VerdictHeadsTheSummaryAndPlotsAreWritten) {
   for (size_t v = 0; v < data.views.size(); ++v) {
     ReportImage image;
     image.file = data.views[v].name + ".png";  // not on disk: no overlays
-    image.outcome = "used";
+    image.outcome = ImageOutcome::kUsable;
+    image.use = ViewUse::kUsed;
     image.view_index = static_cast<int>(v);
     input.images.push_back(image);
   }

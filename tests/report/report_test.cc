@@ -93,12 +93,12 @@ void MakeRun(const testing::SyntheticScene& scene, const fs::path& image_dir,
   // Two images that yielded nothing come first, as a folder listing would.
   ReportImage unreadable;
   unreadable.file = (image_dir / "a_broken.png").string();
-  unreadable.outcome = "unreadable";
+  unreadable.outcome = ImageOutcome::kUnreadable;
   unreadable.reason = "not an image";
   run->input.images.push_back(unreadable);
   ReportImage empty;
   empty.file = (image_dir / "b_wall.png").string();
-  empty.outcome = "no corners";
+  empty.outcome = ImageOutcome::kNoCorners;
   empty.corners_detected = 3;
   run->input.images.push_back(empty);
   for (size_t v = 0; v < run->data.views.size(); ++v) {
@@ -117,7 +117,8 @@ void MakeRun(const testing::SyntheticScene& scene, const fs::path& image_dir,
     }
     ReportImage image;
     image.file = file;
-    image.outcome = "used";
+    image.outcome = ImageOutcome::kUsable;
+    image.use = ViewUse::kUsed;
     image.corners_detected =
         static_cast<int>(run->data.views[v].image_points.size());
     image.view_index = static_cast<int>(v);
@@ -302,8 +303,10 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   EXPECT_NE(markdown.find(rms), std::string::npos) << rms;
   for (size_t i = 0; i < run.input.images.size(); ++i) {
     const ReportImage& image = run.input.images[i];
+    const std::string outcome =
+        i == 0 ? "unreadable" : (i == 1 ? "no corners" : "used");
     const std::string line = "| " + std::to_string(i + 1) + " | " + image.file +
-                             " | " + image.outcome + " | " +
+                             " | " + outcome + " | " +
                              std::to_string(image.corners_detected) + " | ";
     EXPECT_NE(markdown.find(line), std::string::npos) << line;
   }
@@ -486,6 +489,44 @@ TEST(ReportTest, RefusesBadInputWithAMessage) {
       << error;
   EXPECT_TRUE(fs::exists(dir / "empty" / "summary.md"));
   RemoveUnlessKept(dir);
+}
+
+// One record per image: what the pipeline and then the calibration made of
+// it, as the report's table shows it.
+TEST(ReportTest, ImageRecordsSayWhatTheCalibrationMadeOfEachView) {
+  std::vector<ImageResult> images(3);
+  images[0].file = "a.png";
+  images[0].outcome = ImageOutcome::kNoGrid;
+  images[0].reason = "no lattice";
+  images[1].file = "b.png";
+  images[1].outcome = ImageOutcome::kUsable;
+  images[1].view_index = 0;
+  images[1].corners.resize(7);
+  images[2].file = "c.png";
+  images[2].outcome = ImageOutcome::kUsable;
+  images[2].view_index = 1;
+  CalibrationResult result;
+  result.view_used = {true, false};
+  result.view_reason = {"", "too few inliers"};
+  result.inlier = {{true, false, true, true}, {}};
+
+  const std::vector<ReportImage> lines = MakeReportImages(images, &result);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0].use, ViewUse::kNoView);
+  EXPECT_EQ(lines[0].OutcomeText(), "no consistent grid");
+  EXPECT_EQ(lines[0].reason, "no lattice");
+  EXPECT_EQ(lines[1].use, ViewUse::kUsed);
+  EXPECT_EQ(lines[1].OutcomeText(), "used");
+  EXPECT_EQ(lines[1].corners_used, 3);
+  EXPECT_EQ(lines[1].corners_detected, 7);
+  EXPECT_EQ(lines[2].use, ViewUse::kDropped);
+  EXPECT_EQ(lines[2].OutcomeText(), "not used by the calibration");
+  EXPECT_EQ(lines[2].reason, "too few inliers");
+
+  // A failed calibration: the pipeline's outcomes stand.
+  const std::vector<ReportImage> failed = MakeReportImages(images, nullptr);
+  EXPECT_EQ(failed[1].use, ViewUse::kNoView);
+  EXPECT_EQ(failed[1].OutcomeText(), "usable");
 }
 
 }  // namespace
