@@ -7,8 +7,8 @@
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
 #include "apps/subcommand.h"
-#include "util/atomic_file.h"
 #include "sim/print_board.h"
+#include "util/atomic_file.h"
 
 DEFINE_string(page, "fit",
               "Sheet: a4, a3, letter, or fit (the pattern plus a printable "

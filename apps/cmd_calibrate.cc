@@ -19,6 +19,7 @@
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
+#include "apps/options_io.h"
 #include "apps/subcommand.h"
 #include "calib/calibrate.h"
 #include "calib/camera_yaml.h"
@@ -42,7 +43,8 @@ constexpr char kUsage[] =
     "                    [--format puzzlecal|opencv|ros|kalibr] "
     "[--report DIR] [--threads N]\n"
     "                    [--rostopic TOPIC] [--camera-name NAME] "
-    "[--quiet | --verbose]\n\n"
+    "[--quiet | --verbose]\n"
+    "                    [--options FILE]  (`puzzlecal options` writes one)\n\n"
     "Calibrates a camera from every image in DIR (png, jpg, tif, bmp; 8 or 16 "
     "bit; grey or colour)\nshowing the board of BOARD.yaml. --out is the "
     "camera file to write (a file path in an\nexisting folder; --format "
@@ -243,6 +245,7 @@ struct CalibrateRequest {
   // The format decides the model's free parameters (Kalibr's radtan has no
   // k3), so they are settled here.
   CalibrationOptions calibration_options;
+  RunOptions options;  // --options FILE, or the defaults
   int threads = 1;
   Board board;
   ImageListing listing;
@@ -280,6 +283,12 @@ int ParseRequest(CalibrateRequest* request) {
     return kExitUsage;
   }
   std::string error;
+  if (!FLAGS_options.empty() &&
+      !LoadOptionsFile(FLAGS_options, &request->options, &error)) {
+    std::cerr << "puzzlecal calibrate: " << error << "\n";
+    return kExitBadInput;
+  }
+  request->calibration_options = request->options.calibration;
   if (!CameraFileFormatFromName(FLAGS_format, &request->format)) {
     std::cerr << "puzzlecal calibrate: unknown format '" << FLAGS_format
               << "'; choose one of puzzlecal, opencv, ros, kalibr.\n";
@@ -329,7 +338,8 @@ int DetectAll(const CalibrateRequest& request, CalibrationRun* run) {
   cv::setNumThreads(1);
   Progress progress(request.listing.images.size(), request.verbosity);
   run->images = ProcessImageFiles(
-      request.listing.images, request.board, PipelineOptions(), request.threads,
+      request.listing.images, request.board, request.options.pipeline,
+      request.threads,
       [&](size_t, const ImageResult& result) { progress.Done(result); });
   run->views = MakeCalibrationViews(request.board, &run->images, &run->width,
                                     &run->height);
@@ -358,8 +368,8 @@ int DetectAll(const CalibrateRequest& request, CalibrationRun* run) {
 int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
   std::string error;
   if (!SelectModel(run->views, run->width, run->height,
-                   request->calibration_options, ModelSelectionOptions(),
-                   &run->selection, &error)) {
+                   request->calibration_options,
+                   request->options.model_selection, &run->selection, &error)) {
     std::cerr << run->selection.Table() << "puzzlecal calibrate: " << error
               << "\n";
     return kExitNoResult;
@@ -401,11 +411,11 @@ int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
   if (!run->calibrated && !mismatch.empty()) run->calibration_error = mismatch;
   run->seconds_calibrate = calib_timer.Seconds();
   if (!run->calibrated) return kExitOk;
-  const EvidenceOptions evidence_options;
+  const EvidenceOptions& evidence_options = request.options.evidence;
   run->evidence = ComputeEvidence(
       run->views, run->result, request.calibration_options, evidence_options);
   run->verdict = MakeVerdict(run->result, run->evidence, evidence_options,
-                             VerdictOptions());
+                             request.options.verdict);
   return kExitOk;
 }
 
@@ -533,7 +543,8 @@ PUZZLECAL_REGISTER_SUBCOMMAND(calibrate, "calibrate",
                               "calibrate a camera from a folder of photos",
                               kUsage,
                               {"images", "board", "model", "out", "format",
-                               "report", "threads", "rostopic", "camera_name"},
+                               "report", "threads", "rostopic", "camera_name",
+                               "options"},
                               &RunCalibrate);
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
+#include "apps/options_io.h"
 #include "apps/subcommand.h"
 #include "calib/camera_yaml.h"
 #include "calib/evidence.h"
@@ -35,7 +36,8 @@ constexpr char kUsage[] =
     "puzzlecal calibrate-rig --images DIR --board BOARD.yaml "
     "--model M[,M1,...] --out rig.yaml\n"
     "                        [--format puzzlecal|opencv|ros|kalibr] "
-    "[--report DIR] [--threads N]\n\n"
+    "[--report DIR] [--threads N]\n"
+    "                        [--options FILE]\n\n"
     "Calibrates a rig of cameras. DIR holds one subfolder per camera; sorted "
     "by name, the first\nis the reference camera (the rig frame). The same "
     "file name in different subfolders is the\nsame instant; a camera "
@@ -91,6 +93,7 @@ struct RigRequest {
   std::vector<std::vector<std::string>> format_fixed;
   Board board;
   int threads = 1;
+  RunOptions options;  // --options FILE, or the defaults
 };
 
 // The models of --model (one for all cameras or one per camera).
@@ -146,6 +149,11 @@ int ParseRigRequest(RigRequest* request) {
     return code;
   }
   std::string error;
+  if (!FLAGS_options.empty() &&
+      !LoadOptionsFile(FLAGS_options, &request->options, &error)) {
+    std::cerr << kName << ": " << error << "\n";
+    return kExitBadInput;
+  }
   if (!LoadBoardFile(FLAGS_board, &request->board, &error)) {
     std::cerr << kName << ": " << error << "\n";
     return kExitBadInput;
@@ -218,7 +226,7 @@ int DetectCamera(const RigRequest& request, size_t c,
   input->frames.resize(num_frames);
   frame_files->assign(num_frames, "");
   std::vector<ImageResult> images = ProcessImageFiles(
-      listing.images, request.board, PipelineOptions(), request.threads);
+      listing.images, request.board, request.options.pipeline, request.threads);
   std::vector<CalibrationView> views = MakeCalibrationViews(
       request.board, &images, &input->width, &input->height);
   int usable = 0;
@@ -248,17 +256,18 @@ int DetectCamera(const RigRequest& request, size_t c,
 // calib/verdict.h), the time and what was written.
 void PrintRigOutcome(const std::vector<RigCameraInput>& inputs,
                      const RigCalibrationOptions& options,
+                     const RunOptions& run_options,
                      const RigCalibrationResult& result, int threads,
                      double seconds_images, double seconds_total,
                      const std::vector<std::string>& written) {
   std::cout << RigCalibrationReport(result);
   for (size_t c = 0; c < result.cameras.size(); ++c) {
     const RigCameraResult& cam = result.cameras[c];
-    const EvidenceOptions evidence_options;
+    const EvidenceOptions& evidence_options = run_options.evidence;
     const Evidence evidence = ComputeEvidence(inputs[c].frames, cam.single,
                                               options.camera, evidence_options);
-    const Verdict verdict =
-        MakeVerdict(cam.single, evidence, evidence_options, VerdictOptions());
+    const Verdict verdict = MakeVerdict(cam.single, evidence, evidence_options,
+                                        run_options.verdict);
     std::cout << cam.name << ": " << verdict.Line() << "\n";
   }
   std::cout << "time: " << seconds_total << " s wall clock on " << threads
@@ -293,7 +302,7 @@ int RunCalibrateRig() {
   }
   const double seconds_images = images_timer.Seconds();
 
-  RigCalibrationOptions options;
+  RigCalibrationOptions options = request.options.rig;
   options.camera.num_threads = request.threads;
   RigCalibrationResult result;
   std::string calibration_error, error;
@@ -323,15 +332,16 @@ int RunCalibrateRig() {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
   }
-  PrintRigOutcome(inputs, options, result, request.threads, seconds_images,
-                  run_timer.Seconds(), written);
+  PrintRigOutcome(inputs, options, request.options, result, request.threads,
+                  seconds_images, run_timer.Seconds(), written);
   return kExitOk;
 }
 
 PUZZLECAL_REGISTER_SUBCOMMAND(
     calibrate_rig, "calibrate-rig",
     "calibrate a multi-camera rig from one photo folder per camera", kUsage,
-    {"images", "board", "model", "out", "format", "report", "threads"},
+    {"images", "board", "model", "out", "format", "report", "threads",
+     "options"},
     &RunCalibrateRig);
 
 }  // namespace

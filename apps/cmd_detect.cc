@@ -16,6 +16,7 @@
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
+#include "apps/options_io.h"
 #include "apps/subcommand.h"
 #include "pipeline/image_io.h"
 #include "pipeline/pipeline.h"
@@ -205,6 +206,12 @@ int RunDetect() {
     return kExitUsage;
   }
   std::string error;
+  RunOptions run_options;  // --options FILE, or the defaults
+  if (!FLAGS_options.empty() &&
+      !LoadOptionsFile(FLAGS_options, &run_options, &error)) {
+    std::cerr << "puzzlecal detect: " << error << "\n";
+    return kExitBadInput;
+  }
   const bool have_board = !FLAGS_board.empty();
   Board board;
   if (have_board && !LoadBoardFile(FLAGS_board, &board, &error)) {
@@ -235,7 +242,7 @@ int RunDetect() {
     }
   }
 
-  PipelineOptions options;
+  PipelineOptions options = run_options.pipeline;
   options.run_decode = have_board;
   const int threads =
       FLAGS_threads > 0
@@ -307,7 +314,8 @@ int RunDetect() {
 PUZZLECAL_REGISTER_SUBCOMMAND(
     detect, "detect", "detect, label and decode corners; write detections.yaml",
     "puzzlecal detect --images DIR_OR_FILE [--board BOARD.yaml] --out "
-    "detections.yaml\n                 [--draw DIR] [--threads N]\n\n"
+    "detections.yaml\n                 [--draw DIR] [--threads N] [--options "
+    "FILE]\n\n"
     "Runs corner detection, grid reconstruction and, with --board, decoding "
     "on\nevery image. Writes per image: file, width, height, decoded (true "
     "when the\nids are absolute board ids), reason (why it yielded nothing "
@@ -318,7 +326,7 @@ PUZZLECAL_REGISTER_SUBCOMMAND(
     "readable. --draw writes overlays: a\ncircle per corner in its "
     "component's colour (red: unlabelled), a tick\nalong its first Hessian "
     "eigenvector, lattice edges, and every fifth label.",
-    {"images", "board", "out", "draw", "threads"}, &RunDetect);
+    {"images", "board", "out", "draw", "threads", "options"}, &RunDetect);
 
 }  // namespace
 }  // namespace puzzlecal

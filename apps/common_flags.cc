@@ -25,6 +25,12 @@ DEFINE_string(rostopic, "/cam0/image_raw",
               "Image topic written into the kalibr camchain (cam0/rostopic).");
 DEFINE_string(camera_name, "camera",
               "Camera name written into the ros camera_info file.");
+DEFINE_string(options, "",
+              "YAML options file (write one with `puzzlecal options`): "
+              "detector, grid, decode, calibration, evidence, verdict, "
+              "model_selection and rig settings; a field it leaves out keeps "
+              "its default. --threads and --format (its fixed parameters) "
+              "win over it.");
 DEFINE_bool(quiet, false, "Print only errors and what was written.");
 DEFINE_bool(verbose, false,
             "Print every image's outcome and the timings as well.");

@@ -17,6 +17,7 @@ DECLARE_int32(threads);
 DECLARE_int32(dpi);
 DECLARE_string(rostopic);
 DECLARE_string(camera_name);
+DECLARE_string(options);
 
 DECLARE_bool(quiet);
 DECLARE_bool(verbose);

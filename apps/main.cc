@@ -30,9 +30,15 @@ void PrintProgramHelp() {
   std::cout << "puzzlecal: camera calibration from photos of a PuzzleBoard or "
                "checkerboard.\n\nUsage: puzzlecal SUBCOMMAND [--flags]\n\n"
                "Subcommands:\n";
+  // The summaries start in one column, after the longest name.
+  size_t width = 0;
   for (const Subcommand& s : SortedSubcommands()) {
-    std::cout << "  " << s.name << std::string(12 - std::strlen(s.name), ' ')
-              << s.summary << "\n";
+    width = std::max(width, std::strlen(s.name));
+  }
+  for (const Subcommand& s : SortedSubcommands()) {
+    std::cout << "  " << s.name
+              << std::string(width + 2 - std::strlen(s.name), ' ') << s.summary
+              << "\n";
   }
   std::cout << "\n`puzzlecal help SUBCOMMAND` (or `puzzlecal SUBCOMMAND "
                "--help`) explains one subcommand;\n`puzzlecal --version` "

@@ -33,8 +33,8 @@ const std::vector<Subcommand>& Subcommands();
 
 }  // namespace puzzlecal
 
-#define PUZZLECAL_REGISTER_SUBCOMMAND(var, ...)                  \
-  static const bool puzzlecal_registered_##var =                 \
+#define PUZZLECAL_REGISTER_SUBCOMMAND(var, ...)  \
+  static const bool puzzlecal_registered_##var = \
       ::puzzlecal::RegisterSubcommand(::puzzlecal::Subcommand{__VA_ARGS__})
 
 #endif  // PUZZLECAL_APPS_SUBCOMMAND_H_

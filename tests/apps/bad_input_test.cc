@@ -886,6 +886,17 @@ TEST_F(BadInputTest, ConsoleVersionHelpAndQuiet) {
   EXPECT_NE(run.out.find("the camera file"), std::string::npos) << run.out;
   EXPECT_EQ(Run("help calibrate").out, Run("calibrate --help").out);
   EXPECT_EQ(Run("help no-such-thing").exit_code, kExitUsage);
+  // The program's own help lists every subcommand, the longest name too.
+  for (const char* arguments : {"--help", "help"}) {
+    run = Run(arguments);
+    EXPECT_EQ(run.exit_code, kExitOk) << arguments << "\n" << run.all();
+    for (const char* name : {"calibrate ", "calibrate-rig ", "detect ",
+                             "options ", "undistort "}) {
+      EXPECT_NE(run.out.find(std::string("  ") + name), std::string::npos)
+          << name << "\n"
+          << run.out;
+    }
+  }
 
   SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);

@@ -4,9 +4,9 @@
 // built beside this test (<build>/apps/puzzlecal).
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

@@ -1,0 +1,610 @@
+#include "apps/options_io.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <climits>
+#include <cstdint>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "calib/yaml_emit.h"
+#include "calib/yaml_fields.h"
+#include "util/enum_names.h"
+
+namespace puzzlecal {
+namespace {
+
+// ---- the fields, once per struct ----
+//
+// Fields<T>::Visit(v, o) calls v.Field("name", o.name) for every
+// user-facing field of T and v.Group("name", o.name) for every nested
+// group, in declaration order; O is T or const T. The reader, the writer
+// and the list of allowed keys all walk these tables, so a field is named
+// once. A field added to a struct and not here is simply not in the file
+// (it keeps its default).
+
+template <typename T>
+struct Fields;
+
+constexpr EnumName<SubpixelMethod> kSubpixelNames[] = {
+    {SubpixelMethod::kNone, "none"},
+    {SubpixelMethod::kCentroid, "centroid"},
+    {SubpixelMethod::kGradientOrthogonality, "gradient-orthogonality"},
+    {SubpixelMethod::kSaddleFit, "saddle-fit"},
+};
+
+// The loss names are calib's own (RobustLossName).
+const EnumName<RobustLoss> kLossNames[] = {
+    {RobustLoss::kNone, RobustLossName(RobustLoss::kNone)},
+    {RobustLoss::kHuber, RobustLossName(RobustLoss::kHuber)},
+    {RobustLoss::kCauchy, RobustLossName(RobustLoss::kCauchy)},
+};
+
+template <>
+struct Fields<DetectorOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("normalize_by_max", o.normalize_by_max);
+    v.Field("blur_sigma_px", o.blur_sigma_px);
+    v.Field("num_levels", o.num_levels);
+    v.Field("first_level", o.first_level);
+    v.Field("trace_weight_k", o.trace_weight_k);
+    v.Field("min_response", o.min_response);
+    v.Field("noise_response_factor", o.noise_response_factor);
+    v.Field("nms_radius_px", o.nms_radius_px);
+    v.Field("nms_radius_coarse_px", o.nms_radius_coarse_px);
+    v.Field("use_corner_mask", o.use_corner_mask);
+    v.Field("use_ring_test", o.use_ring_test);
+    v.Field("ring_radius_px", o.ring_radius_px);
+    v.Field("ring_samples", o.ring_samples);
+    v.Field("min_ring_contrast", o.min_ring_contrast);
+    v.Field("max_ring_asymmetry", o.max_ring_asymmetry);
+    v.Field("max_ring_asymmetry_clean", o.max_ring_asymmetry_clean);
+    v.Field("min_ring_second_harmonic_clean", o.min_ring_second_harmonic_clean);
+    v.Field("min_contrast_factor_clean", o.min_contrast_factor_clean);
+    v.Field("min_ring_second_harmonic", o.min_ring_second_harmonic);
+    v.Field("max_ring_centre_offset", o.max_ring_centre_offset);
+    v.Field("ring_noise_factor", o.ring_noise_factor);
+    v.Field("subpixel", o.subpixel);
+    v.Field("window_fraction_of_neighbor", o.window_fraction_of_neighbor);
+    v.Field("min_window_px", o.min_window_px);
+    v.Field("max_window_px", o.max_window_px);
+    v.Field("saddle_sigma_fraction", o.saddle_sigma_fraction);
+    v.Field("min_saddle_sigma_px", o.min_saddle_sigma_px);
+    v.Field("max_saddle_sigma_px", o.max_saddle_sigma_px);
+    v.Field("saddle_max_iterations", o.saddle_max_iterations);
+    v.Field("saddle_convergence_px", o.saddle_convergence_px);
+    v.Field("max_iterations", o.max_iterations);
+    v.Field("convergence_px", o.convergence_px);
+    v.Field("max_shift_fraction", o.max_shift_fraction);
+    v.Field("merge_distance_px", o.merge_distance_px);
+    v.Field("orientation_spacing_fraction", o.orientation_spacing_fraction);
+  }
+};
+
+template <>
+struct Fields<GridCandidateOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("num_neighbors", o.num_neighbors);
+    v.Field("min_orientation_difference_deg", o.min_orientation_difference_deg);
+    v.Field("min_edge_length_px", o.min_edge_length_px);
+    v.Field("max_abs_coordinate_px", o.max_abs_coordinate_px);
+  }
+};
+
+template <>
+struct Fields<GridEdgeImageOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("intensity_samples", o.intensity_samples);
+    v.Field("intensity_difference_fraction", o.intensity_difference_fraction);
+    v.Field("penalty_factor", o.penalty_factor);
+    v.Field("refuse_penalised_edges", o.refuse_penalised_edges);
+    v.Field("side_offset_fraction", o.side_offset_fraction);
+    v.Field("side_min_contrast", o.side_min_contrast);
+  }
+};
+
+template <>
+struct Fields<GridMergeOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("neighbor_weight_ratio", o.neighbor_weight_ratio);
+    v.Field("tree_mean_weight_ratio_min", o.tree_mean_weight_ratio_min);
+    v.Field("tree_mean_weight_ratio_max", o.tree_mean_weight_ratio_max);
+    v.Field("max_collinearity_sin", o.max_collinearity_sin);
+    v.Field("max_line_spacing_ratio", o.max_line_spacing_ratio);
+    v.Field("max_axis_deviation_deg", o.max_axis_deviation_deg);
+    v.Field("max_axis_deviation_with_image_deg",
+            o.max_axis_deviation_with_image_deg);
+    v.Field("max_adjacency_deviation_with_image_deg",
+            o.max_adjacency_deviation_with_image_deg);
+    v.Field("max_adjacency_length_ratio", o.max_adjacency_length_ratio);
+    v.Field("max_axis_aspect_ratio", o.max_axis_aspect_ratio);
+    v.Field("kruskal_passes", o.kruskal_passes);
+  }
+};
+
+template <>
+struct Fields<GridCleanupOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("check_saddle_pattern", o.check_saddle_pattern);
+    v.Field("saddle_sample_fraction", o.saddle_sample_fraction);
+    v.Field("line_prediction_tolerance", o.line_prediction_tolerance);
+    v.Field("min_component_size", o.min_component_size);
+  }
+};
+
+template <>
+struct Fields<GridAttachOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("rounds", o.rounds);
+    v.Field("tolerance", o.tolerance);
+    v.Field("contradiction_tolerance", o.contradiction_tolerance);
+    v.Field("min_support", o.min_support);
+    v.Field("saddle_sample_fraction", o.saddle_sample_fraction);
+    v.Field("max_join_direction_deviation_deg",
+            o.max_join_direction_deviation_deg);
+    v.Field("max_component_joins", o.max_component_joins);
+  }
+};
+
+template <>
+struct Fields<GridOffLatticeOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("enabled", o.enabled);
+    v.Field("tolerance", o.tolerance);
+    v.Field("agreement", o.agreement);
+    v.Field("min_agreeing", o.min_agreeing);
+    v.Field("max_rounds", o.max_rounds);
+  }
+};
+
+template <>
+struct Fields<DecodeOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Group("bits", o.bits);
+    v.Field("min_corners", o.min_corners);
+    v.Field("max_label_extent", o.max_label_extent);
+    v.Field("max_lattice_deviation", o.max_lattice_deviation);
+    v.Field("min_bits_read", o.min_bits_read);
+    v.Field("min_agreement", o.min_agreement);
+    v.Field("min_margin", o.min_margin);
+    v.Field("min_log10_odds", o.min_log10_odds);
+    v.Field("max_log10_nfa", o.max_log10_nfa);
+    v.Field("refuse_better_off_board", o.refuse_better_off_board);
+    v.Field("drop_corner_min_disagreeing_edges",
+            o.drop_corner_min_disagreeing_edges);
+  }
+};
+
+template <>
+struct Fields<EdgeBitOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("min_confidence", o.min_confidence);
+    v.Field("min_tile_contrast", o.min_tile_contrast);
+    v.Field("disc_sample_offset", o.disc_sample_offset);
+    v.Field("tile_sample_offset", o.tile_sample_offset);
+  }
+};
+
+template <>
+struct Fields<CalibrationOptions> {
+  // Not here: fixed_params (--format decides them) and num_threads
+  // (--threads).
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("fix_focal_length", o.fix_focal_length);
+    v.Field("fix_principal_point", o.fix_principal_point);
+    v.Field("fix_distortion", o.fix_distortion);
+    v.Field("initial_params", o.initial_params);
+    v.Field("loss", o.loss);
+    v.Field("loss_scale_px", o.loss_scale_px);
+    v.Field("outlier_k", o.outlier_k);
+    v.Field("outlier_iterations", o.outlier_iterations);
+    v.Field("min_outlier_threshold_px", o.min_outlier_threshold_px);
+    v.Field("coarse_stride", o.coarse_stride);
+    v.Field("max_iterations", o.max_iterations);
+    v.Field("function_tolerance", o.function_tolerance);
+    v.Field("gradient_tolerance", o.gradient_tolerance);
+    v.Field("parameter_tolerance", o.parameter_tolerance);
+    v.Field("covariance_min_eigenvalue_ratio",
+            o.covariance_min_eigenvalue_ratio);
+    v.Field("deterministic", o.deterministic);
+    v.Field("min_corners_per_view", o.min_corners_per_view);
+    v.Field("min_views", o.min_views);
+    v.Field("min_orientation_spread_deg", o.min_orientation_spread_deg);
+    v.Field("min_coverage", o.min_coverage);
+    v.Field("max_focal_relative_stddev", o.max_focal_relative_stddev);
+    v.Field("coverage_grid", o.coverage_grid);
+    v.Field("max_rms_px", o.max_rms_px);
+    v.Field("staged_distortion", o.staged_distortion);
+    v.Field("compute_covariance", o.compute_covariance);
+    v.Group("initialization", o.initialization);
+  }
+};
+
+template <>
+struct Fields<InitializationOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("reweight_iterations", o.reweight_iterations);
+    v.Field("reweight_k", o.reweight_k);
+    v.Field("focal_search_min_ratio", o.focal_search_min_ratio);
+    v.Field("focal_search_max_ratio", o.focal_search_max_ratio);
+    v.Field("focal_search_steps", o.focal_search_steps);
+    v.Field("focal_search_refine_iterations", o.focal_search_refine_iterations);
+    v.Field("focal_search_reweight_iterations",
+            o.focal_search_reweight_iterations);
+    v.Field("focal_search_truncation_px", o.focal_search_truncation_px);
+    v.Field("focal_search_max_views", o.focal_search_max_views);
+    v.Field("max_focal_aspect", o.max_focal_aspect);
+    v.Field("pose_refine_iterations", o.pose_refine_iterations);
+    v.Field("pose_refine_loss_px", o.pose_refine_loss_px);
+    v.Field("start_refine_iterations", o.start_refine_iterations);
+    v.Field("start_refine_max_views", o.start_refine_max_views);
+    v.Field("start_refine_max_corners_per_view",
+            o.start_refine_max_corners_per_view);
+    v.Field("start_refine_loss_px", o.start_refine_loss_px);
+    v.Field("start_refine_pose_iterations", o.start_refine_pose_iterations);
+  }
+};
+
+template <>
+struct Fields<EvidenceOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("grid_step_px", o.grid_step_px);
+    v.Field("band_width_deg", o.band_width_deg);
+    v.Field("distance_bins", o.distance_bins);
+    v.Field("min_bin_count", o.min_bin_count);
+    v.Field("cross_validation", o.cross_validation);
+    v.Field("report_angles_deg", o.report_angles_deg);
+    v.Field("report_azimuths", o.report_azimuths);
+  }
+};
+
+template <>
+struct Fields<VerdictOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("halves_factor", o.halves_factor);
+    v.Field("halves_floor_px", o.halves_floor_px);
+    v.Field("halves_min_bands", o.halves_min_bands);
+    v.Field("residual_se_factor", o.residual_se_factor);
+    v.Field("residual_floor_px", o.residual_floor_px);
+    v.Field("closeness_rms_ratio", o.closeness_rms_ratio);
+    v.Field("closeness_floor_px", o.closeness_floor_px);
+    v.Field("pinhole_max_field_deg", o.pinhole_max_field_deg);
+    v.Field("max_outlier_fraction", o.max_outlier_fraction);
+    v.Field("view_rms_factor", o.view_rms_factor);
+    v.Field("view_rms_floor_px", o.view_rms_floor_px);
+    v.Field("max_bad_view_fraction", o.max_bad_view_fraction);
+    v.Field("min_views", o.min_views);
+    v.Field("min_coverage", o.min_coverage);
+    v.Field("max_uncertainty_px", o.max_uncertainty_px);
+    v.Field("check_distortion_determined", o.check_distortion_determined);
+    v.Field("min_undetermined_distortion_stddev",
+            o.min_undetermined_distortion_stddev);
+  }
+};
+
+template <>
+struct Fields<ModelSelectionOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("holdout_every", o.holdout_every);
+    v.Field("holdout_offset", o.holdout_offset);
+    v.Field("candidates", o.candidates);
+    v.Field("pinhole_max_field_deg", o.pinhole_max_field_deg);
+    v.Field("min_relative_gain", o.min_relative_gain);
+  }
+};
+
+template <>
+struct Fields<RigCalibrationOptions> {
+  // Not here: camera (the calibration section).
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("min_shared_frames", o.min_shared_frames);
+    v.Field("max_start_rotation_deviation_deg",
+            o.max_start_rotation_deviation_deg);
+  }
+};
+
+template <>
+struct Fields<PipelineOptions> {
+  // Section pipeline: what is left of PipelineOptions besides its groups
+  // (those are sections of their own, see Fields<RunOptions>). Not here:
+  // run_decode (`detect` sets it from --board).
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("min_corners", o.min_corners);
+  }
+};
+
+template <>
+struct Fields<ImageLoadOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("max_pixels", o.max_pixels);
+  }
+};
+
+template <>
+struct Fields<GridOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Group("candidates", o.candidates);
+    v.Group("image_tests", o.image_tests);
+    v.Group("merge", o.merge);
+    v.Group("cleanup", o.cleanup);
+    v.Group("attach", o.attach);
+    v.Group("off_lattice", o.off_lattice);
+  }
+};
+
+// The file's top-level sections.
+template <>
+struct Fields<RunOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Group("detector", o.pipeline.detector);
+    v.Group("grid", o.pipeline.grid);
+    v.Group("decode", o.pipeline.decode);
+    v.Group("load", o.pipeline.load);
+    v.Group("pipeline", o.pipeline);
+    v.Group("calibration", o.calibration);
+    v.Group("evidence", o.evidence);
+    v.Group("verdict", o.verdict);
+    v.Group("model_selection", o.model_selection);
+    v.Group("rig", o.rig);
+  }
+};
+
+// ---- allowed keys ----
+
+class KeyVisitor {
+ public:
+  template <typename X>
+  void Field(const char* key, const X&) {
+    keys.insert(key);
+  }
+  template <typename X>
+  void Group(const char* key, const X&) {
+    keys.insert(key);
+  }
+  std::set<std::string> keys;
+};
+
+template <typename T>
+std::set<std::string> KeysOf() {
+  static const T defaults{};
+  KeyVisitor visitor;
+  Fields<T>::Visit(visitor, defaults);
+  return visitor.keys;
+}
+
+// ---- reading ----
+
+// Reads the fields of one map (at `path`) into a struct; the first failure
+// is kept by the FieldReader and ends the reading.
+class ReadVisitor {
+ public:
+  ReadVisitor(FieldReader* reader, const YAML::Node& map, std::string path)
+      : reader_(reader), map_(map), path_(std::move(path)) {}
+
+  void Field(const char* key, int& x) {
+    if (reader_->ok()) reader_->Int(map_, path_, key, kOptional, &x);
+  }
+  void Field(const char* key, double& x) {
+    if (reader_->ok()) reader_->Double(map_, path_, key, kOptional, &x);
+  }
+  void Field(const char* key, bool& x) {
+    if (reader_->ok()) reader_->Bool(map_, path_, key, kOptional, &x);
+  }
+  void Field(const char* key, long long& x) {
+    uint64_t value = 0;
+    if (!reader_->ok() || !map_[key] ||
+        !reader_->Uint64(map_, path_, key, kOptional, &value)) {
+      return;
+    }
+    if (value > static_cast<uint64_t>(LLONG_MAX)) {
+      reader_->Fail(FieldReader::Join(path_, key), "is too large");
+      return;
+    }
+    x = static_cast<long long>(value);
+  }
+  void Field(const char* key, std::vector<double>& x) {
+    if (reader_->ok()) reader_->Doubles(map_, path_, key, kOptional, -1, &x);
+  }
+  void Field(const char* key, std::vector<std::string>& x);
+  void Field(const char* key, SubpixelMethod& x) {
+    Enum(key, kSubpixelNames, &x);
+  }
+  void Field(const char* key, RobustLoss& x) { Enum(key, kLossNames, &x); }
+
+  template <typename T>
+  void Group(const char* key, T& group);
+
+ private:
+  static constexpr Presence kOptional = Presence::kOptional;
+
+  template <typename E, size_t N>
+  void Enum(const char* key, const EnumName<E> (&names)[N], E* x) {
+    std::string name;
+    if (!reader_->ok() || !map_[key] ||
+        !reader_->String(map_, path_, key, kOptional, &name)) {
+      return;
+    }
+    if (!ValueOf(names, name, x)) {
+      reader_->Fail(
+          FieldReader::Join(path_, key),
+          "must be one of " + JoinedNames(names) + ", got '" + name + "'");
+    }
+  }
+
+  FieldReader* reader_;
+  const YAML::Node map_;
+  const std::string path_;
+};
+
+// A list of names (model names).
+void ReadVisitor::Field(const char* key, std::vector<std::string>& x) {
+  YAML::Node list;
+  if (!reader_->ok() || !reader_->List(map_, path_, key, kOptional, &list) ||
+      !list) {
+    return;
+  }
+  const std::string field = FieldReader::Join(path_, key);
+  std::vector<std::string> names;
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (!list[i].IsScalar()) {
+      reader_->Fail(FieldReader::Index(field, i), "must be a name");
+      return;
+    }
+    names.push_back(list[i].Scalar());
+  }
+  x = names;
+}
+
+// The map `node` at `path` into `group`: only T's keys; a missing or empty
+// (null) map leaves the group as it was.
+template <typename T>
+bool ReadGroup(FieldReader* reader, const YAML::Node& node,
+               const std::string& path, T* group) {
+  if (!node || node.IsNull()) return true;
+  if (!reader->OnlyKeys(node, path, KeysOf<T>())) return false;
+  ReadVisitor visitor(reader, node, path);
+  Fields<T>::Visit(visitor, *group);
+  return reader->ok();
+}
+
+template <typename T>
+void ReadVisitor::Group(const char* key, T& group) {
+  YAML::Node child;
+  if (!reader_->ok() || !reader_->Child(map_, path_, key, kOptional, &child)) {
+    return;
+  }
+  ReadGroup(reader_, child, FieldReader::Join(path_, key), &group);
+}
+
+// ---- checking ----
+
+// Every group's Check(), in the file's order; false with "section 'NAME':
+// WHY".
+bool CheckSections(const RunOptions& o, std::string* why) {
+  std::string inner;
+  const auto failed = [&](const char* section) {
+    *why = std::string("section '") + section + "': " + inner;
+    return false;
+  };
+  if (!o.pipeline.detector.Check(&inner)) return failed("detector");
+  if (!o.pipeline.grid.Check(&inner)) return failed("grid");
+  if (!o.pipeline.decode.Check(&inner)) return failed("decode");
+  if (!o.pipeline.load.Check(&inner)) return failed("load");
+  if (!o.pipeline.Check(&inner)) return failed("pipeline");
+  if (!o.calibration.Check(&inner)) return failed("calibration");
+  if (!o.evidence.Check(&inner)) return failed("evidence");
+  if (!o.verdict.Check(&inner)) return failed("verdict");
+  if (!o.model_selection.Check(&inner)) return failed("model_selection");
+  if (!o.rig.Check(&inner)) return failed("rig");
+  return true;
+}
+
+// ---- writing ----
+
+// Writes every field as `key: value` into the open map of `out`; numbers
+// with the fewest digits that read back exactly.
+class WriteVisitor {
+ public:
+  explicit WriteVisitor(YAML::Emitter* out) : out_(*out) {}
+
+  void Field(const char* key, const int& x) { Key(key) << x; }
+  void Field(const char* key, const long long& x) { Key(key) << x; }
+  void Field(const char* key, const bool& x) { Key(key) << x; }
+  void Field(const char* key, const double& x) { EmitExact(Key(key), x); }
+  void Field(const char* key, const std::vector<double>& x) {
+    EmitExactFlow(Key(key), x);
+  }
+  void Field(const char* key, const std::vector<std::string>& x) {
+    Key(key) << YAML::Flow << YAML::BeginSeq;
+    for (const std::string& name : x) out_ << name;
+    out_ << YAML::EndSeq;
+  }
+  void Field(const char* key, const SubpixelMethod& x) {
+    Key(key) << NameOf(kSubpixelNames, x);
+  }
+  void Field(const char* key, const RobustLoss& x) {
+    Key(key) << NameOf(kLossNames, x);
+  }
+
+  template <typename T>
+  void Group(const char* key, const T& group) {
+    Key(key) << YAML::BeginMap;
+    Fields<T>::Visit(*this, group);
+    out_ << YAML::EndMap;
+  }
+
+ private:
+  YAML::Emitter& Key(const char* key) {
+    return out_ << YAML::Key << key << YAML::Value;
+  }
+
+  YAML::Emitter& out_;
+};
+
+constexpr char kHeader[] =
+    "# puzzlecal options (read with --options FILE by calibrate, detect and\n"
+    "# calibrate-rig). Every field with its value; delete the ones you keep\n"
+    "# at their defaults. Meaning and range of each field: detector\n"
+    "# detection/detector.h (DetectorOptions), grid grid/grid.h "
+    "(GridOptions),\n"
+    "# decode decode/decoder.h and decode/edge_bits.h (DecodeOptions,\n"
+    "# EdgeBitOptions), load apps/image_io.h (ImageLoadOptions), pipeline\n"
+    "# apps/pipeline.h (PipelineOptions), calibration calib/calibrate.h and\n"
+    "# calib/initialization.h, evidence calib/evidence.h, verdict\n"
+    "# calib/verdict.h, model_selection calib/model_selection.h, rig\n"
+    "# calib/rig_calibration.h (its camera options are the calibration\n"
+    "# section). --threads and --format's fixed parameters are flags only.\n";
+
+}  // namespace
+
+bool LoadOptionsFile(const std::string& path, RunOptions* options,
+                     std::string* error) {
+  std::string text;
+  YAML::Node root;
+  if (!ReadTextFile(path, &text, error) ||
+      !ParseYaml(text, path, &root, error)) {
+    return false;
+  }
+  RunOptions read = *options;
+  FieldReader reader(path, error);
+  if (!ReadGroup(&reader, root, "", &read)) return false;
+  read.rig.camera = read.calibration;
+  std::string why;
+  if (!CheckSections(read, &why)) {
+    *error = path + ": " + why;
+    return false;
+  }
+  *options = read;
+  return true;
+}
+
+std::string OptionsYaml(const RunOptions& options) {
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  WriteVisitor visitor(&out);
+  Fields<RunOptions>::Visit(visitor, options);
+  out << YAML::EndMap;
+  return kHeader + std::string(out.c_str()) + "\n";
+}
+
+}  // namespace puzzlecal

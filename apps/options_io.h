@@ -1,0 +1,64 @@
+#ifndef PUZZLECAL_APPS_OPTIONS_IO_H_
+#define PUZZLECAL_APPS_OPTIONS_IO_H_
+
+// Every algorithmic option of a run, in one place, and the YAML options file
+// that sets them (`puzzlecal options` writes one with the defaults;
+// `--options FILE` reads one). The file's top-level sections are the
+// groups below and its keys the C++ field names, a nested group being a
+// nested map:
+//
+//   grid:
+//     merge:
+//       neighbor_weight_ratio: 2.9
+//   calibration:
+//     outlier_k: 4
+//     initialization:
+//       focal_search_steps: 40
+//
+// A field the file leaves out keeps its default. The meaning and range of
+// each field is documented at its options struct (named below).
+
+#include <string>
+
+#include "calib/calibrate.h"
+#include "calib/evidence.h"
+#include "calib/model_selection.h"
+#include "calib/rig_calibration.h"
+#include "calib/verdict.h"
+#include "pipeline/pipeline.h"
+
+namespace puzzlecal {
+
+struct RunOptions {
+  // Sections detector (DetectorOptions), grid (GridOptions), decode
+  // (DecodeOptions), load (ImageLoadOptions) and pipeline (min_corners).
+  // run_decode is not in the file: `detect` sets it from --board.
+  PipelineOptions pipeline;
+  // Section calibration (CalibrationOptions, with initialization). Not in
+  // the file: fixed_params (set from --format) and num_threads (from
+  // --threads).
+  CalibrationOptions calibration;
+  EvidenceOptions evidence;               // section evidence
+  VerdictOptions verdict;                 // section verdict
+  ModelSelectionOptions model_selection;  // section model_selection
+  // Section rig: min_shared_frames, max_start_rotation_deviation_deg. Its
+  // `camera` options are the calibration section (LoadOptionsFile copies
+  // them).
+  RigCalibrationOptions rig;
+};
+
+// Reads the options file at `path` over `options` (fields it leaves out
+// keep their values), then runs every group's Check(). False with a message
+// naming the file and the field ("FILE: field 'grid.merge.kruskal_passes':
+// must be an integer, got 'two'"; unknown fields list the allowed names) or
+// the section whose Check() failed ("FILE: section 'detector': ...").
+bool LoadOptionsFile(const std::string& path, RunOptions* options,
+                     std::string* error);
+
+// Every field of `options` with its value, as an options file (what
+// LoadOptionsFile reads back to the same options).
+std::string OptionsYaml(const RunOptions& options);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_APPS_OPTIONS_IO_H_
