@@ -2,6 +2,7 @@
 
 #include <ceres/jet.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -431,6 +432,53 @@ ProjectionUncertainty ComputeProjectionUncertainty(
   return out;
 }
 
+namespace {
+
+// The Mahalanobis distance of the difference of two calibrations' free
+// intrinsics under the sum of their covariances, and the number of free
+// intrinsics (0 and 0 when the sum is singular).
+void IntrinsicsChiSquare(const CalibrationResult& a, const CalibrationResult& b,
+                         double* chi2, int* dof) {
+  *chi2 = 0;
+  *dof = 0;
+  std::vector<int> free;
+  for (size_t k = 0; k < a.camera.params.size(); ++k) {
+    const bool fixed_a = k < a.param_fixed.size() && a.param_fixed[k];
+    const bool fixed_b = k < b.param_fixed.size() && b.param_fixed[k];
+    if (!fixed_a && !fixed_b) free.push_back(static_cast<int>(k));
+  }
+  const int n = static_cast<int>(free.size());
+  const Eigen::Index num_params =
+      static_cast<Eigen::Index>(a.camera.params.size());
+  if (n == 0 || a.covariance.rows() < num_params ||
+      b.covariance.rows() < num_params) {
+    return;
+  }
+  Eigen::VectorXd d(n);
+  Eigen::MatrixXd sum(n, n);
+  for (int i = 0; i < n; ++i) {
+    d(i) = a.camera.params[free[i]] - b.camera.params[free[i]];
+    for (int j = 0; j < n; ++j) {
+      sum(i, j) =
+          a.covariance(free[i], free[j]) + b.covariance(free[i], free[j]);
+    }
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(sum);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return;
+  const double value = d.dot(ldlt.solve(d));
+  if (!std::isfinite(value)) return;
+  *chi2 = value;
+  *dof = n;
+}
+
+}  // namespace
+
+double ChiSquareZ(double chi2, int dof) {
+  if (dof < 1 || !(chi2 >= 0)) return 0;
+  const double v = 2.0 / (9.0 * dof);
+  return (std::cbrt(chi2 / dof) - (1.0 - v)) / std::sqrt(v);
+}
+
 CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
                               const CalibrationResult& result,
                               const CalibrationOptions& calibration,
@@ -465,6 +513,8 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
   out.camera_b = halves[1].camera;
   out.rms_a_px = halves[0].rms_px;
   out.rms_b_px = halves[1].rms_px;
+  IntrinsicsChiSquare(halves[0], halves[1], &out.intrinsics_chi2,
+                      &out.intrinsics_dof);
 
   // The two halves' camera frames are each tied to their own board poses
   // only: rotating a camera frame together with all of its poses changes no
@@ -622,6 +672,13 @@ std::string EvidenceText(const Evidence& evidence) {
                      d.median, d.p95)
            << Printf("   %8.3f   %8.3f px", e.median, e.p95)
            << "  n=" << d.count << "\n";
+    }
+    if (cv.intrinsics_dof > 0) {
+      text << Printf(
+          "  intrinsics as a whole: chi-square %.1f for %.0f free "
+          "parameters (z = %.1f)\n",
+          cv.intrinsics_chi2, cv.intrinsics_dof,
+          ChiSquareZ(cv.intrinsics_chi2, cv.intrinsics_dof));
     }
   } else {
     text << "cross-validation: " << cv.error << "\n";

@@ -99,8 +99,23 @@ struct CrossValidation {
   PixelMap expected_px;
   std::vector<AngleBand> difference_bands;
   std::vector<AngleBand> expected_bands;
+  // The halves' free intrinsics as a whole: the Mahalanobis distance
+  // d' (C_A + C_B)^-1 d of their difference d under the sum of their
+  // covariances, chi-square distributed with intrinsics_dof degrees of
+  // freedom when the two differ by noise alone. A band median above
+  // (difference_bands) can come from one parameter that is poorly
+  // determined everywhere in the band (every pixel of a band shares the one
+  // draw of the parameters); this figure says whether the difference is
+  // larger than the covariances allow at all.
+  double intrinsics_chi2 = 0;
+  int intrinsics_dof = 0;
   double seconds = 0;  // the two calibrations and the comparison
 };
+
+// The standard normal quantile of a chi-square value with `dof` degrees of
+// freedom (Wilson-Hilferty: (x/k)^(1/3) is nearly normal with mean
+// 1 - 2/(9k) and variance 2/(9k)); 0 for dof < 1.
+double ChiSquareZ(double chi2, int dof);
 
 // One field angle at which the uncertainty is reported.
 struct UncertaintyPoint {

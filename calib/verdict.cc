@@ -104,9 +104,18 @@ void AddHalvesFindings(const CrossValidation& cv, double halves_scale,
       }
     }
   }
-  if (!halves_text.empty()) {
-    findings->push_back({VerdictKind::kModelError, halves_text});
+  if (halves_text.empty()) return;
+  if (cv.intrinsics_dof > 0) {
+    const double z = ChiSquareZ(
+        cv.intrinsics_chi2 / (halves_scale * halves_scale), cv.intrinsics_dof);
+    if (options.halves_min_z > 0 && z <= options.halves_min_z) return;
+    halves_text += Printf(
+        "; their intrinsics differ with chi-square %.1f for %.0f parameters "
+        "(z = %.1f)",
+        cv.intrinsics_chi2 / (halves_scale * halves_scale), cv.intrinsics_dof,
+        z);
   }
+  findings->push_back({VerdictKind::kModelError, halves_text});
 }
 
 // Model error: binned residual means far from zero (by field angle, by
@@ -413,6 +422,9 @@ bool VerdictOptions::Check(std::string* why) const {
   if (!(halves_factor > 0)) return Fail("halves_factor must be > 0", why);
   if (!(halves_floor_px >= 0)) return Fail("halves_floor_px must be >= 0", why);
   if (halves_min_bands < 0) return Fail("halves_min_bands must be >= 0", why);
+  if (!std::isfinite(halves_min_z)) {
+    return Fail("halves_min_z must be finite", why);
+  }
   if (!(residual_se_factor > 0)) {
     return Fail("residual_se_factor must be > 0", why);
   }

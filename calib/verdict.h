@@ -50,6 +50,16 @@ struct VerdictOptions {
   // exceeds 1, and the halves_factor test applies to the scaled
   // prediction. 0 turns the scaling off. Default 3.
   int halves_min_bands = 3;
+  // A band's excess is judged a model error only when the halves' free
+  // intrinsics as a whole also differ by more than their covariances allow:
+  // the chi-square of their difference (CrossValidation::intrinsics_chi2),
+  // divided by the square of the prediction's scale above, as a standard
+  // normal quantile (ChiSquareZ) above halves_min_z. One poorly determined
+  // parameter can lift the medians of the bands where it dominates (every
+  // pixel of a band shares the one draw of the parameters) without the
+  // parameters differing significantly. Default 3.1 (a false alarm about
+  // once in a thousand runs); 0 or less turns the test off.
+  double halves_min_z = 3.1;
   // A residual bin (min_bin_count corners or more) is systematic when its
   // mean radial or tangential component is more than residual_se_factor
   // standard errors and more than residual_floor_px from zero. The standard

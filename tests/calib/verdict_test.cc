@@ -174,12 +174,12 @@ TEST(Verdict, CentralModelOnNoncentralLensNamesNoncentral) {
       << judged.verdict.reason << "\n"
       << EvidenceText(judged.evidence);
 
-  // The non-central model on the same corners: the pupil shift recovered
-  // and no systematic residuals. (Its halves are not judged here: on these
+  // The non-central model on the same corners: the pupil shift recovered,
+  // no systematic residuals and no disagreement of the halves. (On these
   // 20 + 20 views their e2 differ by 2.3 of their sigmas, which at 80-85
   // degrees, where that one direction dominates, is 2.7 times the predicted
-  // difference; every pixel of a band shares the one parameter draw, so a
-  // band median does not average it out.)
+  // band median: every pixel of a band shares the one parameter draw. The
+  // intrinsics as a whole differ as noise does, so it is no model error.)
   const Judged noncentral =
       Judge(data.views, CameraModelId::kKannalaBrandtNoncentral, truth.width,
             truth.height);
@@ -204,7 +204,12 @@ TEST(Verdict, CentralModelOnNoncentralLensNamesNoncentral) {
   for (const std::string& finding : noncentral.verdict.findings) {
     EXPECT_EQ(finding.find("systematic"), std::string::npos) << finding;
     EXPECT_EQ(finding.find("closer"), std::string::npos) << finding;
+    EXPECT_EQ(finding.find("halves"), std::string::npos)
+        << finding << "\n"
+        << EvidenceText(noncentral.evidence);
   }
+  EXPECT_NE(noncentral.verdict.kind, VerdictKind::kModelError)
+      << noncentral.verdict.Line();
 
   // The same poses through the central lens: good.
   SyntheticScene central = scene;
@@ -216,8 +221,11 @@ TEST(Verdict, CentralModelOnNoncentralLensNamesNoncentral) {
 }
 
 // Cross-validation facts made by hand: bands of 100 samples at 10-degree
-// steps whose difference is `ratio[b]` times the prediction of 0.05 px.
-Judged HandMadeHalves(const std::vector<double>& ratio) {
+// steps whose difference is `ratio[b]` times the prediction of 0.05 px, and
+// intrinsics whose chi-square is `chi2` for `dof` free parameters (dof 0:
+// not judged).
+Judged HandMadeHalves(const std::vector<double>& ratio, double chi2 = 0,
+                      int dof = 0) {
   const Camera truth = testing::TruthFisheye190();
   const SyntheticData data = MakeSyntheticData(Scene(truth, 24, 3));
   Judged judged = Judge(data.views, truth.model, truth.width, truth.height);
@@ -225,6 +233,8 @@ Judged HandMadeHalves(const std::vector<double>& ratio) {
   cv.ok = true;
   cv.difference_bands.clear();
   cv.expected_bands.clear();
+  cv.intrinsics_chi2 = chi2;
+  cv.intrinsics_dof = dof;
   for (size_t b = 0; b < ratio.size(); ++b) {
     AngleBand e;
     e.lo_deg = 10.0 * b;
@@ -261,6 +271,33 @@ TEST(Verdict, HalvesJudgedAgainstTheirBestAgreeingBand) {
   VerdictOptions options;
   options.halves_min_bands = -1;
   EXPECT_FALSE(options.Check());
+}
+
+// A band excess is a model error only when the intrinsics as a whole differ
+// more than their covariances allow.
+TEST(Verdict, HalvesBandExcessNeedsSignificantIntrinsics) {
+  // Chi-square quantiles: the median of 10 degrees of freedom (9.34) is
+  // about z = 0, the 0.999 quantile (29.59) z = 3.09.
+  EXPECT_NEAR(ChiSquareZ(9.34, 10), 0.0, 0.05);
+  EXPECT_NEAR(ChiSquareZ(29.59, 10), 3.09, 0.05);
+  EXPECT_NEAR(ChiSquareZ(6.63, 1), 2.33, 0.1);
+  EXPECT_EQ(ChiSquareZ(5, 0), 0);
+  const Judged noise = HandMadeHalves({1, 1, 1, 2, 4}, 9.0, 10);
+  for (const std::string& finding : noise.verdict.findings) {
+    EXPECT_EQ(finding.find("halves"), std::string::npos) << finding;
+  }
+  const Judged real = HandMadeHalves({1, 1, 1, 2, 4}, 200.0, 10);
+  EXPECT_EQ(real.verdict.kind, VerdictKind::kModelError) << real.verdict.Line();
+  EXPECT_NE(real.verdict.reason.find("chi-square 200.0 for 10 parameters"),
+            std::string::npos)
+      << real.verdict.reason;
+  VerdictOptions off;
+  off.halves_min_z = 0;
+  const Judged gate_off = HandMadeHalves({1, 1, 1, 2, 4}, 9.0, 10);
+  EXPECT_EQ(
+      MakeVerdict(gate_off.result, gate_off.evidence, EvidenceOptions(), off)
+          .kind,
+      VerdictKind::kModelError);
 }
 
 // Four views: the halves cannot be calibrated alone and the views are few.
