@@ -479,91 +479,99 @@ double ChiSquareZ(double chi2, int dof) {
   return (std::cbrt(chi2 / dof) - (1.0 - v)) / std::sqrt(v);
 }
 
-CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
-                              const CalibrationResult& result,
-                              const CalibrationOptions& calibration,
-                              double max_angle_deg,
-                              const EvidenceOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  CrossValidation out;
+namespace {
+
+// The halves' two calibrations, started from the full solution, each with
+// its covariance. False (with out->error) when a half cannot be calibrated
+// or does not determine the model.
+bool CalibrateHalves(const std::vector<CalibrationView>& views,
+                     const CalibrationResult& result,
+                     const CalibrationOptions& calibration,
+                     CrossValidation* out, CalibrationResult halves[2]) {
   const Camera& camera = result.camera;
   CalibrationOptions half_options = calibration;
   half_options.initial_params = camera.params;
   half_options.compute_covariance = true;
-  CalibrationResult halves[2];
   for (int h = 0; h < 2; ++h) {
     const std::vector<CalibrationView> half = Half(views, result, h);
-    (h == 0 ? out.views_a : out.views_b) = static_cast<int>(half.size());
+    (h == 0 ? out->views_a : out->views_b) = static_cast<int>(half.size());
     std::string error;
     if (!Calibrate(half, camera.model, camera.width, camera.height,
                    half_options, &halves[h], &error)) {
-      out.error = std::string("half ") + (h == 0 ? "A" : "B") + " (" +
-                  std::to_string(half.size()) + " views): " + error;
-      out.seconds = SecondsSince(start);
-      return out;
+      out->error = std::string("half ") + (h == 0 ? "A" : "B") + " (" +
+                   std::to_string(half.size()) + " views): " + error;
+      return false;
     }
     if (!halves[h].covariance_ok) {
-      out.error = std::string("half ") + (h == 0 ? "A" : "B") +
-                  ": no covariance (the half does not determine the model)";
-      out.seconds = SecondsSince(start);
-      return out;
+      out->error = std::string("half ") + (h == 0 ? "A" : "B") +
+                   ": no covariance (the half does not determine the model)";
+      return false;
     }
   }
-  out.camera_a = halves[0].camera;
-  out.camera_b = halves[1].camera;
-  out.rms_a_px = halves[0].rms_px;
-  out.rms_b_px = halves[1].rms_px;
-  IntrinsicsChiSquare(halves[0], halves[1], &out.intrinsics_chi2,
-                      &out.intrinsics_dof);
+  return true;
+}
 
-  // The two halves' camera frames are each tied to their own board poses
-  // only: rotating a camera frame together with all of its poses changes no
-  // projection of the boards, and a small such rotation is nearly the same
-  // as a shift of the principal point. Two independent fits therefore differ
-  // by a rotation that is no disagreement about the lens. As mrcal does
-  // (projection_diff), the rotation that best aligns the rays of the two
-  // solutions over the observed field is fitted first (Kabsch: least
-  // squares over the unit rays of the grid pixels) and the difference is
-  // taken after it: pixel -> ray under A -> rotated into B's frame ->
-  // projected by B, against the pixel itself.
-  PixelMap map = EmptyMap(camera, options.grid_step_px);
-  std::vector<Eigen::Vector3d> rays_a(map.values.size()),
-      rays_b(map.values.size());
-  std::vector<bool> valid(map.values.size(), false);
-  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();
+// The rays of both halves at the grid pixels of `map` within the observed
+// field; valid[k] where both unproject and B's pixel Jacobian exists
+// (g[k]: the derivative of B's projection with respect to a small rotation
+// of the ray).
+struct HalvesRays {
+  std::vector<Eigen::Vector3d> a, b;
+  std::vector<Eigen::Matrix<double, 2, 3>> g;
+  std::vector<bool> unprojected;  // both halves unproject the pixel
+  std::vector<bool> valid;        // and B's pixel Jacobian exists
+};
+
+HalvesRays RaysOfHalves(const CrossValidation& out, const PixelMap& map,
+                        const Camera& camera, double max_angle_deg) {
+  HalvesRays rays;
+  rays.a.resize(map.values.size());
+  rays.b.resize(map.values.size());
+  rays.g.resize(map.values.size());
+  rays.unprojected.assign(map.values.size(), false);
+  rays.valid.assign(map.values.size(), false);
   for (int j = 0; j < map.rows; ++j) {
     for (int i = 0; i < map.cols; ++i) {
       const int k = j * map.cols + i;
       const double angle = map.angle_deg[k];
       if (!std::isfinite(angle) || angle > max_angle_deg) continue;
       const Eigen::Vector2d pixel = MapPixel(map, camera, i, j);
-      if (!out.camera_a.Unproject(pixel, &rays_a[k]).converged ||
-          !out.camera_b.Unproject(pixel, &rays_b[k]).converged) {
+      if (!out.camera_a.Unproject(pixel, &rays.a[k]).converged ||
+          !out.camera_b.Unproject(pixel, &rays.b[k]).converged) {
         continue;
       }
-      valid[k] = true;
-      cross += rays_b[k] * rays_a[k].transpose();
+      rays.unprojected[k] = true;
+      Eigen::MatrixXd unused;
+      rays.valid[k] = PixelJacobians(out.camera_b, pixel, &unused, &rays.g[k]);
     }
+  }
+  return rays;
+}
+
+// The two halves' camera frames are each tied to their own board poses
+// only: rotating a camera frame together with all of its poses changes no
+// projection of the boards, and a small such rotation is nearly the same as
+// a shift of the principal point. Two independent fits therefore differ by
+// a rotation that is no disagreement about the lens. As mrcal does
+// (projection_diff), the rotation that best aligns the rays of the two
+// solutions over the observed field is fitted first (Kabsch: least squares
+// over the unit rays of the grid pixels), then refined by a few
+// Gauss-Newton steps on the pixel differences themselves, the measure the
+// expected figures use (RotationGauge).
+Eigen::Matrix3d FitRotationBetweenHalves(const CrossValidation& out,
+                                         const PixelMap& map,
+                                         const Camera& camera,
+                                         const HalvesRays& rays) {
+  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < rays.valid.size(); ++k) {
+    if (rays.unprojected[k]) cross += rays.b[k] * rays.a[k].transpose();
   }
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(
       cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
   d(2, 2) =
       (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
-  out.b_from_a = svd.matrixU() * d * svd.matrixV().transpose();
-  // Then a few Gauss-Newton steps on the pixel differences themselves, the
-  // measure the expected figures below use (RotationGauge).
-  std::vector<Eigen::Matrix<double, 2, 3>> g(map.values.size());
-  for (int j = 0; j < map.rows; ++j) {
-    for (int i = 0; i < map.cols; ++i) {
-      const int k = j * map.cols + i;
-      Eigen::MatrixXd unused;
-      if (valid[k] && !PixelJacobians(out.camera_b, MapPixel(map, camera, i, j),
-                                      &unused, &g[k])) {
-        valid[k] = false;
-      }
-    }
-  }
+  Eigen::Matrix3d b_from_a = svd.matrixU() * d * svd.matrixV().transpose();
   for (int iteration = 0; iteration < 3; ++iteration) {
     Eigen::Matrix3d gtg = Eigen::Matrix3d::Zero();
     Eigen::Vector3d gtr = Eigen::Vector3d::Zero();
@@ -571,39 +579,34 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
       for (int i = 0; i < map.cols; ++i) {
         const int k = j * map.cols + i;
         Eigen::Vector2d projected;
-        if (!valid[k] ||
-            !ProjectDirection(out.camera_b, out.b_from_a * rays_a[k],
-                              &projected)) {
+        if (!rays.valid[k] ||
+            !ProjectDirection(out.camera_b, b_from_a * rays.a[k], &projected)) {
           continue;
         }
-        gtg += g[k].transpose() * g[k];
-        gtr += g[k].transpose() * (projected - MapPixel(map, camera, i, j));
+        gtg += rays.g[k].transpose() * rays.g[k];
+        gtr +=
+            rays.g[k].transpose() * (projected - MapPixel(map, camera, i, j));
       }
     }
     const Eigen::FullPivLU<Eigen::Matrix3d> lu(gtg);
     if (!lu.isInvertible()) break;
     const Eigen::Vector3d omega = -lu.solve(gtr);
     if (!omega.allFinite() || omega.norm() == 0) break;
-    out.b_from_a =
+    b_from_a =
         Eigen::AngleAxisd(omega.norm(), omega.normalized()).toRotationMatrix() *
-        out.b_from_a;
+        b_from_a;
   }
-  out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDeg;
-  for (int j = 0; j < map.rows; ++j) {
-    for (int i = 0; i < map.cols; ++i) {
-      const int k = j * map.cols + i;
-      if (!valid[k]) continue;
-      Eigen::Vector2d projected;
-      if (ProjectDirection(out.camera_b, out.b_from_a * rays_a[k],
-                           &projected)) {
-        map.values[k] = (projected - MapPixel(map, camera, i, j)).norm();
-      }
-    }
-  }
-  out.difference_px = map;
-  // Noise alone: the two halves' projection covariances add.
-  // Each half's covariance with its own rotation gauge removed over the
-  // same field, as the comparison removes the rotation between them.
+  return b_from_a;
+}
+
+// What noise alone would give at each pixel of `difference`: the two
+// halves' projection covariances add, each with its own rotation gauge
+// removed over the same field, as the comparison removes the rotation
+// between them.
+PixelMap ExpectedDifference(const CrossValidation& out,
+                            const CalibrationResult halves[2],
+                            const PixelMap& difference, double max_angle_deg,
+                            const EvidenceOptions& options) {
   const Eigen::MatrixXd gauge_a =
       RotationGauge(out.camera_a, options.grid_step_px, max_angle_deg);
   const Eigen::MatrixXd gauge_b =
@@ -614,13 +617,58 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
   const PixelMap expected_b = CovarianceTraceMap(
       out.camera_b, halves[1].covariance, options.grid_step_px, 1.0,
       gauge_b.size() > 0 ? &gauge_b : nullptr);
-  out.expected_px = map;
-  for (size_t k = 0; k < map.values.size(); ++k) {
-    out.expected_px.values[k] =
-        std::isfinite(map.values[k])
+  PixelMap expected = difference;
+  for (size_t k = 0; k < difference.values.size(); ++k) {
+    expected.values[k] =
+        std::isfinite(difference.values[k])
             ? std::hypot(expected_a.values[k], expected_b.values[k])
             : kNaN;
   }
+  return expected;
+}
+
+}  // namespace
+
+CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
+                              const CalibrationResult& result,
+                              const CalibrationOptions& calibration,
+                              double max_angle_deg,
+                              const EvidenceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CrossValidation out;
+  const Camera& camera = result.camera;
+  CalibrationResult halves[2];
+  if (!CalibrateHalves(views, result, calibration, &out, halves)) {
+    out.seconds = SecondsSince(start);
+    return out;
+  }
+  out.camera_a = halves[0].camera;
+  out.camera_b = halves[1].camera;
+  out.rms_a_px = halves[0].rms_px;
+  out.rms_b_px = halves[1].rms_px;
+  IntrinsicsChiSquare(halves[0], halves[1], &out.intrinsics_chi2,
+                      &out.intrinsics_dof);
+
+  // |project_B(R * unproject_A(pixel)) - pixel| after the rotation between
+  // the halves is taken out.
+  PixelMap map = EmptyMap(camera, options.grid_step_px);
+  const HalvesRays rays = RaysOfHalves(out, map, camera, max_angle_deg);
+  out.b_from_a = FitRotationBetweenHalves(out, map, camera, rays);
+  out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDeg;
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) {
+      const int k = j * map.cols + i;
+      if (!rays.valid[k]) continue;
+      Eigen::Vector2d projected;
+      if (ProjectDirection(out.camera_b, out.b_from_a * rays.a[k],
+                           &projected)) {
+        map.values[k] = (projected - MapPixel(map, camera, i, j)).norm();
+      }
+    }
+  }
+  out.difference_px = map;
+  out.expected_px =
+      ExpectedDifference(out, halves, map, max_angle_deg, options);
   out.difference_bands = SummarizeByAngle(
       out.difference_px, options.band_width_deg, max_angle_deg);
   out.expected_bands =
