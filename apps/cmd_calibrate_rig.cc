@@ -251,29 +251,68 @@ int DetectCamera(const RigRequest& request, size_t c,
   return kExitBadInput;
 }
 
-// The rig's figures, each camera's own calibration judged as `calibrate`
-// judges one camera (halves, uncertainty, binned residuals;
-// calib/verdict.h), the time and what was written.
-void PrintRigOutcome(const std::vector<RigCameraInput>& inputs,
-                     const RigCalibrationOptions& options,
-                     const RunOptions& run_options,
-                     const RigCalibrationResult& result, int threads,
+// Each camera's own calibration judged as `calibrate` judges one camera
+// (halves, uncertainty, binned residuals; calib/evidence.h,
+// calib/verdict.h), once, for the report and the output alike.
+struct CameraJudgements {
+  std::vector<Evidence> evidence;  // one per camera
+  std::vector<Verdict> verdicts;
+};
+
+CameraJudgements JudgeCameras(const std::vector<RigCameraInput>& inputs,
+                              const RigCalibrationOptions& options,
+                              const RunOptions& run_options,
+                              const RigCalibrationResult& result) {
+  CameraJudgements judged;
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    const RigCameraResult& cam = result.cameras[c];
+    judged.evidence.push_back(ComputeEvidence(
+        inputs[c].frames, cam.single, options.camera, run_options.evidence));
+    judged.verdicts.push_back(MakeVerdict(cam.single, judged.evidence.back(),
+                                          run_options.evidence,
+                                          run_options.verdict));
+  }
+  return judged;
+}
+
+// The rig's figures, each camera's verdict line (the one in the report),
+// the time and what was written.
+void PrintRigOutcome(const RigCalibrationResult& result,
+                     const CameraJudgements& judged, int threads,
                      double seconds_images, double seconds_total,
                      const std::vector<std::string>& written) {
   std::cout << RigCalibrationReport(result);
   for (size_t c = 0; c < result.cameras.size(); ++c) {
-    const RigCameraResult& cam = result.cameras[c];
-    const EvidenceOptions& evidence_options = run_options.evidence;
-    const Evidence evidence = ComputeEvidence(inputs[c].frames, cam.single,
-                                              options.camera, evidence_options);
-    const Verdict verdict = MakeVerdict(cam.single, evidence, evidence_options,
-                                        run_options.verdict);
-    std::cout << cam.name << ": " << verdict.Line() << "\n";
+    std::cout << RigVerdictLine(result.cameras[c].name, judged.verdicts[c])
+              << "\n";
   }
   std::cout << "time: " << seconds_total << " s wall clock on " << threads
             << " threads (images " << seconds_images << " s, calibration "
             << result.seconds_single + result.seconds_joint << " s)\n";
   for (const std::string& path : written) std::cout << "wrote " << path << "\n";
+}
+
+// The report (--report DIR) with the judgements when the calibration
+// succeeded.
+bool WriteReport(const RigCalibrationResult& result, bool calibrated,
+                 const std::string& calibration_error,
+                 const CameraJudgements& judged,
+                 const std::vector<std::vector<std::string>>& frame_files,
+                 double seconds_images, double seconds_total, int threads,
+                 std::string* error) {
+  RigReportInput report;
+  report.result = &result;
+  report.calibration_ok = calibrated;
+  report.calibration_error = calibration_error;
+  report.files = frame_files;
+  report.seconds_images = seconds_images;
+  report.seconds_total = seconds_total;
+  report.threads = threads;
+  for (size_t c = 0; c < judged.verdicts.size(); ++c) {
+    report.evidence.push_back(&judged.evidence[c]);
+    report.verdicts.push_back(&judged.verdicts[c]);
+  }
+  return WriteRigReport(FLAGS_report, report, RigReportOptions(), error);
 }
 
 int RunCalibrateRig() {
@@ -308,19 +347,15 @@ int RunCalibrateRig() {
   std::string calibration_error, error;
   const bool calibrated =
       CalibrateRig(inputs, options, &result, &calibration_error);
-  if (!FLAGS_report.empty()) {
-    RigReportInput report;
-    report.result = &result;
-    report.calibration_ok = calibrated;
-    report.calibration_error = calibration_error;
-    report.files = frame_files;
-    report.seconds_images = seconds_images;
-    report.seconds_total = run_timer.Seconds();
-    report.threads = request.threads;
-    if (!WriteRigReport(FLAGS_report, report, RigReportOptions(), &error)) {
-      std::cerr << kName << ": report not written: " << error << "\n";
-      if (calibrated) return kExitOutputError;
-    }
+  const CameraJudgements judged =
+      calibrated ? JudgeCameras(inputs, options, request.options, result)
+                 : CameraJudgements();
+  if (!FLAGS_report.empty() &&
+      !WriteReport(result, calibrated, calibration_error, judged, frame_files,
+                   seconds_images, run_timer.Seconds(), request.threads,
+                   &error)) {
+    std::cerr << kName << ": report not written: " << error << "\n";
+    if (calibrated) return kExitOutputError;
   }
   if (!calibrated) {
     std::cerr << kName << ": no calibration written. " << calibration_error
@@ -332,8 +367,8 @@ int RunCalibrateRig() {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
   }
-  PrintRigOutcome(inputs, options, request.options, result, request.threads,
-                  seconds_images, run_timer.Seconds(), written);
+  PrintRigOutcome(result, judged, request.threads, seconds_images,
+                  run_timer.Seconds(), written);
   return kExitOk;
 }
 

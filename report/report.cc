@@ -12,6 +12,7 @@
 #include "report/overlay.h"
 #include "report/plot.h"
 #include "util/atomic_file.h"
+#include "util/failure.h"
 #include "util/string_format.h"
 
 namespace puzzlecal {
@@ -1081,27 +1082,26 @@ std::string FormatWithSigma(double value, double sigma,
   return StringPrintf("%.8g", value);
 }
 
-namespace {
-
-// The evidence section of summary.md.
-std::string EvidenceMarkdown(const ReportInput& input) {
-  const Evidence& evidence = *input.evidence;
+std::string EvidenceMarkdown(const Evidence& evidence, const Verdict* verdict,
+                             int heading_level) {
+  const std::string heading(std::clamp(heading_level, 1, 5), '#');
+  const std::string sub = heading + "#";
   std::ostringstream md;
-  md << "## Evidence\n\n";
-  if (input.verdict != nullptr) {
-    md << "Verdict **" << VerdictKindName(input.verdict->kind)
-       << "**: " << input.verdict->reason
-       << ". Next step: " << input.verdict->next_step << ".\n\n";
-    if (input.verdict->findings.size() > 1) {
+  md << heading << " Evidence\n\n";
+  if (verdict != nullptr) {
+    md << "Verdict **" << VerdictKindName(verdict->kind)
+       << "**: " << verdict->reason << ". Next step: " << verdict->next_step
+       << ".\n\n";
+    if (verdict->findings.size() > 1) {
       md << "All findings:\n\n";
-      for (const std::string& f : input.verdict->findings) {
+      for (const std::string& f : verdict->findings) {
         md << "- " << f << "\n";
       }
       md << "\n";
     }
   }
   const CrossValidation& cv = evidence.cross_validation;
-  md << "### Cross-validation (two halves of the views)\n\n";
+  md << sub << " Cross-validation (two halves of the views)\n\n";
   if (cv.ok) {
     md << StringPrintf(
         "Views alternately into halves of %d and %d, each calibrated alone "
@@ -1124,7 +1124,7 @@ std::string EvidenceMarkdown(const ReportInput& input) {
   } else {
     md << "Not available: " << Cell(cv.error) << "\n\n";
   }
-  md << "### Projection uncertainty\n\n";
+  md << sub << " Projection uncertainty\n\n";
   const ProjectionUncertainty& u = evidence.uncertainty;
   if (u.ok) {
     md << "1-sigma of the projection of a far point, per image axis "
@@ -1148,8 +1148,8 @@ std::string EvidenceMarkdown(const ReportInput& input) {
   } else {
     md << "Not available (no covariance).\n\n";
   }
-  md << "### Systematic residuals\n\n"
-        "Mean residual (projected minus detected) of the inlier corners, "
+  md << sub << " Systematic residuals\n\n"
+     << "Mean residual (projected minus detected) of the inlier corners, "
         "split into the component away from the principal point (radial) and "
         "across it (tangential), +- its standard error (corners taken as "
         "independent).\n\n";
@@ -1175,7 +1175,24 @@ std::string EvidenceMarkdown(const ReportInput& input) {
   return md.str();
 }
 
-}  // namespace
+std::string EvidenceChartDescription(const std::string& chart) {
+  if (chart == kCrossValidationChart) {
+    return "how far the two halves of the views, calibrated apart, "
+           "disagree on where a far point projects (after the best-fit "
+           "rotation between their camera frames). Compare with the "
+           "expected figures in the evidence section.";
+  }
+  if (chart == kUncertaintyChart) {
+    return "the 1-sigma of the projection of a far point at each pixel, "
+           "from the parameter covariance: how well the views pin the "
+           "model down there (not whether the model suits the lens).";
+  }
+  if (chart == kResidualBinsChart) {
+    return "residual means by field angle and by board distance with "
+           "+- 2 standard errors; means away from zero are model error.";
+  }
+  return "";
+}
 
 std::string ReportMarkdown(const ReportInput& input,
                            const ReportOptions& options,
@@ -1253,7 +1270,9 @@ std::string ReportMarkdown(const ReportInput& input,
   if (!input.model_selection.empty()) {
     md << "## Model selection\n\n```\n" << input.model_selection << "```\n\n";
   }
-  if (input.evidence != nullptr) md << EvidenceMarkdown(input);
+  if (input.evidence != nullptr) {
+    md << EvidenceMarkdown(*input.evidence, input.verdict, 2);
+  }
 
   // Worst views.
   std::vector<int> used;
@@ -1366,18 +1385,9 @@ std::string ReportMarkdown(const ReportInput& input,
                    "more than 90 deg off the axis")
          << ". White lines mark the angle of the ray from the optical "
             "axis.\n";
-    } else if (file == "cross_validation.png") {
-      md << "how far the two halves of the views, calibrated apart, "
-            "disagree on where a far point projects (after the best-fit "
-            "rotation between their camera frames). Compare with the "
-            "expected figures in the evidence section.\n";
-    } else if (file == "uncertainty.png") {
-      md << "the 1-sigma of the projection of a far point at each pixel, "
-            "from the parameter covariance: how well the views pin the "
-            "model down there (not whether the model suits the lens).\n";
-    } else if (file == "residual_bins.png") {
-      md << "residual means by field angle and by board distance with "
-            "+- 2 standard errors; means away from zero are model error.\n";
+    } else if (const std::string about = EvidenceChartDescription(file);
+               !about.empty()) {
+      md << about << "\n";
     } else {
       md << "\n";
     }
@@ -1403,6 +1413,31 @@ std::string ReportMarkdown(const ReportInput& input,
 
 namespace {
 
+// The evidence charts (those of them the evidence holds), named `prefix` +
+// the chart's name, each passed to `write_png` (false: stop). The plots use
+// only the image size of `data`.
+template <typename WritePngFn>
+bool WriteEvidenceChartsWith(const ReportData& data,
+                             const ReportOptions& options,
+                             const Evidence& evidence,
+                             const std::string& prefix,
+                             const WritePngFn& write_png) {
+  if (evidence.cross_validation.ok &&
+      !write_png(
+          prefix + kCrossValidationChart,
+          PlotCrossValidation(data, options, evidence.cross_validation))) {
+    return false;
+  }
+  if (evidence.uncertainty.ok &&
+      !write_png(prefix + kUncertaintyChart,
+                 PlotUncertainty(data, options, evidence.uncertainty,
+                                 evidence.residuals.max_angle_deg))) {
+    return false;
+  }
+  return write_png(prefix + kResidualBinsChart,
+                   PlotResidualBins(data, options, evidence.residuals));
+}
+
 // The charts of the report, each passed to `write_png` (false: stop).
 template <typename WritePngFn>
 bool WriteCharts(const ReportData& data, const ReportOptions& options,
@@ -1423,24 +1458,37 @@ bool WriteCharts(const ReportData& data, const ReportOptions& options,
     return false;
   }
   if (data.input->evidence == nullptr) return true;
-  const Evidence& evidence = *data.input->evidence;
-  if (evidence.cross_validation.ok &&
-      !write_png(
-          "cross_validation.png",
-          PlotCrossValidation(data, options, evidence.cross_validation))) {
-    return false;
-  }
-  if (evidence.uncertainty.ok &&
-      !write_png("uncertainty.png",
-                 PlotUncertainty(data, options, evidence.uncertainty,
-                                 evidence.residuals.max_angle_deg))) {
-    return false;
-  }
-  return write_png("residual_bins.png",
-                   PlotResidualBins(data, options, evidence.residuals));
+  return WriteEvidenceChartsWith(data, options, *data.input->evidence, "",
+                                 write_png);
 }
 
 }  // namespace
+
+bool WriteEvidenceCharts(const std::string& dir, const std::string& prefix,
+                         int width, int height, const Evidence& evidence,
+                         const ReportOptions& options,
+                         std::vector<std::string>* files, std::string* error) {
+  std::string why;
+  if (!options.Check(&why)) return Fail("report options: " + why, error);
+  if (width <= 0 || height <= 0 || width > kMaxImageSide ||
+      height > kMaxImageSide) {
+    return Fail(StringPrintf("evidence charts: the image size %d x %d is not "
+                             "valid",
+                             width, height),
+                error);
+  }
+  if (!plot::ChartsAvailable(&why)) return Fail("no charts: " + why, error);
+  ReportData data;  // the evidence plots need the image size alone
+  data.width = width;
+  data.height = height;
+  const std::filesystem::path folder(dir);
+  auto write_png = [&](const std::string& name, const cv::Mat& image) {
+    if (!WritePng((folder / name).string(), image, error)) return false;
+    if (files != nullptr) files->push_back(name);
+    return true;
+  };
+  return WriteEvidenceChartsWith(data, options, evidence, prefix, write_png);
+}
 
 bool WriteReport(const std::string& dir, const ReportInput& input,
                  const ReportOptions& options, std::string* error,

@@ -106,8 +106,8 @@ struct ReportInput {
   int threads = 0;
   // Evidence on the calibration and its verdict (calib/evidence.h,
   // calib/verdict.h); null when not computed. The verdict heads
-  // summary.md; the evidence adds a section and cross_validation.png,
-  // uncertainty.png and residual_bins.png.
+  // summary.md; the evidence adds a section (EvidenceMarkdown) and its
+  // charts (WriteEvidenceCharts).
   const Evidence* evidence = nullptr;
   const Verdict* verdict = nullptr;
   // The comparison table of `--model auto` ("" when not run).
@@ -135,6 +135,37 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
 std::string ReportMarkdown(const ReportInput& input,
                            const ReportOptions& options,
                            const std::vector<std::string>& png_files);
+
+// The evidence part of a report (calib/evidence.h), shared by the
+// single-camera report and the rig report (one per camera).
+
+// File names of the evidence charts (the rig report puts the camera's name
+// in front).
+inline constexpr char kCrossValidationChart[] = "cross_validation.png";
+inline constexpr char kUncertaintyChart[] = "uncertainty.png";
+inline constexpr char kResidualBinsChart[] = "residual_bins.png";
+
+// The evidence section of a summary: the verdict (null: none) with all its
+// findings, then the cross-validation, projection uncertainty and
+// systematic residual tables. Its heading has `heading_level` '#' (1-5),
+// its subsections one more.
+std::string EvidenceMarkdown(const Evidence& evidence, const Verdict* verdict,
+                             int heading_level);
+
+// How to read an evidence chart (`chart`: one of the names above, without
+// a prefix), one sentence; "" for any other file.
+std::string EvidenceChartDescription(const std::string& chart);
+
+// Writes the evidence charts the evidence holds (the cross-validation and
+// uncertainty maps when computed, the residual bins always) into `dir`,
+// named `prefix` + the chart's name, for images of width x height, and
+// appends the file names to `files` (optional). False with a message on an
+// invalid size, when charts cannot be drawn, or when a file cannot be
+// written.
+bool WriteEvidenceCharts(const std::string& dir, const std::string& prefix,
+                         int width, int height, const Evidence& evidence,
+                         const ReportOptions& options,
+                         std::vector<std::string>* files, std::string* error);
 
 // How far the model's distortion moves `pixel`: the distance in pixels
 // between `pixel` and where its ray (camera.Unproject) lands in the same

@@ -1,6 +1,7 @@
 #include "report/rig_report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <opencv2/imgproc.hpp>
@@ -9,19 +10,187 @@
 
 #include "pipeline/image_io.h"
 #include "report/overlay.h"
+#include "report/plot.h"
 #include "util/atomic_file.h"
 #include "util/failure.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
 
+// The charts written for one camera and, when there are none, why.
+struct CameraCharts {
+  std::vector<std::string> files;
+  std::string missing;
+};
+
+// The frame both first cameras saw with the most corners between them, -1
+// when there is none (or the calibration failed).
+int PairFrame(const RigReportInput& input) {
+  if (!input.calibration_ok || input.result == nullptr ||
+      input.result->cameras.size() < 2 || input.files.size() < 2) {
+    return -1;
+  }
+  const RigCalibrationResult& result = *input.result;
+  int best = -1, best_corners = 0;
+  for (size_t f = 0; f < result.frame_used.size(); ++f) {
+    if (f >= input.files[0].size() || f >= input.files[1].size()) break;
+    if (!result.cameras[0].frame_used[f] || !result.cameras[1].frame_used[f]) {
+      continue;
+    }
+    const int corners = static_cast<int>(result.cameras[0].inlier[f].size() +
+                                         result.cameras[1].inlier[f].size());
+    if (corners > best_corners) {
+      best_corners = corners;
+      best = static_cast<int>(f);
+    }
+  }
+  return best;
+}
+
+bool HasEvidence(const RigReportInput& input) {
+  return input.calibration_ok && input.result != nullptr &&
+         !input.evidence.empty();
+}
+
+// The evidence charts of every camera, drawn by the single-camera report's
+// code. A camera whose charts cannot be drawn (no chart library, an
+// invalid image size) gets the reason instead; a file that cannot be
+// written is an error.
+bool WriteAllCameraCharts(const std::string& dir, const RigReportInput& input,
+                          const RigReportOptions& options,
+                          std::vector<CameraCharts>* charts,
+                          std::string* error) {
+  charts->assign(input.evidence.size(), CameraCharts());
+  std::string why;
+  const bool available = plot::ChartsAvailable(&why);
+  for (size_t c = 0; c < input.evidence.size(); ++c) {
+    const Camera& camera = input.result->cameras[c].camera;
+    if (!available) {
+      (*charts)[c].missing = "no charts: " + why;
+      continue;
+    }
+    if (camera.width <= 0 || camera.height <= 0) {
+      (*charts)[c].missing =
+          StringPrintf("no charts: the image size %d x %d is not valid",
+                       camera.width, camera.height);
+      continue;
+    }
+    if (!WriteEvidenceCharts(dir, RigChartPrefix(input.result->cameras[c].name),
+                             camera.width, camera.height, *input.evidence[c],
+                             options.charts, &(*charts)[c].files, error)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The rig's residuals for the camera beside its own calibration's.
+std::string CameraFiguresTable(const RigCameraResult& cam) {
+  std::ostringstream md;
+  md << "| | rig (joint solve) | own calibration |\n|---|---:|---:|\n";
+  md << StringPrintf(
+      "| RMS reprojection error (px per coordinate) | %.4f | "
+      "%.4f |\n",
+      cam.rms_px, cam.single_rms_px);
+  md << StringPrintf("| corners used | %d | %d |\n", cam.num_corners_used,
+                     cam.single.num_corners_used);
+  md << StringPrintf("| outliers | %d | %d |\n", cam.num_outliers,
+                     cam.single.num_outliers);
+  md << StringPrintf("| frames used (own calibration: views) | %d | %d |\n\n",
+                     cam.num_frames_used, cam.single_views_used);
+  return md.str();
+}
+
+// One camera's section: verdict, figures, evidence and its charts.
+std::string CameraSection(const RigCameraResult& cam, const Evidence* evidence,
+                          const Verdict* verdict, const CameraCharts* charts) {
+  std::ostringstream md;
+  md << "## Camera " << cam.name << "\n\n";
+  md << "Model **" << CameraModelName(cam.camera.model) << "**, image "
+     << cam.camera.width << " x " << cam.camera.height << " px.\n\n";
+  if (verdict != nullptr) {
+    md << "**" << RigVerdictLine(cam.name, *verdict) << "**\n\n";
+  }
+  md << CameraFiguresTable(cam);
+  if (evidence == nullptr) return md.str();
+  md << "Evidence and verdict judge the camera's own calibration, as "
+        "`puzzlecal calibrate` judges one camera.\n\n";
+  md << EvidenceMarkdown(*evidence, verdict, 3);
+  md << "### Charts\n\n";
+  if (charts->files.empty()) {
+    md << (charts->missing.empty() ? std::string("No charts were drawn.")
+                                   : charts->missing)
+       << "\n\n";
+  }
+  const std::string prefix = RigChartPrefix(cam.name);
+  for (const std::string& file : charts->files) {
+    md << "- `" << file
+       << "`: " << EvidenceChartDescription(file.substr(prefix.size()))
+       << "\n\n  ![" << file << "](" << file << ")\n\n";
+  }
+  return md.str();
+}
+
+std::string RigSummary(const RigReportInput& input,
+                       const std::vector<CameraCharts>& charts, bool pair) {
+  std::ostringstream md;
+  md << "# Rig calibration report\n\n";
+  const bool evidence = HasEvidence(input);
+  if (evidence) {
+    for (size_t c = 0; c < input.verdicts.size(); ++c) {
+      md << "- "
+         << RigVerdictLine(input.result->cameras[c].name, *input.verdicts[c])
+         << "\n";
+    }
+    md << "\n";
+  }
+  if (!input.calibration_ok) {
+    md << "> **Calibration failed:** " << input.calibration_error << "\n\n";
+  } else if (input.result != nullptr && !input.result->cameras.empty()) {
+    md << "## Rig\n\n```\n" << RigCalibrationReport(*input.result) << "```\n\n";
+    for (size_t c = 0; c < input.result->cameras.size(); ++c) {
+      md << CameraSection(input.result->cameras[c],
+                          evidence ? input.evidence[c] : nullptr,
+                          evidence ? input.verdicts[c] : nullptr,
+                          evidence ? &charts[c] : nullptr);
+    }
+  }
+  if (pair) {
+    md << "## Rectified pair\n\n`rectified_pair.png`: one frame of the "
+          "first two cameras, rectified side by side with horizontal lines; "
+          "after a good calibration every board corner lies on the same row "
+          "in both halves.\n\n![rectified_pair.png](rectified_pair.png)\n\n";
+  }
+  md << "## Time\n\n"
+     << StringPrintf("%.2f s on %d threads (images %.2f s).\n",
+                     input.seconds_total, input.threads, input.seconds_images);
+  return md.str();
+}
+
 }  // namespace
 
 bool RigReportOptions::Check(std::string* why) const {
   if (line_spacing_px < 2) return Fail("line_spacing_px must be >= 2", why);
+  std::string charts_why;
+  if (!charts.Check(&charts_why)) return Fail("charts: " + charts_why, why);
   return true;
+}
+
+std::string RigVerdictLine(const std::string& name, const Verdict& verdict) {
+  return name + ": " + verdict.Line();
+}
+
+std::string RigChartPrefix(const std::string& name) {
+  std::string prefix = name.empty() ? std::string("camera") : name;
+  for (char& c : prefix) {
+    const bool ok = std::isalnum(static_cast<unsigned char>(c)) || c == '-' ||
+                    c == '_' || c == '.';
+    if (!ok) c = '_';
+  }
+  return prefix + "_";
 }
 
 cv::Mat RectifyImage(const cv::Mat& image, const Camera& lens,
@@ -127,50 +296,40 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
                     const RigReportOptions& options, std::string* error) {
   std::string why;
   if (!options.Check(&why)) return Fail("rig report options: " + why, error);
+  if (HasEvidence(input)) {
+    const size_t n = input.result->cameras.size();
+    if (input.evidence.size() != n || input.verdicts.size() != n ||
+        std::count(input.evidence.begin(), input.evidence.end(), nullptr) ||
+        std::count(input.verdicts.begin(), input.verdicts.end(), nullptr)) {
+      return Fail(StringPrintf("rig report: %zu cameras, but %zu evidence "
+                               "and %zu verdicts (one of each per camera)",
+                               n, input.evidence.size(), input.verdicts.size()),
+                  error);
+    }
+  }
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) return Fail("cannot create '" + dir + "': " + ec.message(), error);
-  std::ostringstream summary;
-  summary << (input.calibration_ok
-                  ? "calibration: ok\n"
-                  : "calibration failed: " + input.calibration_error + "\n");
-  if (input.result != nullptr && !input.result->cameras.empty() &&
-      input.calibration_ok) {
-    summary << RigCalibrationReport(*input.result);
-  }
-  summary << "time: " << input.seconds_total << " s on " << input.threads
-          << " threads (images " << input.seconds_images << " s)\n";
-  if (!WriteFileAtomically((fs::path(dir) / "summary.txt").string(),
-                           summary.str(), error)) {
+  std::vector<CameraCharts> charts;
+  if (HasEvidence(input) &&
+      !WriteAllCameraCharts(dir, input, options, &charts, error)) {
     return false;
   }
-  if (!input.calibration_ok || input.result == nullptr ||
-      input.result->cameras.size() < 2 || input.files.size() < 2) {
-    return true;
+  const int pair_frame = PairFrame(input);
+  if (!WriteFileAtomically((fs::path(dir) / "summary.md").string(),
+                           RigSummary(input, charts, pair_frame >= 0), error)) {
+    return false;
   }
+  if (pair_frame < 0) return true;
   const RigCalibrationResult& result = *input.result;
-  // The frame both first cameras saw with the most corners between them.
-  int best = -1, best_corners = 0;
-  for (size_t f = 0; f < result.frame_used.size(); ++f) {
-    if (f >= input.files[0].size() || f >= input.files[1].size()) break;
-    if (!result.cameras[0].frame_used[f] || !result.cameras[1].frame_used[f]) {
-      continue;
-    }
-    const int corners = static_cast<int>(result.cameras[0].inlier[f].size() +
-                                         result.cameras[1].inlier[f].size());
-    if (corners > best_corners) {
-      best_corners = corners;
-      best = static_cast<int>(f);
-    }
-  }
-  if (best < 0) return true;
   const StereoRectification rect =
       ViewingRectification(result.cameras[0].camera, result.cameras[1].camera,
                            result.cameras[1].cam_from_rig *
                                result.cameras[0].cam_from_rig.inverse());
   cv::Mat first, second;
-  if (!LoadGreyImage(input.files[0][best], ImageLoadOptions(), &first, error) ||
-      !LoadGreyImage(input.files[1][best], ImageLoadOptions(), &second,
+  if (!LoadGreyImage(input.files[0][pair_frame], ImageLoadOptions(), &first,
+                     error) ||
+      !LoadGreyImage(input.files[1][pair_frame], ImageLoadOptions(), &second,
                      error)) {
     return false;
   }

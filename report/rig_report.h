@@ -2,18 +2,25 @@
 #define PUZZLECAL_REPORT_RIG_REPORT_H_
 
 // The rig calibration report (`puzzlecal calibrate-rig --report DIR`): a
-// text summary (summary.txt) and, for the first two cameras, a rectified
-// pair of one frame both saw, side by side with horizontal lines
-// (rectified_pair.png): after a good calibration every board corner lies
-// on the same row in both halves.
+// markdown summary (summary.md) with every camera's verdict on top, the
+// rig's figures, and per camera a section with the joint solve's residuals
+// for it, its own calibration's RMS and the evidence on that calibration as
+// the single-camera report shows it (report/report.h: the same tables, and
+// the same charts named <camera>_cross_validation.png, ...); and, for the
+// first two cameras, a rectified pair of one frame both saw, side by side
+// with horizontal lines (rectified_pair.png): after a good calibration
+// every board corner lies on the same row in both halves.
 
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 #include "calib/camera_models.h"
+#include "calib/evidence.h"
 #include "calib/rig_calibration.h"
 #include "calib/rig_yaml.h"
+#include "calib/verdict.h"
+#include "report/report.h"
 
 namespace puzzlecal {
 
@@ -21,6 +28,8 @@ struct RigReportOptions {
   // Rows between the horizontal lines of the rectified pair, in pixels.
   // Default 24. >= 2.
   int line_spacing_px = 24;
+  // Sizes of the evidence charts (those of the single-camera report).
+  ReportOptions charts;
   bool Check(std::string* why) const;
 };
 
@@ -30,6 +39,12 @@ struct RigReportInput {
   std::string calibration_error;
   // Per camera, per frame: the image file (empty when the camera has none).
   std::vector<std::vector<std::string>> files;
+  // Per camera (the order of result->cameras): the evidence on the camera's
+  // own calibration and its verdict, as `calibrate` judges one camera
+  // (calib/evidence.h, calib/verdict.h). Empty when not computed (a failed
+  // calibration); otherwise one non-null entry per camera each.
+  std::vector<const Evidence*> evidence;
+  std::vector<const Verdict*> verdicts;
   double seconds_images = 0;  // detection, grid and decode, wall clock
   double seconds_total = 0;
   int threads = 1;
@@ -63,8 +78,18 @@ cv::Mat RectifiedPairImage(const cv::Mat& first, const cv::Mat& second,
                            const StereoRectification& rectification,
                            const RigReportOptions& options);
 
-// Writes summary.txt (and rectified_pair.png when the calibration succeeded
-// and the first two cameras share a frame) into `dir`, created if needed.
+// The line that gives camera `name`'s verdict, in summary.md and on the
+// program's output alike: "<name>: verdict: <kind> — <reason> — <next>".
+std::string RigVerdictLine(const std::string& name, const Verdict& verdict);
+
+// File name prefix of camera `name`'s charts ("cam0_"; characters other
+// than letters, digits, '-', '_' and '.' become '_').
+std::string RigChartPrefix(const std::string& name);
+
+// Writes summary.md, the evidence charts of every camera with evidence
+// (and rectified_pair.png when the calibration succeeded and the first two
+// cameras share a frame) into `dir`, created if needed. The evidence and
+// verdicts, when given, must have one entry per camera.
 bool WriteRigReport(const std::string& dir, const RigReportInput& input,
                     const RigReportOptions& options, std::string* error);
 

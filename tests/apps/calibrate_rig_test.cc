@@ -19,6 +19,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,7 @@
 #include "calib/rig_calibration.h"
 #include "calib/rig_yaml.h"
 #include "sim/rig_scenes.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
@@ -128,6 +130,72 @@ void ExpectMatchesTruth(const RigSceneSpec& scene,
   }
 }
 
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in),
+                     std::istreambuf_iterator<char>());
+}
+
+// The line of the program's output that starts with `prefix` ("" if none).
+std::string OutputLine(const std::string& output, const std::string& prefix) {
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(prefix, 0) == 0) return line;
+  }
+  return "";
+}
+
+// Each camera's own calibration gets the single-camera verdict: the same
+// line on the output and in summary.md (at the top and in the camera's
+// section), with the camera's figures from the rig file and its evidence
+// charts, each a drawn PNG.
+void ExpectReportJudgesEachCamera(const RigSceneSpec& scene,
+                                  const std::string& output,
+                                  const YAML::Node& rig_file,
+                                  const fs::path& report) {
+  const std::string summary = ReadText(report / "summary.md");
+  ASSERT_FALSE(summary.empty()) << "no " << (report / "summary.md");
+  const size_t first_section = summary.find("\n## ");
+  for (size_t c = 0; c < scene.cameras.size(); ++c) {
+    const std::string& name = scene.cameras[c].name;
+    SCOPED_TRACE("camera " + name);
+    const std::string line = OutputLine(output, name + ": verdict: ");
+    ASSERT_FALSE(line.empty()) << output;
+    EXPECT_LT(summary.find("- " + line + "\n"), first_section) << summary;
+    const size_t begin = summary.find("\n## Camera " + name + "\n");
+    ASSERT_NE(begin, std::string::npos) << summary;
+    const std::string section =
+        summary.substr(begin, summary.find("\n## ", begin + 1) - begin);
+    EXPECT_NE(section.find("**" + line + "**"), std::string::npos) << section;
+    const YAML::Node cam = rig_file["cameras"][c];
+    ASSERT_EQ(cam["name"].as<std::string>(), name);
+    const std::string rms =
+        StringPrintf("| RMS reprojection error (px per coordinate) | %.4f |",
+                     cam["rms_px"].as<double>());
+    EXPECT_NE(section.find(rms), std::string::npos) << rms << "\n" << section;
+    EXPECT_NE(section.find(StringPrintf("| corners used | %d |",
+                                        cam["corners_used"].as<int>())),
+              std::string::npos)
+        << section;
+    EXPECT_NE(section.find(
+                  StringPrintf("| outliers | %d |", cam["outliers"].as<int>())),
+              std::string::npos)
+        << section;
+    for (const char* chart :
+         {"_cross_validation.png", "_uncertainty.png", "_residual_bins.png"}) {
+      const std::string file = name + chart;
+      EXPECT_NE(section.find("](" + file + ")"), std::string::npos)
+          << file << " not linked\n"
+          << section;
+      const cv::Mat image = cv::imread((report / file).string());
+      ASSERT_FALSE(image.empty()) << file;
+      cv::Scalar mean, stddev;
+      cv::meanStdDev(image, mean, stddev);
+      EXPECT_GT(stddev[0], 5) << file << " is blank";
+    }
+  }
+}
+
 TEST(CalibrateRigTest, FisheyeAndPinholeRendersMeetTheFigures) {
   // 1280 x 960: at 640 x 480 the fisheye's focal length is 137 px (1 px =
   // 0.4 degrees) and its rotation sigma alone is 0.009 degrees.
@@ -142,16 +210,12 @@ TEST(CalibrateRigTest, FisheyeAndPinholeRendersMeetTheFigures) {
       rig.board + " --model kannala-brandt,pinhole-radtan --out " +
       out.string() + " --report " + report.string() + " --threads 2");
   ASSERT_EQ(run.exit_code, kExitOk) << run.output;
-  // Each camera's own calibration gets the single-camera verdict.
-  for (const RigSceneCamera& spec : rig.scene.cameras) {
-    EXPECT_NE(run.output.find(spec.name + ": verdict: "), std::string::npos)
-        << run.output;
-  }
   std::vector<RigFileCamera> cameras;
   std::string error;
   ASSERT_TRUE(ReadRigFile(out.string(), &cameras, &error)) << error;
   ExpectMatchesTruth(rig.scene, cameras);
-  EXPECT_TRUE(fs::exists(report / "summary.txt"));
+  ExpectReportJudgesEachCamera(rig.scene, run.output, YAML::LoadFile(out),
+                               report);
   const cv::Mat pair = cv::imread((report / "rectified_pair.png").string());
   EXPECT_EQ(pair.cols, 2 * 1280);
   EXPECT_EQ(pair.rows, 960);

@@ -1,20 +1,34 @@
 // The rig report's rectification: RectifyImage resamples like OpenCV's
 // initUndistortRectifyMap (pinhole) and fisheye::initUndistortRectifyMap
 // (kannala-brandt) for the same rotation and intrinsics, and the viewing
-// rectification puts every point on the same row in both views.
+// rectification puts every point on the same row in both views. The
+// summary: a section per camera with its verdict, the rig's figures for it
+// and its evidence charts.
 
 #include "report/rig_report.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <regex>
+#include <string>
+#include <vector>
 
+#include "calib/evidence.h"
+#include "calib/rig_calibration.h"
+#include "calib/verdict.h"
 #include "sim/rig_scenes.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
@@ -114,6 +128,161 @@ TEST(RigReportTest, ViewingRectificationPutsPointsOnOneRow) {
     EXPECT_GT(a.x(), b.x());  // positive disparity in front of the rig
   }
   EXPECT_TRUE((rect.r1 * rect.r1.transpose()).isIdentity(1e-12));
+}
+
+namespace fs = std::filesystem;
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in),
+                     std::istreambuf_iterator<char>());
+}
+
+// The text of summary.md from "## Camera <name>" to the next "## " heading.
+std::string CameraSection(const std::string& summary, const std::string& name) {
+  const std::string heading = "\n## Camera " + name + "\n";
+  const size_t begin = summary.find(heading);
+  if (begin == std::string::npos) return "";
+  const size_t end = summary.find("\n## ", begin + heading.size());
+  return summary.substr(
+      begin, end == std::string::npos ? std::string::npos : end - begin);
+}
+
+// The targets of the markdown links and images in `text`.
+std::vector<std::string> LinkedFiles(const std::string& text) {
+  std::vector<std::string> files;
+  const std::regex link("\\]\\(([^)]+)\\)");
+  for (std::sregex_iterator it(text.begin(), text.end(), link), end; it != end;
+       ++it) {
+    files.push_back((*it)[1].str());
+  }
+  return files;
+}
+
+// A two-camera rig's exact correspondences (0.05 px noise), calibrated and
+// judged camera by camera as the program does.
+struct JudgedRig {
+  RigCalibrationResult result;
+  std::vector<Evidence> evidence;
+  std::vector<Verdict> verdicts;
+};
+
+JudgedRig CalibrateAndJudge(const RigSceneSpec& scene) {
+  JudgedRig rig;
+  const std::vector<RigCameraInput> inputs = RigCorrespondences(scene, 0.05);
+  RigCalibrationOptions options;
+  std::string error;
+  EXPECT_TRUE(CalibrateRig(inputs, options, &rig.result, &error)) << error;
+  for (size_t c = 0; c < rig.result.cameras.size(); ++c) {
+    const CalibrationResult& single = rig.result.cameras[c].single;
+    rig.evidence.push_back(ComputeEvidence(inputs[c].frames, single,
+                                           options.camera, EvidenceOptions()));
+    rig.verdicts.push_back(MakeVerdict(single, rig.evidence.back(),
+                                       EvidenceOptions(), VerdictOptions()));
+  }
+  return rig;
+}
+
+RigReportInput MakeInput(const JudgedRig& rig) {
+  RigReportInput input;
+  input.result = &rig.result;
+  input.calibration_ok = true;
+  for (size_t c = 0; c < rig.evidence.size(); ++c) {
+    input.evidence.push_back(&rig.evidence[c]);
+    input.verdicts.push_back(&rig.verdicts[c]);
+  }
+  return input;
+}
+
+TEST(RigReportTest, EachCameraHasItsVerdictFiguresAndEvidenceCharts) {
+  const JudgedRig rig = CalibrateAndJudge(StereoPinholeRig());
+  ASSERT_EQ(rig.result.cameras.size(), 2u);
+  const fs::path dir = fs::temp_directory_path() /
+                       ("puzzlecal_rig_report_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  std::string error;
+  ASSERT_TRUE(
+      WriteRigReport(dir.string(), MakeInput(rig), RigReportOptions(), &error))
+      << error;
+  const std::string summary = ReadText(dir / "summary.md");
+  ASSERT_FALSE(summary.empty());
+  std::vector<std::string> all_charts;
+  for (size_t c = 0; c < rig.result.cameras.size(); ++c) {
+    const RigCameraResult& cam = rig.result.cameras[c];
+    const Verdict& verdict = rig.verdicts[c];
+    SCOPED_TRACE("camera " + cam.name);
+    const std::string line = cam.name + ": " + verdict.Line();
+    EXPECT_EQ(RigVerdictLine(cam.name, verdict), line);
+    // At the top, before the first section.
+    const size_t top = summary.find("- " + line + "\n");
+    EXPECT_LT(top, summary.find("\n## ")) << summary;
+    const std::string section = CameraSection(summary, cam.name);
+    ASSERT_FALSE(section.empty()) << summary;
+    EXPECT_NE(section.find("**" + line + "**"), std::string::npos) << section;
+    EXPECT_NE(section.find("Verdict **" +
+                           std::string(VerdictKindName(verdict.kind)) + "**"),
+              std::string::npos)
+        << section;
+    EXPECT_NE(section.find(StringPrintf(
+                  "| RMS reprojection error (px per coordinate) | %.4f | "
+                  "%.4f |",
+                  cam.rms_px, cam.single_rms_px)),
+              std::string::npos)
+        << section;
+    EXPECT_NE(section.find(StringPrintf("| corners used | %d | %d |",
+                                        cam.num_corners_used,
+                                        cam.single.num_corners_used)),
+              std::string::npos)
+        << section;
+    EXPECT_NE(
+        section.find(StringPrintf("| outliers | %d | %d |", cam.num_outliers,
+                                  cam.single.num_outliers)),
+        std::string::npos)
+        << section;
+    EXPECT_NE(section.find(StringPrintf("| %d | %d |\n", cam.num_frames_used,
+                                        cam.single_views_used)),
+              std::string::npos)
+        << section;
+    // The single-camera report's evidence tables, one level down.
+    EXPECT_NE(section.find("### Evidence\n"), std::string::npos);
+    EXPECT_NE(section.find("#### Cross-validation"), std::string::npos);
+    EXPECT_NE(section.find("#### Systematic residuals"), std::string::npos);
+    // Every evidence chart, named after the camera, linked and drawn.
+    ASSERT_TRUE(rig.evidence[c].cross_validation.ok);
+    ASSERT_TRUE(rig.evidence[c].uncertainty.ok);
+    const std::vector<std::string> charts = LinkedFiles(section);
+    EXPECT_EQ(charts,
+              (std::vector<std::string>{cam.name + "_cross_validation.png",
+                                        cam.name + "_uncertainty.png",
+                                        cam.name + "_residual_bins.png"}));
+    for (const std::string& chart : charts) {
+      const cv::Mat image = cv::imread((dir / chart).string());
+      ASSERT_FALSE(image.empty()) << chart;
+      cv::Scalar mean, stddev;
+      cv::meanStdDev(image, mean, stddev);
+      EXPECT_GT(stddev[0], 5) << chart << " is blank";
+      all_charts.push_back(chart);
+    }
+  }
+  // Two cameras, six different files.
+  std::sort(all_charts.begin(), all_charts.end());
+  EXPECT_EQ(std::unique(all_charts.begin(), all_charts.end()),
+            all_charts.end());
+  EXPECT_EQ(all_charts.size(), 6u);
+  fs::remove_all(dir);
+}
+
+TEST(RigReportTest, RefusesEvidenceThatDoesNotMatchTheCameras) {
+  const JudgedRig rig = CalibrateAndJudge(StereoPinholeRig());
+  RigReportInput input = MakeInput(rig);
+  input.verdicts.pop_back();
+  const fs::path dir = fs::temp_directory_path() /
+                       ("puzzlecal_rig_report_bad_" + std::to_string(getpid()));
+  std::string error;
+  EXPECT_FALSE(WriteRigReport(dir.string(), input, RigReportOptions(), &error));
+  EXPECT_NE(error.find("one of each per camera"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(dir / "summary.md"));
+  fs::remove_all(dir);
 }
 
 }  // namespace
