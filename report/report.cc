@@ -1194,18 +1194,13 @@ std::string EvidenceChartDescription(const std::string& chart) {
   return "";
 }
 
-std::string ReportMarkdown(const ReportInput& input,
-                           const ReportOptions& options,
-                           const std::vector<std::string>& png_files) {
-  if (input.result == nullptr || input.views == nullptr ||
-      input.result->view_used.size() != input.views->size()) {
-    return "# Calibration report\n\nNo consistent calibration result was "
-           "given.\n";
-  }
-  const ReportData data = GatherData(input);
-  const CalibrationResult& result = *input.result;
-  const Camera& camera = result.camera;
-  std::ostringstream md;
+namespace {
+
+// ---- the sections of summary.md ----
+
+// The title, the verdict, the model and board, and a failed calibration.
+void MarkdownHeader(const ReportInput& input, std::ostringstream& md) {
+  const Camera& camera = input.result->camera;
   md << "# Calibration report\n\n";
   if (input.verdict != nullptr) md << "**" << input.verdict->Line() << "**\n\n";
   md << "Model **" << CameraModelName(camera.model) << "**, image "
@@ -1218,7 +1213,11 @@ std::string ReportMarkdown(const ReportInput& input,
        << "\n>\n> The figures below show what the failed attempt reached; do "
           "not use them.\n\n";
   }
+}
 
+// RMS, counts, orientations, coverage, initialisation and solver.
+void MarkdownResult(const ReportInput& input, std::ostringstream& md) {
+  const CalibrationResult& result = *input.result;
   md << "## Result\n\n| | |\n|---|---|\n";
   md << StringPrintf(
       "| RMS reprojection error | %.4f px per coordinate (%.4f px "
@@ -1243,7 +1242,12 @@ std::string ReportMarkdown(const ReportInput& input,
   md << "| initialisation | " << Cell(result.initialization_method) << " |\n";
   md << StringPrintf("| solver | %d iterations, ", result.iterations)
      << Cell(result.termination) << " |\n\n";
+}
 
+// Every parameter with its sigma (or "fixed").
+void MarkdownParameters(const CalibrationResult& result,
+                        std::ostringstream& md) {
+  const Camera& camera = result.camera;
   md << "## Parameters (value ± 1 sigma)\n\n";
   md << "| parameter | value | ± 1 sigma | unit |\n|---|---:|---:|---|\n";
   const std::vector<std::string> names = CameraModelParamNames(camera.model);
@@ -1266,15 +1270,11 @@ std::string ReportMarkdown(const ReportInput& input,
         "suits the lens.";
   if (!result.covariance_ok) md << " **The covariance could not be computed.**";
   md << "\n\n";
+}
 
-  if (!input.model_selection.empty()) {
-    md << "## Model selection\n\n```\n" << input.model_selection << "```\n\n";
-  }
-  if (input.evidence != nullptr) {
-    md << EvidenceMarkdown(*input.evidence, input.verdict, 2);
-  }
-
-  // Worst views.
+// The used views of highest RMS.
+void MarkdownWorstViews(const ReportData& data, const CalibrationResult& result,
+                        const ReportOptions& options, std::ostringstream& md) {
   std::vector<int> used;
   for (size_t v = 0; v < data.view_rms.size(); ++v) {
     if (std::isfinite(data.view_rms[v])) used.push_back(static_cast<int>(v));
@@ -1311,7 +1311,12 @@ std::string ReportMarkdown(const ReportInput& input,
     }
     md << "\n";
   }
+}
 
+// One row per input image: outcome, corners, RMS and details.
+void MarkdownImages(const ReportInput& input, const ReportData& data,
+                    std::ostringstream& md) {
+  const CalibrationResult& result = *input.result;
   md << "## Images\n\n";
   md << "| # | file | outcome | corners detected | corners used | RMS (px) | "
         "details |\n|---:|---|---|---:|---:|---:|---|\n";
@@ -1337,7 +1342,10 @@ std::string ReportMarkdown(const ReportInput& input,
        << " | " << Cell(reason) << " |\n";
   }
   md << "\n";
+}
 
+// Time per step.
+void MarkdownTime(const ReportInput& input, std::ostringstream& md) {
   md << "## Time\n\n| step | seconds |\n|---|---:|\n";
   md << "| reading and decoding image files | " << Seconds(input.seconds_load)
      << " |\n";
@@ -1350,7 +1358,12 @@ std::string ReportMarkdown(const ReportInput& input,
        << " threads; their times are summed over the images, so together "
           "they can exceed the whole run.\n\n";
   }
+}
 
+// What each chart and overlay shows and how to read it.
+void MarkdownPlots(const Camera& camera,
+                   const std::vector<std::string>& png_files,
+                   std::ostringstream& md) {
   md << "## Plots\n\n";
   if (png_files.empty()) md << "No plots were drawn.\n";
   std::vector<std::string> overlays;
@@ -1408,6 +1421,34 @@ std::string ReportMarkdown(const ReportInput& input,
           "outlier) and their reprojections by the calibrated model (magenta "
           "crosses), which should sit inside the circles.\n";
   }
+}
+
+}  // namespace
+
+std::string ReportMarkdown(const ReportInput& input,
+                           const ReportOptions& options,
+                           const std::vector<std::string>& png_files) {
+  if (input.result == nullptr || input.views == nullptr ||
+      input.result->view_used.size() != input.views->size()) {
+    return "# Calibration report\n\nNo consistent calibration result was "
+           "given.\n";
+  }
+  const ReportData data = GatherData(input);
+  const CalibrationResult& result = *input.result;
+  std::ostringstream md;
+  MarkdownHeader(input, md);
+  MarkdownResult(input, md);
+  MarkdownParameters(result, md);
+  if (!input.model_selection.empty()) {
+    md << "## Model selection\n\n```\n" << input.model_selection << "```\n\n";
+  }
+  if (input.evidence != nullptr) {
+    md << EvidenceMarkdown(*input.evidence, input.verdict, 2);
+  }
+  MarkdownWorstViews(data, result, options, md);
+  MarkdownImages(input, data, md);
+  MarkdownTime(input, md);
+  MarkdownPlots(result.camera, png_files, md);
   return md.str();
 }
 
