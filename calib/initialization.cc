@@ -361,8 +361,8 @@ void PoseToBlock(const Eigen::Isometry3d& cam_from_board, double* block) {
 template <typename Model>
 bool RefineStartOnSubset(const std::vector<const CalibrationView*>& views,
                          const std::vector<Eigen::Isometry3d>& poses,
-                         const InitializationOptions& options,
-                         Camera* camera, int* iterations) {
+                         const InitializationOptions& options, Camera* camera,
+                         int* iterations) {
   std::vector<double> intrinsics = camera->params;
   std::vector<std::array<double, kPoseBlockSize>> blocks(views.size());
   ceres::Problem::Options problem_options;
@@ -472,8 +472,8 @@ bool InitializationOptions::Check(std::string* why) const {
     return Fail("initialization.start_refine_max_views must be >= 1", why);
   }
   if (start_refine_max_corners_per_view < 1) {
-    return Fail(
-        "initialization.start_refine_max_corners_per_view must be >= 1", why);
+    return Fail("initialization.start_refine_max_corners_per_view must be >= 1",
+                why);
   }
   if (!(start_refine_loss_px > 0)) {
     return Fail("initialization.start_refine_loss_px must be > 0", why);
@@ -634,6 +634,136 @@ void PoseAllViews(const Camera& camera,
   }
 }
 
+// An evenly spread subset of at most `max_views` of `used`.
+std::vector<const CalibrationView*> SpreadSubset(
+    const std::vector<const CalibrationView*>& used, int max_views) {
+  if (static_cast<int>(used.size()) <= max_views) return used;
+  std::vector<const CalibrationView*> subset;
+  for (int k = 0; k < max_views; ++k) {
+    subset.push_back(used[static_cast<size_t>(k) * used.size() / max_views]);
+  }
+  return subset;
+}
+
+// The distortion-free starting camera: the focal-length search with a
+// centred principal point and, for the pinhole models, Zhang's closed forms
+// competing with it (the best fit to the search views wins). `method` says
+// which.
+Camera StartingCamera(CameraModelId model, int width, int height,
+                      const std::vector<const CalibrationView*>& search_views,
+                      const InitializationOptions& options,
+                      std::string* method) {
+  double search_cost = 0;
+  const double f_search = SearchFocalLength(model, width, height, search_views,
+                                            options, &search_cost);
+  Camera camera = CandidateCamera(model, width, height, f_search);
+  *method = "focal-length search (f = " + std::to_string(f_search) +
+            " px, centred principal point)";
+  if (!CameraModelIsPinhole(model)) return camera;
+  const double cx0 = 0.5 * (width - 1), cy0 = 0.5 * (height - 1);
+  const double scale = 0.5 * std::max(width, height);
+  const std::vector<Eigen::Matrix3d> homographies =
+      NormalisedHomographies(search_views, cx0, cy0, scale, options);
+  double best_cost = search_cost;
+  double fx, fy, u0, v0;
+  if (ZhangFull(homographies, &fx, &fy, &u0, &v0)) {
+    Camera full = CandidateCamera(model, width, height, fx * scale);
+    full.params[1] = fy * scale;
+    full.params[2] = cx0 + u0 * scale;
+    full.params[3] = cy0 + v0 * scale;
+    const bool plausible = fx / fy > 1.0 / options.max_focal_aspect &&
+                           fx / fy < options.max_focal_aspect &&
+                           full.params[2] > 0 && full.params[2] < width &&
+                           full.params[3] > 0 && full.params[3] < height;
+    const double cost = plausible ? ViewFitCost(full, search_views, options)
+                                  : std::numeric_limits<double>::infinity();
+    if (cost < best_cost) {
+      best_cost = cost;
+      camera = full;
+      *method = "Zhang closed form";
+    }
+  }
+  double f;
+  if (ZhangCentred(homographies, &f)) {
+    const Camera centred = CandidateCamera(model, width, height, f * scale);
+    const double cost = ViewFitCost(centred, search_views, options);
+    if (cost < best_cost) {
+      best_cost = cost;
+      camera = centred;
+      *method = "Zhang closed form, centred principal point";
+    }
+  }
+  return camera;
+}
+
+// The distortion-free start refined on a subset of the posed views (k1, k2
+// free); then every view is posed again through the refined camera, which
+// replaces the start when it poses any view.
+void RefineStart(const std::vector<CalibrationView>& views,
+                 const std::vector<bool>& use_view, CameraModelId model,
+                 const InitializationOptions& options, Camera* camera,
+                 InitializationResult* result) {
+  std::vector<const CalibrationView*> posed;
+  std::vector<Eigen::Isometry3d> posed_poses;
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (result->view_ok[i]) {
+      posed.push_back(&views[i]);
+      posed_poses.push_back(result->cam_from_board[i]);
+    }
+  }
+  std::vector<const CalibrationView*> subset;
+  std::vector<Eigen::Isometry3d> subset_poses;
+  const size_t want = std::min<size_t>(
+      posed.size(), static_cast<size_t>(options.start_refine_max_views));
+  for (size_t k = 0; k < want; ++k) {
+    subset.push_back(posed[k * posed.size() / want]);
+    subset_poses.push_back(posed_poses[k * posed.size() / want]);
+  }
+  Camera refined = *camera;
+  int iterations = 0;
+  const bool improved = DispatchCameraModel(model, [&](auto m) {
+    return RefineStartOnSubset<decltype(m)>(subset, subset_poses, options,
+                                            &refined, &iterations);
+  });
+  result->start_refine_iterations = iterations;
+  if (!improved) return;
+  InitializationOptions pose_options = options;
+  pose_options.pose_refine_iterations = std::max(
+      options.pose_refine_iterations, options.start_refine_pose_iterations);
+  InitializationResult refined_result;
+  PoseAllViews(refined, views, use_view, pose_options, &refined_result);
+  if (std::count(refined_result.view_ok.begin(), refined_result.view_ok.end(),
+                 true) == 0) {
+    return;
+  }
+  *camera = refined;
+  result->view_ok = refined_result.view_ok;
+  result->cam_from_board = refined_result.cam_from_board;
+  result->view_reason = refined_result.view_reason;
+  result->start_refined = true;
+  result->method += ", refined on " + std::to_string(subset.size()) +
+                    " views with k1, k2 free";
+}
+
+// The largest angle between the board normals of two posed views (radians);
+// false when no view is posed.
+bool OrientationSpread(const InitializationResult& result, double* spread) {
+  std::vector<Eigen::Vector3d> normals;
+  for (size_t i = 0; i < result.view_ok.size(); ++i) {
+    if (result.view_ok[i]) {
+      normals.push_back(result.cam_from_board[i].linear().col(2));
+    }
+  }
+  if (normals.empty()) return false;
+  *spread = 0;
+  for (size_t i = 0; i < normals.size(); ++i) {
+    for (size_t j = i + 1; j < normals.size(); ++j) {
+      *spread = std::max(*spread, AngleBetween(normals[i], normals[j]));
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool InitializeCalibration(const std::vector<CalibrationView>& views,
@@ -656,17 +786,6 @@ bool InitializeCalibration(const std::vector<CalibrationView>& views,
     if (use_view[i]) used.push_back(&views[i]);
   }
   if (used.empty()) return Fail("no views to initialise from", error);
-  // Evenly spread subset for the intrinsics search.
-  std::vector<const CalibrationView*> search_views;
-  const int max_views = options.focal_search_max_views;
-  if (static_cast<int>(used.size()) <= max_views) {
-    search_views = used;
-  } else {
-    for (int k = 0; k < max_views; ++k) {
-      search_views.push_back(
-          used[static_cast<size_t>(k) * used.size() / max_views]);
-    }
-  }
 
   Camera camera;
   if (!initial_params.empty()) {
@@ -684,112 +803,20 @@ bool InitializeCalibration(const std::vector<CalibrationView>& views,
     camera.params = initial_params;
     result->method = "given by the caller";
   } else {
-    double search_cost = 0;
-    const double f_search = SearchFocalLength(
-        model, width, height, search_views, options, &search_cost);
-    camera = CandidateCamera(model, width, height, f_search);
-    result->method = "focal-length search (f = " + std::to_string(f_search) +
-                     " px, centred principal point)";
-    if (CameraModelIsPinhole(model)) {
-      // Zhang's closed forms compete with the search; the best fit wins.
-      const double cx0 = 0.5 * (width - 1), cy0 = 0.5 * (height - 1);
-      const double scale = 0.5 * std::max(width, height);
-      const std::vector<Eigen::Matrix3d> homographies =
-          NormalisedHomographies(search_views, cx0, cy0, scale, options);
-      double best_cost = search_cost;
-      double fx, fy, u0, v0;
-      if (ZhangFull(homographies, &fx, &fy, &u0, &v0)) {
-        Camera full = CandidateCamera(model, width, height, fx * scale);
-        full.params[1] = fy * scale;
-        full.params[2] = cx0 + u0 * scale;
-        full.params[3] = cy0 + v0 * scale;
-        const bool plausible = fx / fy > 1.0 / options.max_focal_aspect &&
-                               fx / fy < options.max_focal_aspect &&
-                               full.params[2] > 0 && full.params[2] < width &&
-                               full.params[3] > 0 && full.params[3] < height;
-        const double cost = plausible ? ViewFitCost(full, search_views, options)
-                                      : std::numeric_limits<double>::infinity();
-        if (cost < best_cost) {
-          best_cost = cost;
-          camera = full;
-          result->method = "Zhang closed form";
-        }
-      }
-      double f;
-      if (ZhangCentred(homographies, &f)) {
-        const Camera centred = CandidateCamera(model, width, height, f * scale);
-        const double cost = ViewFitCost(centred, search_views, options);
-        if (cost < best_cost) {
-          best_cost = cost;
-          camera = centred;
-          result->method = "Zhang closed form, centred principal point";
-        }
-      }
-    }
+    camera = StartingCamera(model, width, height,
+                            SpreadSubset(used, options.focal_search_max_views),
+                            options, &result->method);
   }
-
   PoseAllViews(camera, views, use_view, options, result);
   if (initial_params.empty() && options.start_refine_iterations > 0) {
-    // The distortion-free start refined on a subset of the posed views; then
-    // every view is posed again through the refined camera.
-    std::vector<const CalibrationView*> posed;
-    std::vector<Eigen::Isometry3d> posed_poses;
-    for (size_t i = 0; i < views.size(); ++i) {
-      if (result->view_ok[i]) {
-        posed.push_back(&views[i]);
-        posed_poses.push_back(result->cam_from_board[i]);
-      }
-    }
-    std::vector<const CalibrationView*> subset;
-    std::vector<Eigen::Isometry3d> subset_poses;
-    const size_t want = std::min<size_t>(
-        posed.size(), static_cast<size_t>(options.start_refine_max_views));
-    for (size_t k = 0; k < want; ++k) {
-      subset.push_back(posed[k * posed.size() / want]);
-      subset_poses.push_back(posed_poses[k * posed.size() / want]);
-    }
-    Camera refined = camera;
-    int iterations = 0;
-    const bool improved = DispatchCameraModel(model, [&](auto m) {
-      return RefineStartOnSubset<decltype(m)>(subset, subset_poses, options,
-                                              &refined, &iterations);
-    });
-    result->start_refine_iterations = iterations;
-    if (improved) {
-      InitializationOptions pose_options = options;
-      pose_options.pose_refine_iterations = std::max(
-          options.pose_refine_iterations, options.start_refine_pose_iterations);
-      InitializationResult refined_result;
-      PoseAllViews(refined, views, use_view, pose_options, &refined_result);
-      if (std::count(refined_result.view_ok.begin(),
-                     refined_result.view_ok.end(), true) > 0) {
-        camera = refined;
-        result->view_ok = refined_result.view_ok;
-        result->cam_from_board = refined_result.cam_from_board;
-        result->view_reason = refined_result.view_reason;
-        result->start_refined = true;
-        result->method += ", refined on " + std::to_string(subset.size()) +
-                          " views with k1, k2 free";
-      }
-    }
+    RefineStart(views, use_view, model, options, &camera, result);
   }
   result->camera = camera;
-  std::vector<Eigen::Vector3d> normals;
-  for (size_t i = 0; i < views.size(); ++i) {
-    if (result->view_ok[i]) {
-      normals.push_back(result->cam_from_board[i].linear().col(2));
-    }
-  }
-  if (normals.empty()) {
+  double spread = 0;
+  if (!OrientationSpread(*result, &spread)) {
     return Fail("no view gives a pose with the initial intrinsics (" +
                     result->method + ")",
                 error);
-  }
-  double spread = 0;
-  for (size_t i = 0; i < normals.size(); ++i) {
-    for (size_t j = i + 1; j < normals.size(); ++j) {
-      spread = std::max(spread, AngleBetween(normals[i], normals[j]));
-    }
   }
   result->orientation_spread_deg = spread * 180.0 / M_PI;
   return true;
