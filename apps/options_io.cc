@@ -305,6 +305,8 @@ struct Fields<ModelSelectionOptions> {
     v.Field("candidates", o.candidates);
     v.Field("pinhole_max_field_deg", o.pinhole_max_field_deg);
     v.Field("min_relative_gain", o.min_relative_gain);
+    v.Field("gross_error_k", o.gross_error_k);
+    v.Field("gross_error_floor_px", o.gross_error_floor_px);
   }
 };
 

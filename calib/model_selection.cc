@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "util/failure.h"
+#include "util/statistics.h"
 #include "util/string_format.h"
 #include "util/timer.h"
 
@@ -49,12 +50,17 @@ bool ModelSelectionOptions::Check(std::string* why) const {
   if (!(min_relative_gain >= 0)) {
     return Fail("min_relative_gain must be >= 0", why);
   }
+  if (!(gross_error_k > 0)) return Fail("gross_error_k must be > 0", why);
+  if (!(gross_error_floor_px >= 0)) {
+    return Fail("gross_error_floor_px must be >= 0", why);
+  }
   return true;
 }
 
 bool HoldoutError(const std::vector<CalibrationView>& views,
                   const Camera& camera, const CalibrationOptions& calibration,
-                  double* rms_px, int* corners, std::string* error) {
+                  double* rms_px, int* corners, std::string* error,
+                  std::vector<std::vector<Eigen::Vector2d>>* residuals) {
   // Calibrate with every intrinsic held: only the poses move. The checks
   // meant for a calibration (views, spread, coverage, RMS) do not apply to
   // a pose fit; no corner is dropped, so a model that cannot follow the
@@ -77,18 +83,84 @@ bool HoldoutError(const std::vector<CalibrationView>& views,
   }
   double sum2 = 0;
   int n = 0;
+  if (residuals != nullptr) {
+    residuals->assign(views.size(), {});
+    for (size_t v = 0; v < views.size(); ++v) {
+      (*residuals)[v].assign(
+          views[v].board_points.size(),
+          Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
+    }
+  }
   for (size_t v = 0; v < result.residuals.size(); ++v) {
     if (!result.view_used[v]) continue;
     for (size_t i = 0; i < result.residuals[v].size(); ++i) {
       if (!result.inlier[v][i]) continue;
       sum2 += result.residuals[v][i].squaredNorm();
       ++n;
+      if (residuals != nullptr) (*residuals)[v][i] = result.residuals[v][i];
     }
   }
   *corners = n;
   *rms_px = n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
   return n > 0 || Fail("no held-out corner projects", error);
 }
+
+namespace {
+
+using CornerResiduals = std::vector<std::vector<Eigen::Vector2d>>;
+
+// Which held-out corners are gross for every candidate (detection errors):
+// [view][corner]. `residuals` holds each successful candidate's.
+std::vector<std::vector<bool>> DetectionErrors(
+    const std::vector<CornerResiduals>& residuals,
+    const ModelSelectionOptions& options) {
+  std::vector<std::vector<bool>> gross;
+  if (residuals.empty()) return gross;
+  gross.resize(residuals[0].size());
+  for (size_t v = 0; v < residuals[0].size(); ++v) {
+    gross[v].assign(residuals[0][v].size(), true);
+  }
+  for (const CornerResiduals& candidate : residuals) {
+    std::vector<double> magnitudes;
+    for (const auto& view : candidate) {
+      for (const Eigen::Vector2d& r : view) {
+        if (!r.allFinite()) continue;
+        magnitudes.push_back(std::abs(r.x()));
+        magnitudes.push_back(std::abs(r.y()));
+      }
+    }
+    const double threshold =
+        std::max(options.gross_error_k * 1.4826 * Median(magnitudes),
+                 options.gross_error_floor_px);
+    for (size_t v = 0; v < candidate.size(); ++v) {
+      for (size_t i = 0; i < candidate[v].size(); ++i) {
+        // A corner the candidate cannot project says nothing about it.
+        const Eigen::Vector2d& r = candidate[v][i];
+        if (r.allFinite() && r.norm() <= threshold) gross[v][i] = false;
+      }
+    }
+  }
+  return gross;
+}
+
+// The RMS per coordinate of the corners that project, detection errors left
+// out; `corners` receives their number.
+double HoldoutRms(const CornerResiduals& residuals,
+                  const std::vector<std::vector<bool>>& gross, int* corners) {
+  double sum2 = 0;
+  int n = 0;
+  for (size_t v = 0; v < residuals.size(); ++v) {
+    for (size_t i = 0; i < residuals[v].size(); ++i) {
+      if (!residuals[v][i].allFinite() || gross[v][i]) continue;
+      sum2 += residuals[v][i].squaredNorm();
+      ++n;
+    }
+  }
+  *corners = n;
+  return n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
+}
+
+}  // namespace
 
 bool SelectModel(const std::vector<CalibrationView>& views, int width,
                  int height, const CalibrationOptions& calibration,
@@ -135,7 +207,9 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
     return !CameraModelIsPinhole(id);
   });
   double widest_deg = 0;
-  for (CameraModelId model : models) {
+  std::vector<CornerResiduals> residuals(models.size());
+  for (size_t m = 0; m < models.size(); ++m) {
+    const CameraModelId model = models[m];
     const Timer timer;
     ModelCandidate candidate;
     candidate.model = model;
@@ -162,7 +236,7 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
       std::string holdout_error;
       if (HoldoutError(holdout, result.camera, calibration,
                        &candidate.holdout_rms_px, &candidate.holdout_corners,
-                       &holdout_error)) {
+                       &holdout_error, &residuals[m])) {
         candidate.ok = true;
       } else {
         candidate.error = "held-out fit failed: " + holdout_error;
@@ -170,6 +244,22 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
     }
     candidate.seconds = timer.Seconds();
     selection->candidates.push_back(candidate);
+  }
+  // The candidates are compared on the same corners: those that are not
+  // detection errors.
+  std::vector<CornerResiduals> fitted;
+  for (size_t m = 0; m < models.size(); ++m) {
+    if (selection->candidates[m].ok) fitted.push_back(residuals[m]);
+  }
+  const std::vector<std::vector<bool>> gross = DetectionErrors(fitted, options);
+  for (const auto& view : gross) {
+    selection->holdout_detection_errors +=
+        static_cast<int>(std::count(view.begin(), view.end(), true));
+  }
+  for (size_t m = 0; m < models.size(); ++m) {
+    ModelCandidate& c = selection->candidates[m];
+    if (c.ok)
+      c.holdout_rms_px = HoldoutRms(residuals[m], gross, &c.holdout_corners);
   }
   // Lowest held-out error; a model with more parameters must beat the best
   // one with fewer by min_relative_gain.
@@ -205,7 +295,13 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
 std::string ModelSelection::Table() const {
   std::ostringstream table;
   table << "model selection: " << fit_views << " views fitted, "
-        << holdout_views << " held out (poses fitted, intrinsics fixed)\n";
+        << holdout_views << " held out (poses fitted, intrinsics fixed)";
+  if (holdout_detection_errors > 0) {
+    table << "; " << holdout_detection_errors
+          << " held-out corner(s) off for every model left out as detection "
+             "errors";
+  }
+  table << "\n";
   table << "  model                       params  fit RMS   held-out RMS  "
            "corners  time\n";
   for (size_t k = 0; k < candidates.size(); ++k) {

@@ -33,6 +33,18 @@ struct ModelSelectionOptions {
   // A candidate must beat the best held-out error by more than this
   // fraction to be preferred over one with fewer parameters. Default 0.02.
   double min_relative_gain = 0.02;
+  // A held-out corner whose error is gross for every candidate that fits
+  // is a detection error (a false corner), not a model's failure: it is left
+  // out of every candidate's held-out RMS, so that one such corner cannot
+  // drown the differences between models (its squared error counts as much
+  // as thousands of good corners'). Gross: above gross_error_k times the
+  // candidate's own robust sigma of its held-out residual coordinates
+  // (1.4826 x their median absolute value) and above gross_error_floor_px.
+  // A corner only some candidates miss stays: that is what a model that
+  // cannot follow the lens looks like. Defaults 10 and 3 px; k > 0, floor
+  // >= 0.
+  double gross_error_k = 10.0;
+  double gross_error_floor_px = 3.0;
 
   bool Check(std::string* why = nullptr) const;
 };
@@ -41,9 +53,11 @@ struct ModelCandidate {
   CameraModelId model = CameraModelId::kPinholeRadtan;
   int num_params = 0;
   bool ok = false;
-  std::string error;          // why the candidate failed, when !ok
-  double fit_rms_px = 0;      // calibration views, inliers, per coordinate
-  double holdout_rms_px = 0;  // held-out views, every corner, per coordinate
+  std::string error;      // why the candidate failed, when !ok
+  double fit_rms_px = 0;  // calibration views, inliers, per coordinate
+  // Held-out views, per coordinate, every corner the candidate projects but
+  // the detection errors (ModelSelectionOptions::gross_error_k).
+  double holdout_rms_px = 0;
   int holdout_views = 0;
   int holdout_corners = 0;
   double seconds = 0;
@@ -55,6 +69,8 @@ struct ModelSelection {
   int fit_views = 0;
   int holdout_views = 0;
   double min_relative_gain = 0;  // the options' tie margin, for Table()
+  // Held-out corners left out as gross for every candidate.
+  int holdout_detection_errors = 0;
 
   // The comparison table (one line per candidate, the chosen one marked).
   std::string Table() const;
@@ -70,9 +86,13 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
 
 // The held-out error of `camera` on `views`: each view's pose fitted with
 // the intrinsics fixed; RMS per coordinate over all corners that project.
-bool HoldoutError(const std::vector<CalibrationView>& views,
-                  const Camera& camera, const CalibrationOptions& calibration,
-                  double* rms_px, int* corners, std::string* error);
+// `residuals`, when given, receives every corner's residual ([view][corner],
+// NaN where the corner does not project or its view was not fitted).
+bool HoldoutError(
+    const std::vector<CalibrationView>& views, const Camera& camera,
+    const CalibrationOptions& calibration, double* rms_px, int* corners,
+    std::string* error,
+    std::vector<std::vector<Eigen::Vector2d>>* residuals = nullptr);
 
 }  // namespace puzzlecal
 
