@@ -278,6 +278,7 @@ struct Fields<VerdictOptions> {
     v.Field("halves_factor", o.halves_factor);
     v.Field("halves_floor_px", o.halves_floor_px);
     v.Field("halves_min_bands", o.halves_min_bands);
+    v.Field("halves_min_z", o.halves_min_z);
     v.Field("residual_se_factor", o.residual_se_factor);
     v.Field("residual_floor_px", o.residual_floor_px);
     v.Field("closeness_rms_ratio", o.closeness_rms_ratio);
@@ -570,8 +571,9 @@ constexpr char kHeader[] =
     "# detection/detector.h (DetectorOptions), grid grid/grid.h "
     "(GridOptions),\n"
     "# decode decode/decoder.h and decode/edge_bits.h (DecodeOptions,\n"
-    "# EdgeBitOptions), load apps/image_io.h (ImageLoadOptions), pipeline\n"
-    "# apps/pipeline.h (PipelineOptions), calibration calib/calibrate.h and\n"
+    "# EdgeBitOptions), load pipeline/image_io.h (ImageLoadOptions),\n"
+    "# pipeline pipeline/pipeline.h (PipelineOptions), calibration\n"
+    "# calib/calibrate.h and\n"
     "# calib/initialization.h, evidence calib/evidence.h, verdict\n"
     "# calib/verdict.h, model_selection calib/model_selection.h, rig\n"
     "# calib/rig_calibration.h (its camera options are the calibration\n"
