@@ -160,6 +160,138 @@ double HoldoutRms(const CornerResiduals& residuals,
   return n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
 }
 
+
+// The candidate models: options.candidates, or every model; fisheye models
+// first (the widest field angle they see tells whether a pinhole model can
+// hold the views at all).
+std::vector<CameraModelId> CandidateModels(
+    const ModelSelectionOptions& options) {
+  std::vector<CameraModelId> models;
+  if (options.candidates.empty()) {
+    models.assign(kAllCameraModels.begin(), kAllCameraModels.end());
+  } else {
+    for (const std::string& name : options.candidates) {
+      CameraModelId id;
+      CameraModelIdFromName(name, &id);
+      models.push_back(id);
+    }
+  }
+  std::stable_partition(models.begin(), models.end(), [](CameraModelId id) {
+    return !CameraModelIsPinhole(id);
+  });
+  return models;
+}
+
+// Every holdout_every-th view with enough corners is held out. Returns the
+// number of such views.
+int SplitViews(const std::vector<CalibrationView>& views,
+               int min_corners_per_view, const ModelSelectionOptions& options,
+               std::vector<CalibrationView>* fit,
+               std::vector<CalibrationView>* holdout) {
+  int position = 0;
+  for (const CalibrationView& view : views) {
+    if (static_cast<int>(view.board_points.size()) < min_corners_per_view) {
+      continue;
+    }
+    if (position++ % options.holdout_every == options.holdout_offset) {
+      holdout->push_back(view);
+    } else {
+      fit->push_back(view);
+    }
+  }
+  return position;
+}
+
+// One candidate: calibrated on the fit views, then its held-out error
+// (`residuals` per held-out corner). `widest_deg` is the widest field angle
+// a fisheye candidate saw so far (it skips pinhole candidates beyond their
+// field) and grows with this one's.
+ModelCandidate FitCandidate(CameraModelId model,
+                            const std::vector<CalibrationView>& fit,
+                            const std::vector<CalibrationView>& holdout,
+                            int width, int height,
+                            const CalibrationOptions& calibration,
+                            const ModelSelectionOptions& options,
+                            double* widest_deg, CornerResiduals* residuals) {
+  const Timer timer;
+  ModelCandidate candidate;
+  candidate.model = model;
+  candidate.num_params = CameraModelNumParams(model);
+  candidate.holdout_views = static_cast<int>(holdout.size());
+  CalibrationOptions fit_options = calibration;
+  fit_options.compute_covariance = false;
+  CalibrationResult result;
+  std::string fit_error;
+  if (CameraModelIsPinhole(model) &&
+      *widest_deg > options.pinhole_max_field_deg) {
+    candidate.error = StringPrintf(
+        "skipped: the corners reach %.1f deg off the axis "
+        "(limit %.1f deg for a pinhole model)",
+        *widest_deg, options.pinhole_max_field_deg);
+  } else if (!Calibrate(fit, model, width, height, fit_options, &result,
+                        &fit_error)) {
+    candidate.error = "calibration failed: " + fit_error;
+  } else {
+    candidate.fit_rms_px = result.rms_px;
+    if (!CameraModelIsPinhole(model)) {
+      *widest_deg = std::max(*widest_deg, WidestFieldDeg(fit, result));
+    }
+    std::string holdout_error;
+    if (HoldoutError(holdout, result.camera, calibration,
+                     &candidate.holdout_rms_px, &candidate.holdout_corners,
+                     &holdout_error, residuals)) {
+      candidate.ok = true;
+    } else {
+      candidate.error = "held-out fit failed: " + holdout_error;
+    }
+  }
+  candidate.seconds = timer.Seconds();
+  return candidate;
+}
+
+// The candidates compared on the same corners: those that are not
+// detection errors.
+void CompareOnTheSameCorners(const std::vector<CornerResiduals>& residuals,
+                             const ModelSelectionOptions& options,
+                             ModelSelection* selection) {
+  std::vector<CornerResiduals> fitted;
+  for (size_t m = 0; m < residuals.size(); ++m) {
+    if (selection->candidates[m].ok) fitted.push_back(residuals[m]);
+  }
+  const std::vector<std::vector<bool>> gross = DetectionErrors(fitted, options);
+  for (const auto& view : gross) {
+    selection->holdout_detection_errors +=
+        static_cast<int>(std::count(view.begin(), view.end(), true));
+  }
+  for (size_t m = 0; m < residuals.size(); ++m) {
+    ModelCandidate& c = selection->candidates[m];
+    if (c.ok) {
+      c.holdout_rms_px = HoldoutRms(residuals[m], gross, &c.holdout_corners);
+    }
+  }
+}
+
+// The lowest held-out error; a model with more parameters must beat the
+// best one with fewer by min_relative_gain. -1 when no candidate succeeded.
+int ChooseCandidate(const std::vector<ModelCandidate>& candidates,
+                    double min_relative_gain) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const ModelCandidate& c : candidates) {
+    if (c.ok) best = std::min(best, c.holdout_rms_px);
+  }
+  int chosen = -1;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const ModelCandidate& c = candidates[k];
+    if (!c.ok || c.holdout_rms_px > best * (1 + min_relative_gain)) continue;
+    if (chosen < 0 || c.num_params < candidates[chosen].num_params ||
+        (c.num_params == candidates[chosen].num_params &&
+         c.holdout_rms_px < candidates[chosen].holdout_rms_px)) {
+      chosen = static_cast<int>(k);
+    }
+  }
+  return chosen;
+}
+
 }  // namespace
 
 bool SelectModel(const std::vector<CalibrationView>& views, int width,
@@ -171,115 +303,27 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
   std::string why;
   if (!options.Check(&why))
     return Fail("model selection options: " + why, error);
-  std::vector<CameraModelId> models;
-  if (options.candidates.empty()) {
-    models.assign(kAllCameraModels.begin(), kAllCameraModels.end());
-  } else {
-    for (const std::string& name : options.candidates) {
-      CameraModelId id;
-      CameraModelIdFromName(name, &id);
-      models.push_back(id);
-    }
-  }
+  const std::vector<CameraModelId> models = CandidateModels(options);
   std::vector<CalibrationView> fit, holdout;
-  int position = 0;
-  for (const CalibrationView& view : views) {
-    if (static_cast<int>(view.board_points.size()) <
-        calibration.min_corners_per_view) {
-      continue;
-    }
-    if (position++ % options.holdout_every == options.holdout_offset) {
-      holdout.push_back(view);
-    } else {
-      fit.push_back(view);
-    }
-  }
+  const int usable = SplitViews(views, calibration.min_corners_per_view,
+                                options, &fit, &holdout);
   selection->fit_views = static_cast<int>(fit.size());
   selection->holdout_views = static_cast<int>(holdout.size());
   if (holdout.empty()) {
     return Fail("model selection: too few views to hold any out (" +
-                    std::to_string(position) + ")",
+                    std::to_string(usable) + ")",
                 error);
   }
-  // Fisheye models first: the widest field angle they see tells whether a
-  // pinhole model can hold the views at all.
-  std::stable_partition(models.begin(), models.end(), [](CameraModelId id) {
-    return !CameraModelIsPinhole(id);
-  });
   double widest_deg = 0;
   std::vector<CornerResiduals> residuals(models.size());
   for (size_t m = 0; m < models.size(); ++m) {
-    const CameraModelId model = models[m];
-    const Timer timer;
-    ModelCandidate candidate;
-    candidate.model = model;
-    candidate.num_params = CameraModelNumParams(model);
-    candidate.holdout_views = static_cast<int>(holdout.size());
-    CalibrationOptions fit_options = calibration;
-    fit_options.compute_covariance = false;
-    CalibrationResult result;
-    std::string fit_error;
-    if (CameraModelIsPinhole(model) &&
-        widest_deg > options.pinhole_max_field_deg) {
-      candidate.error = StringPrintf(
-          "skipped: the corners reach %.1f deg off the axis "
-          "(limit %.1f deg for a pinhole model)",
-          widest_deg, options.pinhole_max_field_deg);
-    } else if (!Calibrate(fit, model, width, height, fit_options, &result,
-                          &fit_error)) {
-      candidate.error = "calibration failed: " + fit_error;
-    } else {
-      candidate.fit_rms_px = result.rms_px;
-      if (!CameraModelIsPinhole(model)) {
-        widest_deg = std::max(widest_deg, WidestFieldDeg(fit, result));
-      }
-      std::string holdout_error;
-      if (HoldoutError(holdout, result.camera, calibration,
-                       &candidate.holdout_rms_px, &candidate.holdout_corners,
-                       &holdout_error, &residuals[m])) {
-        candidate.ok = true;
-      } else {
-        candidate.error = "held-out fit failed: " + holdout_error;
-      }
-    }
-    candidate.seconds = timer.Seconds();
-    selection->candidates.push_back(candidate);
+    selection->candidates.push_back(FitCandidate(models[m], fit, holdout, width,
+                                                 height, calibration, options,
+                                                 &widest_deg, &residuals[m]));
   }
-  // The candidates are compared on the same corners: those that are not
-  // detection errors.
-  std::vector<CornerResiduals> fitted;
-  for (size_t m = 0; m < models.size(); ++m) {
-    if (selection->candidates[m].ok) fitted.push_back(residuals[m]);
-  }
-  const std::vector<std::vector<bool>> gross = DetectionErrors(fitted, options);
-  for (const auto& view : gross) {
-    selection->holdout_detection_errors +=
-        static_cast<int>(std::count(view.begin(), view.end(), true));
-  }
-  for (size_t m = 0; m < models.size(); ++m) {
-    ModelCandidate& c = selection->candidates[m];
-    if (c.ok)
-      c.holdout_rms_px = HoldoutRms(residuals[m], gross, &c.holdout_corners);
-  }
-  // Lowest held-out error; a model with more parameters must beat the best
-  // one with fewer by min_relative_gain.
-  double best = std::numeric_limits<double>::infinity();
-  for (const ModelCandidate& c : selection->candidates) {
-    if (c.ok) best = std::min(best, c.holdout_rms_px);
-  }
-  for (size_t k = 0; k < selection->candidates.size(); ++k) {
-    const ModelCandidate& c = selection->candidates[k];
-    if (!c.ok || c.holdout_rms_px > best * (1 + options.min_relative_gain)) {
-      continue;
-    }
-    if (selection->chosen < 0 ||
-        c.num_params < selection->candidates[selection->chosen].num_params ||
-        (c.num_params == selection->candidates[selection->chosen].num_params &&
-         c.holdout_rms_px <
-             selection->candidates[selection->chosen].holdout_rms_px)) {
-      selection->chosen = static_cast<int>(k);
-    }
-  }
+  CompareOnTheSameCorners(residuals, options, selection);
+  selection->chosen =
+      ChooseCandidate(selection->candidates, options.min_relative_gain);
   if (selection->chosen < 0) {
     std::string reasons;
     for (const ModelCandidate& c : selection->candidates) {
