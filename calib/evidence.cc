@@ -315,16 +315,23 @@ SystematicResiduals ComputeSystematicResiduals(
     }
   }
   if (samples.empty()) return out;
-  // By field angle: fixed-width bins up to the widest corner.
-  const int angle_bins = std::max(
+  // By field angle: fixed-width bins up to the widest corner. A last bin
+  // narrower than a quarter of the width (a sliver holding the few widest
+  // corners, with no usable statistics) joins the one before it.
+  int angle_bins = std::max(
       1, static_cast<int>(
              std::ceil(out.max_angle_deg / options.band_width_deg - 1e-9)));
+  if (angle_bins > 1 &&
+      out.max_angle_deg - (angle_bins - 1) * options.band_width_deg <
+          0.25 * options.band_width_deg) {
+    --angle_bins;
+  }
   for (int b = 0; b < angle_bins; ++b) {
+    const bool last = b + 1 == angle_bins;
     const double lo = b * options.band_width_deg;
-    const double hi = std::min(out.max_angle_deg, lo + options.band_width_deg);
+    const double hi = last ? out.max_angle_deg : lo + options.band_width_deg;
     std::vector<double> radial, tangential;
     for (const Sample& s : samples) {
-      const bool last = b + 1 == angle_bins;
       if (s.angle_deg >= lo &&
           (s.angle_deg < hi || (last && s.angle_deg <= hi))) {
         radial.push_back(s.radial);

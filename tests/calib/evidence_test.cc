@@ -280,6 +280,47 @@ TEST(CrossValidation, HalvesAgreeOnCleanData) {
   }
 }
 
+// Field-angle bins cover 0 to the widest corner; a last sliver narrower than
+// a quarter of the bin width (here the one corner at 50.5 deg) joins the bin
+// before it instead of standing alone with no usable statistics.
+TEST(SystematicResiduals, AngleBinsLeaveNoSliverAtTheWidestCorner) {
+  CalibrationResult result;
+  result.camera = testing::TruthRadtan();
+  CalibrationView view;
+  std::vector<Eigen::Vector2d> residuals;
+  for (double angle_deg : {5.0, 15.0, 25.0, 35.0, 45.0, 47.0, 50.5}) {
+    const double t = std::tan(angle_deg * M_PI / 180.0);
+    view.board_points.emplace_back(t, 0.0, 1.0);
+    view.image_points.emplace_back(result.camera.params[2] + 100 * t,
+                                   result.camera.params[3] + 20 * t);
+    residuals.emplace_back(0.1, 0.0);
+  }
+  result.view_used = {true};
+  result.residuals = {residuals};
+  result.inlier = {std::vector<bool>(residuals.size(), true)};
+  result.cam_from_board = {Eigen::Isometry3d::Identity()};
+  EvidenceOptions options;
+  options.band_width_deg = 10;
+  const SystematicResiduals bins =
+      ComputeSystematicResiduals({view}, result, options);
+  ASSERT_EQ(bins.by_angle.size(), 5u);
+  int total = 0;
+  for (size_t b = 0; b < bins.by_angle.size(); ++b) {
+    EXPECT_DOUBLE_EQ(bins.by_angle[b].lo, 10.0 * b);
+    total += bins.by_angle[b].count;
+  }
+  EXPECT_NEAR(bins.by_angle.back().hi, 50.5, 1e-9);
+  EXPECT_EQ(bins.by_angle.back().count, 3);  // 45, 47 and 50.5 deg
+  EXPECT_EQ(total, 7);
+  // A wide last bin stays: up to 53 deg there are six bins.
+  const double t = std::tan(53.0 * M_PI / 180.0);
+  view.board_points.back() = Eigen::Vector3d(t, 0.0, 1.0);
+  const SystematicResiduals six =
+      ComputeSystematicResiduals({view}, result, options);
+  ASSERT_EQ(six.by_angle.size(), 6u);
+  EXPECT_EQ(six.by_angle.back().count, 1);
+}
+
 // Clean data leave residual means within a few standard errors of zero; a
 // wrong model leaves them far from it.
 TEST(SystematicResiduals, ZeroForTheRightModelNotForAWrongOne) {
