@@ -504,9 +504,7 @@ double RejectionThreshold(CalibrationState* s) {
       }
     }
   }
-  const double median = Median(coordinates);
-  for (double& c : coordinates) c = std::abs(c - median);
-  const double sigma = 1.4826 * Median(coordinates);
+  const double sigma = MedianAbsoluteDeviationSigma(coordinates);
   s->result->noise_sigma_px = sigma;
   s->result->outlier_threshold_px = std::max(
       s->options.outlier_k * sigma, s->options.min_outlier_threshold_px);

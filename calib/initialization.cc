@@ -12,21 +12,11 @@
 #include <memory>
 
 #include "calib/reprojection_error.h"
+#include "util/failure.h"
+#include "util/statistics.h"
 
 namespace puzzlecal {
 namespace {
-
-bool Fail(const std::string& message, std::string* why) {
-  if (why != nullptr) *why = message;
-  return false;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
-}
 
 // Angle between a unit ray and a direction (any length), radians.
 double AngleBetween(const Eigen::Vector3d& ray, const Eigen::Vector3d& v) {
@@ -538,7 +528,7 @@ bool EstimateBoardToRayHomography(const std::vector<Eigen::Vector2d>& board_xy,
     }
     // Floor: exact data must not lose points to rounding.
     const double threshold =
-        std::max(options.reweight_k * 1.4826 * Median(kept_errors), 1e-9);
+        std::max(options.reweight_k * RobustSigmaAboutZero(kept_errors), 1e-9);
     std::vector<bool> next(n, false);
     for (size_t i = 0; i < n; ++i) next[i] = error[i] <= threshold;
     if (next == use) break;

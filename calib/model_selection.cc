@@ -121,16 +121,16 @@ std::vector<std::vector<bool>> DetectionErrors(
     gross[v].assign(residuals[0][v].size(), true);
   }
   for (const CornerResiduals& candidate : residuals) {
-    std::vector<double> magnitudes;
+    std::vector<double> coordinates;
     for (const auto& view : candidate) {
       for (const Eigen::Vector2d& r : view) {
         if (!r.allFinite()) continue;
-        magnitudes.push_back(std::abs(r.x()));
-        magnitudes.push_back(std::abs(r.y()));
+        coordinates.push_back(r.x());
+        coordinates.push_back(r.y());
       }
     }
     const double threshold =
-        std::max(options.gross_error_k * 1.4826 * Median(magnitudes),
+        std::max(options.gross_error_k * RobustSigmaAboutZero(coordinates),
                  options.gross_error_floor_px);
     for (size_t v = 0; v < candidate.size(); ++v) {
       for (size_t i = 0; i < candidate[v].size(); ++i) {
@@ -159,7 +159,6 @@ double HoldoutRms(const CornerResiduals& residuals,
   *corners = n;
   return n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
 }
-
 
 // The candidate models: options.candidates, or every model; fisheye models
 // first (the widest field angle they see tells whether a pinhole model can

@@ -694,16 +694,16 @@ bool RejectJointOutliers(const CornerResiduals& residuals,
                          const CalibrationOptions& options, JointState* state) {
   bool changed = false;
   for (size_t c = 0; c < residuals.size(); ++c) {
-    std::vector<double> magnitudes;
+    std::vector<double> coordinates;
     for (size_t f = 0; f < residuals[c].size(); ++f) {
       for (size_t i = 0; i < residuals[c][f].size(); ++i) {
         if (!projects[c][f][i]) continue;
-        magnitudes.push_back(std::abs(residuals[c][f][i].x()));
-        magnitudes.push_back(std::abs(residuals[c][f][i].y()));
+        coordinates.push_back(residuals[c][f][i].x());
+        coordinates.push_back(residuals[c][f][i].y());
       }
     }
     const double threshold =
-        std::max(options.outlier_k * 1.4826 * Median(magnitudes),
+        std::max(options.outlier_k * RobustSigmaAboutZero(coordinates),
                  options.min_outlier_threshold_px);
     for (size_t f = 0; f < residuals[c].size(); ++f) {
       if (!state->used[c][f]) continue;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace puzzlecal {
 
@@ -30,8 +31,13 @@ double MedianAbsoluteDeviationSigma(const std::vector<double>& values) {
   for (size_t i = 0; i < values.size(); ++i) {
     deviations[i] = std::abs(values[i] - center);
   }
+  return RobustSigmaAboutZero(std::move(deviations));
+}
+
+double RobustSigmaAboutZero(std::vector<double> values) {
+  for (double& v : values) v = std::abs(v);
   // 1.4826 = 1 / Phi^-1(3/4): for Gaussian values the MAD times this is sigma.
-  return 1.4826 * Median(deviations);
+  return 1.4826 * Median(std::move(values));
 }
 
 }  // namespace puzzlecal

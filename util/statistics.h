@@ -18,6 +18,11 @@ double Quantile(std::vector<double> values, double fraction);
 // estimated robustly; 0 for no values.
 double MedianAbsoluteDeviationSigma(const std::vector<double>& values);
 
+// 1.4826 * median(|v|): the same about zero, for values whose mean is zero
+// by construction (residual coordinates) or that are non-negative errors;
+// 0 for no values.
+double RobustSigmaAboutZero(std::vector<double> values);
+
 }  // namespace puzzlecal
 
 #endif  // PUZZLECAL_UTIL_STATISTICS_H_
