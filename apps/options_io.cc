@@ -233,6 +233,7 @@ struct Fields<CalibrationOptions> {
 
 template <>
 struct Fields<InitializationOptions> {
+  // Not here: num_threads (Calibrate sets it from --threads).
   template <typename V, typename O>
   static void Visit(V& v, O& o) {
     v.Field("reweight_iterations", o.reweight_iterations);

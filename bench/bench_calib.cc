@@ -12,10 +12,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <opencv2/calib3d.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/calib3d.hpp>
 
 #include "calib/calibrate.h"
 #include "tests/calib/opencv_reference.h"
@@ -57,8 +56,7 @@ SyntheticScene Scene(CameraModelId model, int views, int cols, int rows) {
 }
 
 double Seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                       since)
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since)
       .count();
 }
 
@@ -66,9 +64,11 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 int main(int argc, char** argv) {
   // argv[1]: repeats per problem size (default 3); argv[2]: largest number
-  // of views to time (default 300).
+  // of views to time (default 300); argv[3]: only the timing cases of this
+  // model (e.g. kannala-brandt, to profile one case; default all).
   const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
   const int max_views = argc > 2 ? std::atoi(argv[2]) : 300;
+  const std::string only_model = argc > 3 ? argv[3] : "";
   std::printf("{\n  \"timing\": [\n");
   const int view_counts[] = {20, 100, 300};
   const int boards[][2] = {{11, 8}, {23, 16}};
@@ -96,6 +96,10 @@ int main(int argc, char** argv) {
   }
   for (const Case& c : cases) {
     if (c.views > max_views) continue;
+    if (!only_model.empty() &&
+        only_model != puzzlecal::CameraModelName(c.model)) {
+      continue;
+    }
     const CameraModelId model = c.model;
     CalibrationOptions options;
     options.compute_covariance = c.covariance;
@@ -112,8 +116,7 @@ int main(int argc, char** argv) {
       const auto start = std::chrono::steady_clock::now();
       const std::clock_t cpu_start = std::clock();
       ok &= puzzlecal::Calibrate(data.views, model, scene.camera.width,
-                                 scene.camera.height, options, &result,
-                                 &error);
+                                 scene.camera.height, options, &result, &error);
       cpu_times.push_back(static_cast<double>(std::clock() - cpu_start) /
                           CLOCKS_PER_SEC);
       times.push_back(Seconds(start));
@@ -125,19 +128,19 @@ int main(int argc, char** argv) {
     std::sort(cpu_times.begin(), cpu_times.end());
     std::sort(init_times.begin(), init_times.end());
     std::sort(solve_times.begin(), solve_times.end());
-    std::printf("%s    {\"model\": \"%s\", \"covariance\": %s, "
-                "\"threads\": %d, \"views\": %d, "
-                "\"corners_per_board\": %d, \"corners\": %d, \"ok\": %s, "
-                "\"runs\": %d, \"best_s\": %.3f, \"median_s\": %.3f, "
-                "\"best_cpu_s\": %.3f, \"init_s\": %.3f, "
-                "\"solve_and_covariance_s\": %.3f, "
-                "\"iterations\": %d, \"rms_px\": %.4f}",
-                first ? "" : ",\n", puzzlecal::CameraModelName(model),
-                c.covariance ? "true" : "false", c.threads, c.views,
-                c.cols * c.rows, data.num_corners, ok ? "true" : "false", runs,
-                times.front(), times[times.size() / 2], cpu_times.front(),
-                init_times.front(), solve_times.front(), result.iterations,
-                result.rms_px);
+    std::printf(
+        "%s    {\"model\": \"%s\", \"covariance\": %s, "
+        "\"threads\": %d, \"views\": %d, "
+        "\"corners_per_board\": %d, \"corners\": %d, \"ok\": %s, "
+        "\"runs\": %d, \"best_s\": %.3f, \"median_s\": %.3f, "
+        "\"best_cpu_s\": %.3f, \"init_s\": %.3f, "
+        "\"solve_and_covariance_s\": %.3f, "
+        "\"iterations\": %d, \"rms_px\": %.4f}",
+        first ? "" : ",\n", puzzlecal::CameraModelName(model),
+        c.covariance ? "true" : "false", c.threads, c.views, c.cols * c.rows,
+        data.num_corners, ok ? "true" : "false", runs, times.front(),
+        times[times.size() / 2], cpu_times.front(), init_times.front(),
+        solve_times.front(), result.iterations, result.rms_px);
     first = false;
     std::fflush(stdout);
   }
@@ -176,22 +179,24 @@ int main(int argc, char** argv) {
             data.views, model, scene.camera.width, scene.camera.height);
     const double cv_seconds = Seconds(cv_start);
     auto row = [&](const char* who, bool converged,
-                   const std::vector<double>& q, double rms_point,
-                   double secs, const std::string& note) {
-      std::printf("%s    {\"model\": \"%s\", \"solver\": \"%s\", "
-                  "\"ok\": %s",
-                  first ? "" : ",\n", puzzlecal::CameraModelName(model), who,
-                  converged ? "true" : "false");
+                   const std::vector<double>& q, double rms_point, double secs,
+                   const std::string& note) {
+      std::printf(
+          "%s    {\"model\": \"%s\", \"solver\": \"%s\", "
+          "\"ok\": %s",
+          first ? "" : ",\n", puzzlecal::CameraModelName(model), who,
+          converged ? "true" : "false");
       first = false;
       if (converged && q.size() >= 4) {
-        std::printf(", \"dfx_rel_pct\": %.4f, \"dfy_rel_pct\": %.4f, "
-                    "\"dcx_px\": %.3f, \"dcy_px\": %.3f, "
-                    "\"rms_point_px\": %.5f, \"rms_over_floor\": %.4f, "
-                    "\"seconds\": %.3f",
-                    100 * std::abs(q[0] - t[0]) / t[0],
-                    100 * std::abs(q[1] - t[1]) / t[1], std::abs(q[2] - t[2]),
-                    std::abs(q[3] - t[3]), rms_point,
-                    rms_point / std::sqrt(2.0) / floor, secs);
+        std::printf(
+            ", \"dfx_rel_pct\": %.4f, \"dfy_rel_pct\": %.4f, "
+            "\"dcx_px\": %.3f, \"dcy_px\": %.3f, "
+            "\"rms_point_px\": %.5f, \"rms_over_floor\": %.4f, "
+            "\"seconds\": %.3f",
+            100 * std::abs(q[0] - t[0]) / t[0],
+            100 * std::abs(q[1] - t[1]) / t[1], std::abs(q[2] - t[2]),
+            std::abs(q[3] - t[3]), rms_point,
+            rms_point / std::sqrt(2.0) / floor, secs);
       }
       if (!note.empty()) {
         std::string clean = note;

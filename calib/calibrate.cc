@@ -251,9 +251,11 @@ bool Initialise(CalibrationState* s) {
   }
   InitializationResult init;
   std::string why;
+  InitializationOptions init_options = s->options.initialization;
+  init_options.num_threads = s->options.num_threads;
   if (!InitializeCalibration(clean, s->view_used, s->model, s->width, s->height,
-                             s->options.initial_params,
-                             s->options.initialization, &init, &why)) {
+                             s->options.initial_params, init_options, &init,
+                             &why)) {
     return Fail("initialisation failed: " + why, s->error);
   }
   s->result->initialization_method = init.method;

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "util/failure.h"
+#include "util/parallel_for.h"
 
 namespace puzzlecal {
 namespace {
@@ -499,18 +500,29 @@ bool CalibrateHalves(const std::vector<CalibrationView>& views,
   CalibrationOptions half_options = calibration;
   half_options.initial_params = camera.params;
   half_options.compute_covariance = true;
+  // The two halves side by side, each on its share of the threads (a
+  // calibration's result does not depend on its thread count).
+  const int workers = std::min(2, std::max(1, calibration.num_threads));
+  half_options.num_threads = std::max(1, calibration.num_threads / workers);
+  std::vector<CalibrationView> half[2] = {Half(views, result, 0),
+                                          Half(views, result, 1)};
+  out->views_a = static_cast<int>(half[0].size());
+  out->views_b = static_cast<int>(half[1].size());
+  std::string error[2];
+  char ok[2] = {0, 0};
+  ParallelFor(2, workers, [&](int h) {
+    ok[h] = Calibrate(half[h], camera.model, camera.width, camera.height,
+                      half_options, &halves[h], &error[h]);
+  });
   for (int h = 0; h < 2; ++h) {
-    const std::vector<CalibrationView> half = Half(views, result, h);
-    (h == 0 ? out->views_a : out->views_b) = static_cast<int>(half.size());
-    std::string error;
-    if (!Calibrate(half, camera.model, camera.width, camera.height,
-                   half_options, &halves[h], &error)) {
-      out->error = std::string("half ") + (h == 0 ? "A" : "B") + " (" +
-                   std::to_string(half.size()) + " views): " + error;
+    const std::string name = h == 0 ? "A" : "B";
+    if (!ok[h]) {
+      out->error = "half " + name + " (" + std::to_string(half[h].size()) +
+                   " views): " + error[h];
       return false;
     }
     if (!halves[h].covariance_ok) {
-      out->error = std::string("half ") + (h == 0 ? "A" : "B") +
+      out->error = "half " + name +
                    ": no covariance (the half does not determine the model)";
       return false;
     }

@@ -13,6 +13,7 @@
 
 #include "calib/reprojection_error.h"
 #include "util/failure.h"
+#include "util/parallel_for.h"
 #include "util/statistics.h"
 
 namespace puzzlecal {
@@ -139,23 +140,28 @@ double ViewFitCost(const Camera& camera,
                    const InitializationOptions& options) {
   const double truncation2 =
       options.focal_search_truncation_px * options.focal_search_truncation_px;
-  double cost = 0;
-  for (const CalibrationView* view : views) {
+  std::vector<double> view_cost(views.size(), 0.0);
+  ParallelFor(static_cast<int>(views.size()), options.num_threads, [&](int v) {
+    const CalibrationView& view = *views[v];
     Eigen::Isometry3d pose;
-    if (!PoseFromRays(camera, *view, options, &pose, nullptr)) {
-      cost += truncation2 * view->board_points.size();
-      continue;
+    if (!PoseFromRays(camera, view, options, &pose, nullptr)) {
+      view_cost[v] = truncation2 * view.board_points.size();
+      return;
     }
-    for (size_t i = 0; i < view->board_points.size(); ++i) {
+    double cost = 0;
+    for (size_t i = 0; i < view.board_points.size(); ++i) {
       Eigen::Vector2d pixel;
       double e2 = truncation2;
-      if (camera.Project(pose * view->board_points[i], &pixel)) {
-        e2 = std::min(e2, (pixel - view->image_points[i]).squaredNorm());
+      if (camera.Project(pose * view.board_points[i], &pixel)) {
+        e2 = std::min(e2, (pixel - view.image_points[i]).squaredNorm());
       }
       if (!std::isfinite(e2)) e2 = truncation2;
       cost += e2;
     }
-  }
+    view_cost[v] = cost;
+  });
+  double cost = 0;
+  for (double c : view_cost) cost += c;  // in view order: thread-independent
   return cost;
 }
 
@@ -417,6 +423,9 @@ bool RefineStartOnSubset(const std::vector<const CalibrationView*>& views,
 }  // namespace
 
 bool InitializationOptions::Check(std::string* why) const {
+  if (num_threads < 1) {
+    return Fail("initialization.num_threads must be >= 1", why);
+  }
   if (reweight_iterations < 0) {
     return Fail("initialization.reweight_iterations must be >= 0", why);
   }
@@ -609,19 +618,24 @@ void PoseAllViews(const Camera& camera,
   result->view_ok.assign(views.size(), false);
   result->cam_from_board.assign(views.size(), Eigen::Isometry3d::Identity());
   result->view_reason.assign(views.size(), "");
-  for (size_t i = 0; i < views.size(); ++i) {
+  std::vector<char> ok(views.size(), 0);
+  ParallelFor(static_cast<int>(views.size()), options.num_threads, [&](int i) {
     if (!use_view[i]) {
       result->view_reason[i] = "not used";
-      continue;
+      return;
     }
     std::string view_why;
-    if (EstimateViewPose(camera, views[i], options, &result->cam_from_board[i],
-                         &view_why)) {
-      result->view_ok[i] = true;
+    // view_ok is a vector<bool>, whose bits share words: the threads write
+    // `ok`, copied into it afterwards.
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    if (EstimateViewPose(camera, views[i], options, &pose, &view_why)) {
+      result->cam_from_board[i] = pose;
+      ok[i] = 1;
     } else {
       result->view_reason[i] = view_why;
     }
-  }
+  });
+  for (size_t i = 0; i < views.size(); ++i) result->view_ok[i] = ok[i] != 0;
 }
 
 // An evenly spread subset of at most `max_views` of `used`.

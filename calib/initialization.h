@@ -81,8 +81,13 @@ struct InitializationOptions {
   // Huber scale of the start refinement, pixels. Default 2.
   double start_refine_loss_px = 2.0;
   // Pose-refinement iterations (as pose_refine_iterations) for every view
-  // after a successful start refinement. Default 0 (the homography pose through the refined camera is close enough).
+  // after a successful start refinement. Default 0 (the homography pose through
+  // the refined camera is close enough).
   int start_refine_pose_iterations = 0;
+  // Worker threads for the focal-length search and the per-view poses; the
+  // result is the same for any count (each view's work has its own slot).
+  // Calibrate sets it from CalibrationOptions::num_threads. Default 1.
+  int num_threads = 1;
 
   bool Check(std::string* why) const;
 };
