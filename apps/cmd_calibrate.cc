@@ -495,8 +495,9 @@ void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
               << run.evidence.cross_validation.seconds << " s)\n";
     std::cout << std::setprecision(3) << "time: " << seconds_total
               << " s wall clock on " << request.threads
-              << " threads; summed over images: image decoding "
-              << run.seconds_load << " s, detection " << run.seconds_detect
+              << (request.threads == 1 ? " thread" : " threads")
+              << "; summed over images: image decoding " << run.seconds_load
+              << " s, detection " << run.seconds_detect
               << " s, grid and decode " << run.seconds_grid_decode
               << " s; calibration " << run.seconds_calibrate << " s\n";
   }

@@ -287,7 +287,8 @@ void PrintRigOutcome(const RigCalibrationResult& result,
               << "\n";
   }
   std::cout << "time: " << seconds_total << " s wall clock on " << threads
-            << " threads (images " << seconds_images << " s, calibration "
+            << (threads == 1 ? " thread" : " threads") << " (images "
+            << seconds_images << " s, calibration "
             << result.seconds_single + result.seconds_joint << " s)\n";
   for (const std::string& path : written) std::cout << "wrote " << path << "\n";
 }

@@ -227,6 +227,10 @@ struct Fields<CalibrationOptions> {
     v.Field("max_rms_px", o.max_rms_px);
     v.Field("staged_distortion", o.staged_distortion);
     v.Field("compute_covariance", o.compute_covariance);
+    v.Field("far_field_start_function_tolerance",
+            o.far_field_start_function_tolerance);
+    v.Field("far_field_start_outlier_iterations",
+            o.far_field_start_outlier_iterations);
     v.Group("initialization", o.initialization);
   }
 };

@@ -802,6 +802,8 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
   const std::vector<std::string> far_names = CameraModelParamNames(far.model);
   CalibrationOptions central = *options;
   central.compute_covariance = false;
+  central.function_tolerance = options->far_field_start_function_tolerance;
+  central.outlier_iterations = options->far_field_start_outlier_iterations;
   central.fixed_params.clear();
   for (const std::string& name : options->fixed_params) {
     if (std::find(far_names.begin(), far_names.end(), name) !=
@@ -885,6 +887,12 @@ bool CalibrationOptions::Check(std::string* why) const {
   if (!(outlier_k >= 0)) return Fail("outlier_k must be >= 0", why);
   if (outlier_iterations < 0) {
     return Fail("outlier_iterations must be >= 0", why);
+  }
+  if (!(far_field_start_function_tolerance > 0)) {
+    return Fail("far_field_start_function_tolerance must be > 0", why);
+  }
+  if (far_field_start_outlier_iterations < 0) {
+    return Fail("far_field_start_outlier_iterations must be >= 0", why);
   }
   if (max_iterations < 1) return Fail("max_iterations must be >= 1", why);
   if (coarse_stride < 1) return Fail("coarse_stride must be >= 1", why);

@@ -134,6 +134,14 @@ struct CalibrationOptions {
   bool staged_distortion = false;
   // Compute the parameter covariance and standard deviations. Default true.
   bool compute_covariance = true;
+  // A non-central model starts from a calibration of its central far-field
+  // model. That is only a start, so it stops at this relative cost change
+  // (instead of function_tolerance) and runs this many outlier-rejection
+  // rounds (instead of outlier_iterations): on a lens the central model
+  // cannot follow, its convergence is slow, and a full-precision central
+  // solve would cost more than the non-central one. Defaults 1e-6 and 0.
+  double far_field_start_function_tolerance = 1e-6;
+  int far_field_start_outlier_iterations = 0;
 
   InitializationOptions initialization;
 
