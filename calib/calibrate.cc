@@ -669,6 +669,7 @@ void ComputeCovariance(CalibrationState* s) {
       !(2 * corners > s->free_params) || !s->summary.IsSolutionUsable()) {
     return;
   }
+  const Timer timer;
   Eigen::MatrixXd block;
   bool ok;
   if (s->options.deterministic) {
@@ -681,6 +682,7 @@ void ComputeCovariance(CalibrationState* s) {
   } else {
     ok = CeresCovariance<Model>(s, &block);
   }
+  r->covariance_seconds = timer.Seconds();
   if (!ok) return;
   const double variance = s->sum2 / (2.0 * corners - s->free_params);
   r->covariance = block * variance;

@@ -206,8 +206,12 @@ struct CalibrationResult {
   double outlier_threshold_px = 0;
   int outlier_rounds = 0;  // solves after the first one
   int iterations = 0;      // Levenberg-Marquardt iterations, all solves
+  // Seconds from the start of Calibrate: to the end of the initialisation,
+  // and to the end of the solve and the covariance; and the covariance step
+  // alone.
   double solve_seconds = 0;
   double initialization_seconds = 0;
+  double covariance_seconds = 0;
   std::string initialization_method;
   double orientation_spread_deg = 0;
   double coverage = 0;      // fraction of coverage-grid cells with corners
