@@ -431,9 +431,11 @@ class DetectionPass {
   void MakeBlurKernels();
   void BuildCoarseLevels();
   void BlurRows(int a, int b, cv::Mat* out) const;
+  void BlurRowsInto(int a, int first, int last, cv::Mat* out) const;
 
   void DetectLevel0Streamed();
-  void DetectBand(int y0, int y1, int halo, std::vector<Level0Peak>* kept);
+  void DetectBand(int y0, int y1, int halo, int reach,
+                  std::vector<Level0Peak>* kept);
   void ApplyLevel0Threshold(const std::vector<Level0Peak>& kept);
   void DetectLevel(int level);
   bool FilterPeak(const cv::Mat& level_image, int y_offset,
@@ -611,31 +613,55 @@ void DetectionPass::BlurRows(int a, int b, cv::Mat* out) const {
   }
 }
 
+// The same for rows [first, last) only, into the rows of `out` (already
+// holding the band's rows from `a` on) that they occupy there.
+void DetectionPass::BlurRowsInto(int a, int first, int last,
+                                 cv::Mat* out) const {
+  cv::Mat rows = out->rowRange(first - a, last - a);
+  const uchar* const data = rows.data;
+  BlurRows(first, last, &rows);
+  CV_Assert(rows.data == data);  // written in place, not reallocated
+}
+
 // Level 0: peaks above the absolute threshold per band, filtered while the
 // band is in cache; the noise-adaptive threshold (from the response sampled
 // on the way) then only drops weak peaks: a peak of the whole image is a
 // peak above the lower threshold that exceeds the higher one.
 void DetectionPass::DetectLevel0Streamed() {
   // Rows around a band: response (2) + suppression radius + ring test.
+  // They fix the band's first row, the origin of the peaks' float
+  // centroids (and so their rounding).
   const int halo =
       2 + std::max(options_.nms_radius_px,
                    static_cast<int>(std::ceil(options_.ring_radius_px)) + 2);
+  // Of those, the rows that the band's peaks reach, the only ones blurred:
+  // the response's second differences (2) beyond the suppression window,
+  // and the ring test (its centre, the centroid, is within 1 px of the
+  // peak; its bilinear samples reach one more row), which also needs its
+  // circle inside the band for its inside check to agree with the whole
+  // image's; the corner mask (2) and the next level's rows (1) reach less.
+  const int reach = std::min(
+      halo, std::max(options_.nms_radius_px + 2,
+                     static_cast<int>(std::ceil(options_.ring_radius_px)) + 2));
   std::vector<Level0Peak> kept;
   b_.scratch.clear();
   for (int y0 = 0; y0 < height_; y0 += kBandRows) {
-    DetectBand(y0, std::min(y0 + kBandRows, height_), halo, &kept);
+    DetectBand(y0, std::min(y0 + kBandRows, height_), halo, reach, &kept);
   }
   ApplyLevel0Threshold(kept);
 }
 
-// Level-0 rows [y0, y1): blur (with `halo` rows around), the next level's
-// rows, response + suppression, filters.
-void DetectionPass::DetectBand(int y0, int y1, int halo,
+// Level-0 rows [y0, y1): blur (of the `reach` rows around, in a band with
+// `halo` rows around), the next level's rows, response + suppression,
+// filters.
+void DetectionPass::DetectBand(int y0, int y1, int halo, int reach,
                                std::vector<Level0Peak>* kept) {
   Clock::time_point t = Clock::now();
   const int a = std::max(0, y0 - halo);
   const int b = std::min(height_, y1 + halo);
-  BlurRows(a, b, &b_.band);
+  b_.band.create(b - a, width_, CV_32FC1);
+  BlurRowsInto(a, std::max(0, y0 - reach), std::min(height_, y1 + reach),
+               &b_.band);
   if (levels_ > 1) {
     DownsampleRows(b_.band, a, height_, (y0 + 1) / 2, (y1 + 1) / 2, &b_.row,
                    &b_.blurred[1]);

@@ -240,9 +240,13 @@ PUZZLECAL_VECTOR_CLONES int FindSaddlePeaksInRows(
   radius = std::max(radius, 1);
   const ResponseRing ring(width, radius, rows);
   const uint8_t* flags = ring.Flags();
+  // Only the response rows that the windows of rows [row_begin, row_end)
+  // reach are computed (a band's halo rows beyond them are not).
+  const int first_row = std::max(0, row_begin - radius);
+  const int last_row = std::min(height, std::max(row_end, 0) + radius);
   int above = 0;
-  for (int y_new = 0; y_new < height + radius; ++y_new) {
-    if (y_new < height) {
+  for (int y_new = first_row; y_new < last_row + radius; ++y_new) {
+    if (y_new < last_row) {
       AddResponseRow(blurred, y_new, trace_weight_k, part, row_begin, row_end,
                      ring);
     }
