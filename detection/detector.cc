@@ -335,19 +335,34 @@ struct Candidate {
   int peak_y = 0;
 };
 
-// Buckets of point indices on a square grid, for radius queries.
+// Buckets of point indices on a square grid, for radius queries. Each
+// cell is a list in the order of Add (flat arrays, kept between uses, so
+// a grid of many cells costs no allocation).
 class PointGrid {
  public:
-  PointGrid(double cell, int width, int height)
-      : cell_(std::max(cell, 1.0)),
-        cols_(static_cast<int>(width / cell_) + 1),
-        rows_(static_cast<int>(height / cell_) + 1),
-        cells_(static_cast<size_t>(cols_) * rows_) {}
+  // Empties the grid and sets its cells.
+  void Reset(double cell, int width, int height) {
+    cell_ = std::max(cell, 1.0);
+    cols_ = static_cast<int>(width / cell_) + 1;
+    rows_ = static_cast<int>(height / cell_) + 1;
+    head_.assign(static_cast<size_t>(cols_) * rows_, -1);
+    tail_.assign(head_.size(), -1);
+    next_.clear();
+    items_.clear();
+  }
 
   void Add(const Eigen::Vector2d& p, int index) {
-    cells_[static_cast<size_t>(CellOf(p.y(), rows_)) * cols_ +
-           CellOf(p.x(), cols_)]
-        .push_back(index);
+    const size_t cell = static_cast<size_t>(CellOf(p.y(), rows_)) * cols_ +
+                        CellOf(p.x(), cols_);
+    const int slot = static_cast<int>(items_.size());
+    items_.push_back(index);
+    next_.push_back(-1);
+    if (tail_[cell] < 0) {
+      head_[cell] = slot;
+    } else {
+      next_[tail_[cell]] = slot;
+    }
+    tail_[cell] = slot;
   }
 
   // Calls f(index) for every stored point in cells within `radius` of p
@@ -360,8 +375,9 @@ class PointGrid {
     const int cy1 = CellOf(p.y() + radius, rows_);
     for (int cy = cy0; cy <= cy1; ++cy) {
       for (int cx = cx0; cx <= cx1; ++cx) {
-        for (int index : cells_[static_cast<size_t>(cy) * cols_ + cx]) {
-          f(index);
+        for (int slot = head_[static_cast<size_t>(cy) * cols_ + cx];
+             slot >= 0; slot = next_[slot]) {
+          f(items_[slot]);
         }
       }
     }
@@ -373,10 +389,13 @@ class PointGrid {
     if (!(cell >= 0.0)) return 0;  // also NaN
     return cell >= count - 1 ? count - 1 : static_cast<int>(cell);
   }
-  double cell_;
-  int cols_;
-  int rows_;
-  std::vector<std::vector<int>> cells_;
+  double cell_ = 1.0;
+  int cols_ = 1;
+  int rows_ = 1;
+  std::vector<int> head_;   // per cell: its first slot, -1 when empty
+  std::vector<int> tail_;   // per cell: its last slot, -1 when empty
+  std::vector<int> next_;   // per slot: the next slot of its cell, or -1
+  std::vector<int> items_;  // per slot: the point index
 };
 
 // A level-0 peak above the absolute threshold, kept until the
@@ -404,6 +423,7 @@ struct CornerDetector::Buffers {
   std::vector<float> scratch;        // response and noise samples
   std::vector<ResponsePeak> peaks;   // of one band or one level
   GradientRefineScratch gradient;    // gradient-orthogonality patches
+  PointGrid grid;                    // of one merging or refinement step
 };
 
 namespace {
@@ -812,7 +832,8 @@ Candidate DetectionPass::MakeCandidate(const ResponsePeak& peak, int y_offset,
 // suppression radius (at its level) of one already taken is dropped.
 std::vector<Candidate> DetectionPass::MergeLevels() const {
   std::vector<Candidate> merged;
-  PointGrid grid(8.0 * NmsRadius(options_, 1), width_, height_);
+  PointGrid& grid = b_.grid;
+  grid.Reset(8.0 * NmsRadius(options_, 1), width_, height_);
   for (const Candidate& c : candidates_) {  // already ordered by level
     const double radius =
         std::ldexp(1.0, c.level) * NmsRadius(options_, c.level);
@@ -835,7 +856,8 @@ std::vector<Corner> DetectionPass::Refine(const std::vector<Candidate>& merged,
                                           std::vector<int>* windows) {
   const double reach =
       options_.max_window_px / options_.window_fraction_of_neighbor;
-  PointGrid neighbours(reach, width_, height_);
+  PointGrid& neighbours = b_.grid;
+  neighbours.Reset(reach, width_, height_);
   for (size_t i = 0; i < merged.size(); ++i) {
     neighbours.Add(merged[i].xy, static_cast<int>(i));
   }
@@ -919,7 +941,8 @@ std::vector<Corner> DetectionPass::DropDuplicates(
     return refined[a].response > refined[b].response;
   });
   const double merge = options_.merge_distance_px;
-  PointGrid kept_grid(std::max(merge, 1.0) * 4.0, width_, height_);
+  PointGrid& kept_grid = b_.grid;
+  kept_grid.Reset(std::max(merge, 1.0) * 4.0, width_, height_);
   std::vector<Corner> kept;
   for (int index : order) {
     const Corner& c = refined[index];
