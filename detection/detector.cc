@@ -375,8 +375,8 @@ class PointGrid {
     const int cy1 = CellOf(p.y() + radius, rows_);
     for (int cy = cy0; cy <= cy1; ++cy) {
       for (int cx = cx0; cx <= cx1; ++cx) {
-        for (int slot = head_[static_cast<size_t>(cy) * cols_ + cx];
-             slot >= 0; slot = next_[slot]) {
+        for (int slot = head_[static_cast<size_t>(cy) * cols_ + cx]; slot >= 0;
+             slot = next_[slot]) {
           f(items_[slot]);
         }
       }
