@@ -335,19 +335,34 @@ struct Candidate {
   int peak_y = 0;
 };
 
-// Buckets of point indices on a square grid, for radius queries.
+// Buckets of point indices on a square grid, for radius queries. Each
+// cell is a list in the order of Add (flat arrays, kept between uses, so
+// a grid of many cells costs no allocation).
 class PointGrid {
  public:
-  PointGrid(double cell, int width, int height)
-      : cell_(std::max(cell, 1.0)),
-        cols_(static_cast<int>(width / cell_) + 1),
-        rows_(static_cast<int>(height / cell_) + 1),
-        cells_(static_cast<size_t>(cols_) * rows_) {}
+  // Empties the grid and sets its cells.
+  void Reset(double cell, int width, int height) {
+    cell_ = std::max(cell, 1.0);
+    cols_ = static_cast<int>(width / cell_) + 1;
+    rows_ = static_cast<int>(height / cell_) + 1;
+    head_.assign(static_cast<size_t>(cols_) * rows_, -1);
+    tail_.assign(head_.size(), -1);
+    next_.clear();
+    items_.clear();
+  }
 
   void Add(const Eigen::Vector2d& p, int index) {
-    cells_[static_cast<size_t>(CellOf(p.y(), rows_)) * cols_ +
-           CellOf(p.x(), cols_)]
-        .push_back(index);
+    const size_t cell = static_cast<size_t>(CellOf(p.y(), rows_)) * cols_ +
+                        CellOf(p.x(), cols_);
+    const int slot = static_cast<int>(items_.size());
+    items_.push_back(index);
+    next_.push_back(-1);
+    if (tail_[cell] < 0) {
+      head_[cell] = slot;
+    } else {
+      next_[tail_[cell]] = slot;
+    }
+    tail_[cell] = slot;
   }
 
   // Calls f(index) for every stored point in cells within `radius` of p
@@ -360,8 +375,9 @@ class PointGrid {
     const int cy1 = CellOf(p.y() + radius, rows_);
     for (int cy = cy0; cy <= cy1; ++cy) {
       for (int cx = cx0; cx <= cx1; ++cx) {
-        for (int index : cells_[static_cast<size_t>(cy) * cols_ + cx]) {
-          f(index);
+        for (int slot = head_[static_cast<size_t>(cy) * cols_ + cx]; slot >= 0;
+             slot = next_[slot]) {
+          f(items_[slot]);
         }
       }
     }
@@ -373,10 +389,13 @@ class PointGrid {
     if (!(cell >= 0.0)) return 0;  // also NaN
     return cell >= count - 1 ? count - 1 : static_cast<int>(cell);
   }
-  double cell_;
-  int cols_;
-  int rows_;
-  std::vector<std::vector<int>> cells_;
+  double cell_ = 1.0;
+  int cols_ = 1;
+  int rows_ = 1;
+  std::vector<int> head_;   // per cell: its first slot, -1 when empty
+  std::vector<int> tail_;   // per cell: its last slot, -1 when empty
+  std::vector<int> next_;   // per slot: the next slot of its cell, or -1
+  std::vector<int> items_;  // per slot: the point index
 };
 
 // A level-0 peak above the absolute threshold, kept until the
@@ -404,6 +423,7 @@ struct CornerDetector::Buffers {
   std::vector<float> scratch;        // response and noise samples
   std::vector<ResponsePeak> peaks;   // of one band or one level
   GradientRefineScratch gradient;    // gradient-orthogonality patches
+  PointGrid grid;                    // of one merging or refinement step
 };
 
 namespace {
@@ -431,9 +451,11 @@ class DetectionPass {
   void MakeBlurKernels();
   void BuildCoarseLevels();
   void BlurRows(int a, int b, cv::Mat* out) const;
+  void BlurRowsInto(int a, int first, int last, cv::Mat* out) const;
 
   void DetectLevel0Streamed();
-  void DetectBand(int y0, int y1, int halo, std::vector<Level0Peak>* kept);
+  void DetectBand(int y0, int y1, int halo, int reach,
+                  std::vector<Level0Peak>* kept);
   void ApplyLevel0Threshold(const std::vector<Level0Peak>& kept);
   void DetectLevel(int level);
   bool FilterPeak(const cv::Mat& level_image, int y_offset,
@@ -611,38 +633,64 @@ void DetectionPass::BlurRows(int a, int b, cv::Mat* out) const {
   }
 }
 
+// The same for rows [first, last) only, into the rows of `out` (already
+// holding the band's rows from `a` on) that they occupy there.
+void DetectionPass::BlurRowsInto(int a, int first, int last,
+                                 cv::Mat* out) const {
+  cv::Mat rows = out->rowRange(first - a, last - a);
+  const uchar* const data = rows.data;
+  BlurRows(first, last, &rows);
+  CV_Assert(rows.data == data);  // written in place, not reallocated
+}
+
 // Level 0: peaks above the absolute threshold per band, filtered while the
 // band is in cache; the noise-adaptive threshold (from the response sampled
 // on the way) then only drops weak peaks: a peak of the whole image is a
 // peak above the lower threshold that exceeds the higher one.
 void DetectionPass::DetectLevel0Streamed() {
   // Rows around a band: response (2) + suppression radius + ring test.
+  // They fix the band's first row, the origin of the peaks' float
+  // centroids (and so their rounding).
   const int halo =
       2 + std::max(options_.nms_radius_px,
                    static_cast<int>(std::ceil(options_.ring_radius_px)) + 2);
+  // Of those, the rows that the band's peaks reach, the only ones blurred:
+  // the response's second differences (2) beyond the suppression window,
+  // and the ring test (its centre, the centroid, is within 1 px of the
+  // peak; its bilinear samples reach one more row), which also needs its
+  // circle inside the band for its inside check to agree with the whole
+  // image's; the corner mask (2) and the next level's rows (1) reach less.
+  const int reach = std::min(
+      halo, std::max(options_.nms_radius_px + 2,
+                     static_cast<int>(std::ceil(options_.ring_radius_px)) + 2));
   std::vector<Level0Peak> kept;
   b_.scratch.clear();
   for (int y0 = 0; y0 < height_; y0 += kBandRows) {
-    DetectBand(y0, std::min(y0 + kBandRows, height_), halo, &kept);
+    DetectBand(y0, std::min(y0 + kBandRows, height_), halo, reach, &kept);
   }
   ApplyLevel0Threshold(kept);
 }
 
-// Level-0 rows [y0, y1): blur (with `halo` rows around), the next level's
-// rows, response + suppression, filters.
-void DetectionPass::DetectBand(int y0, int y1, int halo,
+// Level-0 rows [y0, y1): blur (of the `reach` rows around, in a band with
+// `halo` rows around), the next level's rows, response + suppression,
+// filters.
+void DetectionPass::DetectBand(int y0, int y1, int halo, int reach,
                                std::vector<Level0Peak>* kept) {
-  Clock::time_point t = Clock::now();
+  // Each stage's end is the next one's start (one clock reading each: the
+  // thread's CPU clock is a system call).
+  const Clock::time_point t_blur = Clock::now();
   const int a = std::max(0, y0 - halo);
   const int b = std::min(height_, y1 + halo);
-  BlurRows(a, b, &b_.band);
+  b_.band.create(b - a, width_, CV_32FC1);
+  BlurRowsInto(a, std::max(0, y0 - reach), std::min(height_, y1 + reach),
+               &b_.band);
   if (levels_ > 1) {
     DownsampleRows(b_.band, a, height_, (y0 + 1) / 2, (y1 + 1) / 2, &b_.row,
                    &b_.blurred[1]);
   }
-  s_.ms_preprocess += MsSince(t);
+  const Clock::time_point t_response = Clock::now();
+  s_.ms_preprocess += t_response - t_blur;
 
-  t = Clock::now();
   PeakRows part;
   part.begin = y0 - a;
   part.end = y1 - a;
@@ -655,9 +703,9 @@ void DetectionPass::DetectBand(int y0, int y1, int halo,
   s_.candidates += FindSaddlePeaksInRows(
       b_.band, static_cast<float>(options_.trace_weight_k), absolute,
       options_.nms_radius_px, part, &b_.response_rows, &b_.peaks);
-  s_.ms_response += MsSince(t);
+  const Clock::time_point t_filter = Clock::now();
+  s_.ms_response += t_filter - t_response;
 
-  t = Clock::now();
   for (const ResponsePeak& peak : b_.peaks) {
     const size_t before = candidates_.size();
     bool masked = false;
@@ -665,7 +713,7 @@ void DetectionPass::DetectBand(int y0, int y1, int halo,
     kept->push_back(
         {peak.value, masked, passed ? static_cast<int>(before) : -1});
   }
-  s_.ms_filter += MsSince(t);
+  s_.ms_filter += MsSince(t_filter);
 }
 
 // The noise-adaptive threshold of level 0 from the sampled response; drops
@@ -786,7 +834,8 @@ Candidate DetectionPass::MakeCandidate(const ResponsePeak& peak, int y_offset,
 // suppression radius (at its level) of one already taken is dropped.
 std::vector<Candidate> DetectionPass::MergeLevels() const {
   std::vector<Candidate> merged;
-  PointGrid grid(8.0 * NmsRadius(options_, 1), width_, height_);
+  PointGrid& grid = b_.grid;
+  grid.Reset(8.0 * NmsRadius(options_, 1), width_, height_);
   for (const Candidate& c : candidates_) {  // already ordered by level
     const double radius =
         std::ldexp(1.0, c.level) * NmsRadius(options_, c.level);
@@ -809,7 +858,8 @@ std::vector<Corner> DetectionPass::Refine(const std::vector<Candidate>& merged,
                                           std::vector<int>* windows) {
   const double reach =
       options_.max_window_px / options_.window_fraction_of_neighbor;
-  PointGrid neighbours(reach, width_, height_);
+  PointGrid& neighbours = b_.grid;
+  neighbours.Reset(reach, width_, height_);
   for (size_t i = 0; i < merged.size(); ++i) {
     neighbours.Add(merged[i].xy, static_cast<int>(i));
   }
@@ -893,7 +943,8 @@ std::vector<Corner> DetectionPass::DropDuplicates(
     return refined[a].response > refined[b].response;
   });
   const double merge = options_.merge_distance_px;
-  PointGrid kept_grid(std::max(merge, 1.0) * 4.0, width_, height_);
+  PointGrid& kept_grid = b_.grid;
+  kept_grid.Reset(std::max(merge, 1.0) * 4.0, width_, height_);
   std::vector<Corner> kept;
   for (int index : order) {
     const Corner& c = refined[index];

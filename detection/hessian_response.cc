@@ -4,6 +4,11 @@
 #include <cstdint>
 #include <cstring>
 
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define PUZZLECAL_FLAGS_AVX2 1
+#endif
+
 #include "detection/vector_clones.h"
 
 namespace puzzlecal {
@@ -105,21 +110,32 @@ int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
 namespace {
 
 // The last 2 radius + 1 response rows and their horizontal 3-maxima, kept
-// in a ring of rows inside the caller's buffer, and one row of flags.
+// in a ring of rows inside the caller's buffer, one row of flags (a byte
+// per pixel) and the same flags as bits (bit l of byte i: pixel 8 i + l;
+// bytes up to a multiple of 8).
 class ResponseRing {
  public:
   ResponseRing(int width, int radius, std::vector<float>* buffer)
       : width_(width), ring_(2 * radius + 1) {
     const size_t row_size = static_cast<size_t>(width);
-    buffer->resize(2 * ring_ * row_size + row_size);
+    const size_t bit_bytes = BitBytes(width);
+    buffer->resize(2 * ring_ * row_size + row_size + bit_bytes / 4);
     response_ = buffer->data();
     max3_ = buffer->data() + ring_ * row_size;
     flags_ = reinterpret_cast<uint8_t*>(buffer->data() + 2 * ring_ * row_size);
+    bits_ = reinterpret_cast<uint8_t*>(buffer->data() + 2 * ring_ * row_size +
+                                       row_size);
+  }
+
+  // Bytes of the bit flags of a row: whole 64-pixel words.
+  static size_t BitBytes(int width) {
+    return (static_cast<size_t>(width) + 63) / 64 * 8;
   }
 
   float* Row(int y) const { return response_ + Offset(y); }
   float* Max3(int y) const { return max3_ + Offset(y); }
   uint8_t* Flags() const { return flags_; }
+  uint8_t* Bits() const { return bits_; }
 
  private:
   size_t Offset(int y) const {
@@ -130,6 +146,7 @@ class ResponseRing {
   float* response_;
   float* max3_;
   uint8_t* flags_;
+  uint8_t* bits_;
 };
 
 // Response row `y` into the ring, its samples for the median (see
@@ -174,6 +191,84 @@ inline int FlagLocalMaxima(const ResponseRing& ring, int y, int width,
   }
   flags[0] = 0;
   flags[width - 1] = 0;
+  return count;
+}
+
+// The byte flags of a row as bits (see ResponseRing).
+inline void PackFlags(const uint8_t* flags, int width, uint8_t* bits) {
+  const size_t bytes = ResponseRing::BitBytes(width);
+  std::memset(bits, 0, bytes);
+  int x = 0;
+  for (; x + 8 <= width; x += 8) {
+    uint64_t word;
+    std::memcpy(&word, flags + x, sizeof word);
+    // Flags are 0 or 1: the multiplication gathers byte l into bit l of
+    // the top byte (no carries).
+    bits[x / 8] = static_cast<uint8_t>(
+        ((word & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56);
+  }
+  for (; x < width; ++x) {
+    bits[x / 8] = static_cast<uint8_t>(bits[x / 8] | (flags[x] << (x % 8)));
+  }
+}
+
+#ifdef PUZZLECAL_FLAGS_AVX2
+// FlagLocalMaxima writing bits straight from the vector comparisons (the
+// same comparisons, so the same flags and count).
+__attribute__((target("avx2"))) int FlagLocalMaximaBitsAvx2(
+    const ResponseRing& ring, int y, int width, float threshold) {
+  const float* __restrict row = ring.Row(y);
+  const float* __restrict m_up = ring.Max3(y - 1);
+  const float* __restrict m_row = ring.Max3(y);
+  const float* __restrict m_down = ring.Max3(y + 1);
+  uint8_t* __restrict bits = ring.Bits();
+  std::memset(bits, 0, ResponseRing::BitBytes(width));
+  const __m256 t = _mm256_set1_ps(threshold);
+  int count = 0;
+  int x = 0;
+  for (; x + 8 <= width; x += 8) {
+    const __m256 v = _mm256_loadu_ps(row + x);
+    // std::max(a, b) is b when a < b, else a: _mm256_max_ps(b, a).
+    const __m256 m = _mm256_max_ps(
+        _mm256_loadu_ps(m_down + x),
+        _mm256_max_ps(_mm256_loadu_ps(m_row + x), _mm256_loadu_ps(m_up + x)));
+    const __m256 is_above = _mm256_cmp_ps(v, t, _CMP_GT_OQ);
+    const __m256 is_max = _mm256_cmp_ps(v, m, _CMP_GE_OQ);
+    count += __builtin_popcount(_mm256_movemask_ps(is_above));
+    bits[x / 8] = static_cast<uint8_t>(
+        _mm256_movemask_ps(_mm256_and_ps(is_above, is_max)));
+  }
+  for (; x < width; ++x) {
+    const float v = row[x];
+    const float m = std::max(std::max(m_up[x], m_row[x]), m_down[x]);
+    const int is_above = v > threshold;
+    count += is_above;
+    bits[x / 8] =
+        static_cast<uint8_t>(bits[x / 8] | ((is_above & (v >= m)) << (x % 8)));
+  }
+  // Pixels 0 and width - 1 are never flagged nor counted.
+  count -= (row[0] > threshold) + (row[width - 1] > threshold);
+  bits[0] = static_cast<uint8_t>(bits[0] & ~1u);
+  const int last = width - 1;
+  bits[last / 8] = static_cast<uint8_t>(bits[last / 8] & ~(1u << (last % 8)));
+  return count;
+}
+
+bool HasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+#endif
+
+// The flags of row y as bits (ring.Bits()); returns the number of pixels
+// above the threshold (see FlagLocalMaxima).
+inline int FlagLocalMaximaBits(const ResponseRing& ring, int y, int width,
+                               float threshold) {
+#ifdef PUZZLECAL_FLAGS_AVX2
+  if (HasAvx2()) return FlagLocalMaximaBitsAvx2(ring, y, width, threshold);
+#endif
+  const int count = FlagLocalMaxima(ring, y, width, threshold);
+  PackFlags(ring.Flags(), width, ring.Bits());
   return count;
 }
 
@@ -239,28 +334,34 @@ PUZZLECAL_VECTOR_CLONES int FindSaddlePeaksInRows(
   const int row_end = std::min(part.end, height);
   radius = std::max(radius, 1);
   const ResponseRing ring(width, radius, rows);
-  const uint8_t* flags = ring.Flags();
+  const uint8_t* bits = ring.Bits();
+  const int bit_bytes = static_cast<int>(ResponseRing::BitBytes(width));
+  // Only the response rows that the windows of rows [row_begin, row_end)
+  // reach are computed (a band's halo rows beyond them are not).
+  const int first_row = std::max(0, row_begin - radius);
+  const int last_row = std::min(height, std::max(row_end, 0) + radius);
   int above = 0;
-  for (int y_new = 0; y_new < height + radius; ++y_new) {
-    if (y_new < height) {
+  for (int y_new = first_row; y_new < last_row + radius; ++y_new) {
+    if (y_new < last_row) {
       AddResponseRow(blurred, y_new, trace_weight_k, part, row_begin, row_end,
                      ring);
     }
     const int y = y_new - radius;  // the row whose window is complete
     if (y < 1 || y > height - 2 || y < row_begin || y >= row_end) continue;
-    above += FlagLocalMaxima(ring, y, width, threshold);
+    above += FlagLocalMaximaBits(ring, y, width, threshold);
     const float* row = ring.Row(y);
-    for (int x8 = 0; x8 < width; x8 += 8) {
-      // Skip eight flags at once (almost all are zero).
-      if (x8 + 8 <= width) {
-        uint64_t word;
-        std::memcpy(&word, flags + x8, sizeof word);
-        if (word == 0) continue;
-      }
-      for (int x = x8; x < std::min(x8 + 8, width); ++x) {
-        if (flags[x] &&
-            IsWindowMaximum(ring, x, y, row[x], radius, width, height)) {
-          peaks->push_back(PeakAt(ring, x, y, row[x]));
+    for (int i0 = 0; i0 < bit_bytes; i0 += 8) {
+      // Skip 64 flags at once (almost all are zero); then the flagged
+      // pixels in scan order.
+      uint64_t word;
+      std::memcpy(&word, bits + i0, sizeof word);
+      if (word == 0) continue;
+      for (int i = i0; i < i0 + 8; ++i) {
+        for (unsigned byte = bits[i]; byte != 0; byte &= byte - 1) {
+          const int x = 8 * i + __builtin_ctz(byte);
+          if (IsWindowMaximum(ring, x, y, row[x], radius, width, height)) {
+            peaks->push_back(PeakAt(ring, x, y, row[x]));
+          }
         }
       }
     }
