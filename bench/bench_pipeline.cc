@@ -21,6 +21,12 @@
 // a shared machine the wall time measures the neighbours too; on two free
 // cores two threads take at least half their CPU time). Prints JSON.
 //
+// Then the calibration of the folder's views (from the 2-thread run) on 2
+// threads with kannala-brandt and kannala-brandt-noncentral (the models of
+// a fisheye folder), as `calibrate` runs it: the solve and the evidence
+// (cross-validation halves), their seconds and iterations, and the whole
+// `calibrate` per photo (the 2-thread folder run plus both) against SB.
+//
 // Usage: bench_pipeline [folder] [sb_photos] [cols rows]
 //   folder: default the deltille photos (skipped with a message when
 //   absent); sb_photos: photos given to findChessboardCornersSB (default
@@ -40,6 +46,8 @@
 #include <string>
 #include <vector>
 
+#include "calib/calibrate.h"
+#include "calib/evidence.h"
 #include "decode/board.h"
 #include "decode/decoder.h"
 #include "detection/detector.h"
@@ -168,16 +176,51 @@ struct FolderRun {
 };
 
 FolderRun RunFolder(const std::vector<std::string>& files, const Board& board,
-                    const PipelineOptions& options, int threads) {
+                    const PipelineOptions& options, int threads,
+                    std::vector<ImageResult>* results_out = nullptr) {
   FolderRun run;
   const double wall = WallMs(), cpu = ProcessMs();
-  const std::vector<ImageResult> results =
+  std::vector<ImageResult> results =
       ProcessImageFiles(files, board, options, threads);
   run.wall_ms = (WallMs() - wall) / files.size();
   run.cpu_ms = (ProcessMs() - cpu) / files.size();
   for (const ImageResult& r : results) {
     run.usable += r.outcome == ImageOutcome::kUsable ? 1 : 0;
   }
+  if (results_out != nullptr) *results_out = std::move(results);
+  return run;
+}
+
+// One model's calibration of the views on `threads` threads, then its
+// evidence, as `calibrate` runs them (wall seconds).
+struct CalibrationRun {
+  bool ok = false;
+  double calibrate_s = 0, evidence_s = 0;
+  int iterations = 0;
+  double rms_px = 0;
+};
+
+CalibrationRun RunCalibration(const std::vector<CalibrationView>& views,
+                              CameraModelId model, int width, int height,
+                              int threads) {
+  CalibrationRun run;
+  CalibrationOptions options;
+  options.num_threads = threads;
+  CalibrationResult result;
+  std::string error;
+  double t = WallMs();
+  run.ok = Calibrate(views, model, width, height, options, &result, &error);
+  run.calibrate_s = (WallMs() - t) * 1e-3;
+  if (!run.ok) {
+    std::fprintf(stderr, "%s: %s\n", CameraModelName(model), error.c_str());
+    return run;
+  }
+  run.iterations = result.iterations;
+  run.rms_px = result.rms_px;
+  t = WallMs();
+  const Evidence evidence =
+      ComputeEvidence(views, result, options, EvidenceOptions());
+  run.evidence_s = (WallMs() - t) * 1e-3;
   return run;
 }
 
@@ -237,7 +280,17 @@ int main(int argc, char** argv) {
   const double sb = Median(sb_ms);
   const double photo_to_ids = Median(to_ids);
   const FolderRun one = RunFolder(listing.images, board, options, 1);
-  const FolderRun two = RunFolder(listing.images, board, options, 2);
+  std::vector<ImageResult> results;
+  const FolderRun two = RunFolder(listing.images, board, options, 2, &results);
+  int width = 0, height = 0;
+  const std::vector<CalibrationView> views =
+      MakeCalibrationViews(board, &results, &width, &height);
+  const CameraModelId models[] = {CameraModelId::kKannalaBrandt,
+                                  CameraModelId::kKannalaBrandtNoncentral};
+  CalibrationRun calibration[2];
+  for (int m = 0; m < 2; ++m) {
+    calibration[m] = RunCalibration(views, models[m], width, height, 2);
+  }
   std::printf("{\n  \"folder_photos\": %zu,\n", listing.images.size());
   std::printf("  \"median_corners\": %.0f, \"median_ids\": %.0f,\n",
               Median(corners), Median(ids));
@@ -261,6 +314,22 @@ int main(int argc, char** argv) {
       "\"usable\": [%d, %d]},\n",
       one.wall_ms, one.cpu_ms, two.wall_ms, two.cpu_ms, two.cpu_ms / 2,
       one.usable, two.usable);
+  std::printf("  \"calibration_threads_2\": [\n");
+  std::vector<double> whole_ms(2);
+  for (int m = 0; m < 2; ++m) {
+    const CalibrationRun& c = calibration[m];
+    whole_ms[m] = two.wall_ms +
+                  1e3 * (c.calibrate_s + c.evidence_s) / listing.images.size();
+    std::printf(
+        "    {\"model\": \"%s\", \"ok\": %s, \"views\": %zu, "
+        "\"calibrate_s\": %.3f, \"iterations\": %d, \"rms_px\": %.4f, "
+        "\"evidence_s\": %.3f, \"whole_calibrate_ms_per_photo\": %.2f, "
+        "\"whole_calibrate_speedup_over_sb\": %.1f}%s\n",
+        CameraModelName(models[m]), c.ok ? "true" : "false", views.size(),
+        c.calibrate_s, c.iterations, c.rms_px, c.evidence_s, whole_ms[m],
+        sb / whole_ms[m], m == 0 ? "," : "");
+  }
+  std::printf("  ],\n");
   std::printf(
       "  \"speedup_over_sb\": {\"photo_to_ids_one_thread\": %.1f, "
       "\"detect_only\": %.1f, \"folder_threads_1_wall\": %.1f, "
