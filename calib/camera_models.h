@@ -12,14 +12,13 @@
 // - pixels: the centre of the top-left pixel is (0, 0);
 // - every model's parameters start with fx fy cx cy; the rest is distortion.
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace puzzlecal {
 
@@ -53,6 +52,13 @@ struct UnprojectStatus {
 };
 
 namespace internal {
+
+// The plain value of a double or of a ceres::Jet (its scalar part `a`).
+inline double ScalarPart(double x) { return x; }
+template <typename T>
+double ScalarPart(const T& x) {
+  return x.a;
+}
 
 // Pinhole with OpenCV's rational radial + tangential distortion. `Rational`
 // selects the 12-parameter form (k4 k5 k6 in the denominator).
@@ -130,7 +136,8 @@ struct PinholeDistorted {
         std::hypot((fx - xd) * params[0], (fy - yd) * params[1]);
     // A solution past the fold of the distortion (where the mapping turns
     // back, Jacobian determinant <= 0) is not the lens' ray for this pixel.
-    const double det = (fx_dx - fx) * (fy_dy - fy) - (fx_dy - fx) * (fy_dx - fy);
+    const double det =
+        (fx_dx - fx) * (fy_dy - fy) - (fx_dy - fx) * (fy_dx - fy);
     // The same holds for a solution on the far side of the centre (the
     // radial factor turned negative).
     const bool same_side = x * xd + y * yd >= 0;
@@ -227,8 +234,7 @@ struct KannalaBrandtModel {
     constexpr int kMaxIterations = 50;
     for (int it = 0; it < kMaxIterations; ++it) {
       status.iterations = it + 1;
-      const double t2 = theta * theta, t4 = t2 * t2, t6 = t4 * t2,
-                   t8 = t4 * t4;
+      const double t2 = theta * theta, t4 = t2 * t2, t6 = t4 * t2, t8 = t4 * t4;
       const double f = DistortTheta(params, theta) - theta_d;
       const double df = 1.0 + 3.0 * params[4] * t2 + 5.0 * params[5] * t4 +
                         7.0 * params[6] * t6 + 9.0 * params[7] * t8;
@@ -275,14 +281,14 @@ struct KannalaBrandtNoncentralModel {
   static constexpr int kNumParams = 10;
   static constexpr std::array<const char*, kNumParams> kParamNames = {
       "fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4", "e1", "e2"};
-  // Newton steps of SolveTheta, always all of them, so that a value and its
-  // Jet derivatives are the same function of the input wherever they are
+  // Newton steps of SolveTheta on the plain values, always all of them, so
+  // that a value is the same function of the input wherever it is
   // evaluated. Newton starts at the central angle atan2(r, z), off by about
   // z0 sin(theta) / distance, and the error then squares each step. In the
   // hardest case noncentral_test checks (twice the measured deltille shift,
   // points 3 cm away, up to 110 degrees) the start is 0.8 rad off and the
-  // steps leave 0.24, 0.03, 5e-4, 2e-7, 4e-14, 2e-15 rad; the Jet
-  // derivative parts converge one step after the value, hence seven.
+  // steps leave 0.24, 0.03, 5e-4, 2e-7, 4e-14, 2e-15 rad: seven leave the
+  // value converged, and one more step in T carries the derivatives.
   static constexpr int kThetaIterations = 7;
 
   template <typename T>
@@ -301,17 +307,34 @@ struct KannalaBrandtNoncentralModel {
 
   // The angle theta of the ray that passes through a point at distance r > 0
   // from the axis and height z: the root of h(theta) = theta -
-  // atan2(r, z - z0(theta)) by kThetaIterations Newton steps. `residual`
-  // returns |h| and `slope` h' = 1 - r z0' / (r^2 + (z - z0)^2) at the end;
-  // slope <= 0 means the point lies inside the lens' caustic (nearer than
-  // any pupil position can be seen from), where no ray reaches it.
+  // atan2(r, z - z0(theta)), by kThetaIterations Newton steps on the plain
+  // values and one last step in T. For a ceres::Jet that last step, taken
+  // at the root, gives the derivative the implicit function theorem gives
+  // (d theta = -dh / h'), so the dual numbers go through one step instead of
+  // all of them. `residual` returns |h| and `slope` h' = 1 - r z0' / (r^2 +
+  // (z - z0)^2) at the end; slope <= 0 means the point lies inside the
+  // lens' caustic (nearer than any pupil position can be seen from), where
+  // no ray reaches it.
   template <typename T>
   static T SolveTheta(const T* params, const T& r, const T& z, T* residual,
                       T* slope) {
     using std::abs;
     using std::atan2;
-    T theta = atan2(r, z);
+    double pupil[kNumParams] = {};  // PupilZ reads only the pupil terms
+    pupil[kPupilBegin] = internal::ScalarPart(params[kPupilBegin]);
+    pupil[kPupilBegin + 1] = internal::ScalarPart(params[kPupilBegin + 1]);
+    const double r_value = internal::ScalarPart(r);
+    const double z_value = internal::ScalarPart(z);
+    double theta_value = std::atan2(r_value, z_value);
     for (int it = 0; it < kThetaIterations; ++it) {
+      const double w = z_value - PupilZ(pupil, theta_value);
+      const double h = theta_value - std::atan2(r_value, w);
+      const double dh = 1.0 - r_value * PupilZSlope(pupil, theta_value) /
+                                  (r_value * r_value + w * w);
+      theta_value = theta_value - h / dh;
+    }
+    T theta(theta_value);
+    {
       const T w = z - PupilZ(params, theta);
       const T h = theta - atan2(r, w);
       const T dh = T(1) - r * PupilZSlope(params, theta) / (r * r + w * w);
