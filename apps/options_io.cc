@@ -231,6 +231,7 @@ struct Fields<CalibrationOptions> {
             o.far_field_start_function_tolerance);
     v.Field("far_field_start_outlier_iterations",
             o.far_field_start_outlier_iterations);
+    v.Field("far_field_start_max_views", o.far_field_start_max_views);
     v.Group("initialization", o.initialization);
   }
 };

@@ -813,9 +813,18 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
       central.fixed_params.push_back(name);
     }
   }
+  const size_t max_views =
+      static_cast<size_t>(options->far_field_start_max_views);
+  std::vector<CalibrationView> spread;
+  if (max_views > 0 && views.size() > max_views) {
+    for (size_t k = 0; k < max_views; ++k) {
+      spread.push_back(views[k * views.size() / max_views]);
+    }
+  }
   CalibrationResult result;
   std::string why;
-  if (!Calibrate(views, far.model, width, height, central, &result, &why)) {
+  if (!Calibrate(spread.empty() ? views : spread, far.model, width, height,
+                 central, &result, &why)) {
     return Fail(std::string("the central ") + CameraModelName(far.model) +
                     " calibration that starts " + CameraModelName(model) +
                     " failed: " + why,
@@ -824,7 +833,11 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
   options->initial_params = result.camera.params;
   options->initial_params.resize(CameraModelNumParams(model), 0.0);
   *method = std::string("the central ") + CameraModelName(far.model) +
-            " calibration (RMS " + StringPrintf("%.3f", result.rms_px) +
+            " calibration (" +
+            (spread.empty() ? std::string("all views")
+                            : std::to_string(spread.size()) + " of " +
+                                  std::to_string(views.size()) + " views") +
+            ", RMS " + StringPrintf("%.3f", result.rms_px) +
             " px), pupil shift 0";
   return true;
 }
@@ -892,6 +905,9 @@ bool CalibrationOptions::Check(std::string* why) const {
   }
   if (!(far_field_start_function_tolerance > 0)) {
     return Fail("far_field_start_function_tolerance must be > 0", why);
+  }
+  if (far_field_start_max_views < 0) {
+    return Fail("far_field_start_max_views must be >= 0", why);
   }
   if (far_field_start_outlier_iterations < 0) {
     return Fail("far_field_start_outlier_iterations must be >= 0", why);

@@ -142,6 +142,10 @@ struct CalibrationOptions {
   // solve would cost more than the non-central one. Defaults 1e-6 and 0.
   double far_field_start_function_tolerance = 1e-6;
   int far_field_start_outlier_iterations = 0;
+  // The central start uses at most this many views, evenly spread over the
+  // input (0: all): a start needs the intrinsics roughly, not from every
+  // view. Default 32.
+  int far_field_start_max_views = 32;
 
   InitializationOptions initialization;
 
