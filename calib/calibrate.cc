@@ -817,8 +817,8 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
       static_cast<size_t>(options->far_field_start_max_views);
   std::vector<CalibrationView> spread;
   if (max_views > 0 && views.size() > max_views) {
-    for (size_t k = 0; k < max_views; ++k) {
-      spread.push_back(views[k * views.size() / max_views]);
+    for (size_t i : EvenlySpreadIndices(views.size(), max_views)) {
+      spread.push_back(views[i]);
     }
   }
   CalibrationResult result;

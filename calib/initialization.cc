@@ -641,10 +641,9 @@ void PoseAllViews(const Camera& camera,
 // An evenly spread subset of at most `max_views` of `used`.
 std::vector<const CalibrationView*> SpreadSubset(
     const std::vector<const CalibrationView*>& used, int max_views) {
-  if (static_cast<int>(used.size()) <= max_views) return used;
   std::vector<const CalibrationView*> subset;
-  for (int k = 0; k < max_views; ++k) {
-    subset.push_back(used[static_cast<size_t>(k) * used.size() / max_views]);
+  for (size_t i : EvenlySpreadIndices(used.size(), max_views)) {
+    subset.push_back(used[i]);
   }
   return subset;
 }
@@ -717,11 +716,10 @@ void RefineStart(const std::vector<CalibrationView>& views,
   }
   std::vector<const CalibrationView*> subset;
   std::vector<Eigen::Isometry3d> subset_poses;
-  const size_t want = std::min<size_t>(
-      posed.size(), static_cast<size_t>(options.start_refine_max_views));
-  for (size_t k = 0; k < want; ++k) {
-    subset.push_back(posed[k * posed.size() / want]);
-    subset_poses.push_back(posed_poses[k * posed.size() / want]);
+  for (size_t i :
+       EvenlySpreadIndices(posed.size(), options.start_refine_max_views)) {
+    subset.push_back(posed[i]);
+    subset_poses.push_back(posed_poses[i]);
   }
   Camera refined = *camera;
   int iterations = 0;

@@ -17,10 +17,10 @@
 #include <algorithm>
 #include <array>
 #include <memory>
-#include <thread>
 #include <vector>
 
 #include "calib/reprojection_error.h"
+#include "util/parallel_for.h"
 
 namespace puzzlecal {
 
@@ -37,8 +37,7 @@ class ParallelReprojection : public ceres::EvaluationCallback {
   // problem takes ownership of it, this object must outlive the problem.
   ceres::CostFunction* Add(const Eigen::Vector3d& board_point,
                            const Eigen::Vector2d& pixel, const double* pose) {
-    corners_.emplace_back(
-        ReprojectionError<Model>::Create(board_point, pixel));
+    corners_.emplace_back(ReprojectionError<Model>::Create(board_point, pixel));
     poses_.push_back(pose);
     slots_.emplace_back();
     return new Cached(this, corners_.size() - 1);
@@ -51,17 +50,9 @@ class ParallelReprojection : public ceres::EvaluationCallback {
     }
     have_jacobians_ = evaluate_jacobians;
     const size_t n = corners_.size();
-    const int threads =
-        static_cast<int>(std::min<size_t>(num_threads_, std::max<size_t>(n, 1)));
-    std::vector<std::thread> workers;
-    for (int t = 1; t < threads; ++t) {
-      workers.emplace_back([this, t, threads, n, evaluate_jacobians] {
-        EvaluateSlice(n * t / threads, n * (t + 1) / threads,
-                      evaluate_jacobians);
-      });
-    }
-    EvaluateSlice(0, n / threads, evaluate_jacobians);
-    for (std::thread& worker : workers) worker.join();
+    // One contiguous slice of corners per thread, each corner into its slot.
+    ParallelFor(static_cast<int>(n), num_threads_,
+                [&](int i) { EvaluateCorner(i, evaluate_jacobians); });
   }
 
  private:
@@ -81,12 +72,11 @@ class ParallelReprojection : public ceres::EvaluationCallback {
         : owner_(owner), index_(index) {}
     bool Evaluate(double const* const* parameters, double* residuals,
                   double** jacobians) const override {
-      const bool jacobians_wanted = jacobians != nullptr &&
-                                    (jacobians[0] != nullptr ||
-                                     jacobians[1] != nullptr);
+      const bool jacobians_wanted =
+          jacobians != nullptr &&
+          (jacobians[0] != nullptr || jacobians[1] != nullptr);
       if (!SameValues(parameters[0], owner_->intrinsics_, kNumParams) ||
-          !SameValues(parameters[1], owner_->poses_[index_],
-                      kPoseBlockSize) ||
+          !SameValues(parameters[1], owner_->poses_[index_], kPoseBlockSize) ||
           (jacobians_wanted && !owner_->have_jacobians_)) {
         return owner_->corners_[index_]->Evaluate(parameters, residuals,
                                                   jacobians);
@@ -112,14 +102,12 @@ class ParallelReprojection : public ceres::EvaluationCallback {
     size_t index_;
   };
 
-  void EvaluateSlice(size_t begin, size_t end, bool evaluate_jacobians) {
-    for (size_t i = begin; i < end; ++i) {
-      Slot& slot = slots_[i];
-      const double* parameters[2] = {intrinsics_, poses_[i]};
-      double* jacobians[2] = {slot.d_intrinsics.data(), slot.d_pose.data()};
-      slot.ok = corners_[i]->Evaluate(parameters, slot.residual.data(),
-                                      evaluate_jacobians ? jacobians : nullptr);
-    }
+  void EvaluateCorner(size_t i, bool evaluate_jacobians) {
+    Slot& slot = slots_[i];
+    const double* parameters[2] = {intrinsics_, poses_[i]};
+    double* jacobians[2] = {slot.d_intrinsics.data(), slot.d_pose.data()};
+    slot.ok = corners_[i]->Evaluate(parameters, slot.residual.data(),
+                                    evaluate_jacobians ? jacobians : nullptr);
   }
 
   const double* intrinsics_;

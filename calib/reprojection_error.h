@@ -51,6 +51,9 @@ class ReprojectionError {
 
   // Automatic differentiation over all N + 6 values at once: the reference
   // the tests compare ReprojectionCost with.
+  const Eigen::Vector3d& board_point() const { return board_point_; }
+  const Eigen::Vector2d& observed_pixel() const { return observed_pixel_; }
+
   static ceres::CostFunction* CreateAutoDiff(
       const Eigen::Vector3d& board_point,
       const Eigen::Vector2d& observed_pixel) {
@@ -79,9 +82,7 @@ class ReprojectionCost
 
   ReprojectionCost(const Eigen::Vector3d& board_point,
                    const Eigen::Vector2d& observed_pixel)
-      : functor_(board_point, observed_pixel),
-        board_point_(board_point),
-        observed_pixel_(observed_pixel) {}
+      : functor_(board_point, observed_pixel) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
@@ -95,9 +96,10 @@ class ReprojectionCost
     using RotationJet = ceres::Jet<double, 3>;
     const RotationJet w[3] = {RotationJet(pose[0], 0), RotationJet(pose[1], 1),
                               RotationJet(pose[2], 2)};
-    const RotationJet x[3] = {RotationJet(board_point_.x()),
-                              RotationJet(board_point_.y()),
-                              RotationJet(board_point_.z())};
+    const Eigen::Vector3d& board_point = functor_.board_point();
+    const RotationJet x[3] = {RotationJet(board_point.x()),
+                              RotationJet(board_point.y()),
+                              RotationJet(board_point.z())};
     RotationJet rotated[3];
     ceres::AngleAxisRotatePoint(w, x, rotated);
     // d pixel / d (intrinsics, p), N + 3 wide.
@@ -112,8 +114,9 @@ class ReprojectionCost
     }
     ProjectionJet pixel[2];
     if (!Model::Project(params, point_cam, pixel)) return false;
-    residuals[0] = pixel[0].a - observed_pixel_.x();
-    residuals[1] = pixel[1].a - observed_pixel_.y();
+    const Eigen::Vector2d& observed = functor_.observed_pixel();
+    residuals[0] = pixel[0].a - observed.x();
+    residuals[1] = pixel[1].a - observed.y();
     for (int r = 0; r < 2; ++r) {
       if (jacobians[0] != nullptr) {
         for (int k = 0; k < kNumParams; ++k) {
@@ -137,8 +140,6 @@ class ReprojectionCost
 
  private:
   ReprojectionError<Model> functor_;
-  Eigen::Vector3d board_point_;
-  Eigen::Vector2d observed_pixel_;
 };
 
 template <typename Model>

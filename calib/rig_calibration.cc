@@ -11,10 +11,10 @@
 #include <limits>
 #include <memory>
 #include <sstream>
-#include <thread>
 
 #include "calib/reprojection_error.h"
 #include "util/failure.h"
+#include "util/parallel_for.h"
 #include "util/statistics.h"
 #include "util/string_format.h"
 #include "util/timer.h"
@@ -472,23 +472,15 @@ bool CalibrateEachCamera(const std::vector<RigCameraInput>& cameras,
   single->assign(num_cameras, CalibrationResult());
   std::vector<std::string> single_error(num_cameras);
   std::vector<char> single_ok(num_cameras, 0);
-  const int threads = std::max(
-      1, std::min<int>(options.num_threads, static_cast<int>(num_cameras)));
-  std::vector<std::thread> workers;
-  for (int t = 0; t < threads; ++t) {
-    workers.emplace_back([&, t]() {
-      for (size_t c = t; c < num_cameras; c += threads) {
-        CalibrationOptions camera_options = options;
-        camera_options.fixed_params.insert(camera_options.fixed_params.end(),
-                                           cameras[c].fixed_params.begin(),
-                                           cameras[c].fixed_params.end());
-        single_ok[c] = Calibrate(
-            cameras[c].frames, cameras[c].model, cameras[c].width,
-            cameras[c].height, camera_options, &(*single)[c], &single_error[c]);
-      }
-    });
-  }
-  for (std::thread& worker : workers) worker.join();
+  ParallelFor(static_cast<int>(num_cameras), options.num_threads, [&](int c) {
+    CalibrationOptions camera_options = options;
+    camera_options.fixed_params.insert(camera_options.fixed_params.end(),
+                                       cameras[c].fixed_params.begin(),
+                                       cameras[c].fixed_params.end());
+    single_ok[c] = Calibrate(cameras[c].frames, cameras[c].model,
+                             cameras[c].width, cameras[c].height,
+                             camera_options, &(*single)[c], &single_error[c]);
+  });
   for (size_t c = 0; c < num_cameras; ++c) {
     if (!single_ok[c]) {
       return Fail("camera '" + cameras[c].name +

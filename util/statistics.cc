@@ -40,4 +40,11 @@ double RobustSigmaAboutZero(std::vector<double> values) {
   return 1.4826 * Median(std::move(values));
 }
 
+std::vector<size_t> EvenlySpreadIndices(size_t count, size_t max_count) {
+  const size_t take = std::min(count, max_count);
+  std::vector<size_t> indices(take);
+  for (size_t k = 0; k < take; ++k) indices[k] = k * count / take;
+  return indices;
+}
+
 }  // namespace puzzlecal

@@ -3,6 +3,7 @@
 
 // Small order statistics shared by the libraries and the benches.
 
+#include <cstddef>
 #include <vector>
 
 namespace puzzlecal {
@@ -22,6 +23,11 @@ double MedianAbsoluteDeviationSigma(const std::vector<double>& values);
 // by construction (residual coordinates) or that are non-negative errors;
 // 0 for no values.
 double RobustSigmaAboutZero(std::vector<double> values);
+
+// An evenly spread sample of at most `max_count` of the indices 0 .. count-1
+// (k * count / max_count for k = 0 .. max_count-1); all of them, in order,
+// when count <= max_count.
+std::vector<size_t> EvenlySpreadIndices(size_t count, size_t max_count);
 
 }  // namespace puzzlecal
 

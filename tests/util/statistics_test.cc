@@ -34,5 +34,13 @@ TEST(StatisticsTest, MadSigmaEstimatesGaussianSigmaAndIgnoresGrossErrors) {
   EXPECT_NEAR(MedianAbsoluteDeviationSigma(values), 0.3, 0.05);
 }
 
+TEST(StatisticsTest, EvenlySpreadIndicesSampleEvenlyOrTakeAll) {
+  EXPECT_EQ(EvenlySpreadIndices(10, 5), (std::vector<size_t>{0, 2, 4, 6, 8}));
+  EXPECT_EQ(EvenlySpreadIndices(7, 3), (std::vector<size_t>{0, 2, 4}));
+  EXPECT_EQ(EvenlySpreadIndices(3, 8), (std::vector<size_t>{0, 1, 2}));
+  EXPECT_TRUE(EvenlySpreadIndices(5, 0).empty());
+  EXPECT_TRUE(EvenlySpreadIndices(0, 4).empty());
+}
+
 }  // namespace
 }  // namespace puzzlecal
