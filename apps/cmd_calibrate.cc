@@ -38,8 +38,7 @@ namespace fs = std::filesystem;
 
 constexpr char kUsage[] =
     "puzzlecal calibrate --images DIR --board BOARD.yaml --out camera.yaml\n"
-    "                    [--model pinhole-radtan|pinhole-rational|"
-    "kannala-brandt]\n"
+    "                    [--model MODEL|auto]  (MODEL: see --model below)\n"
     "                    [--format puzzlecal|opencv|ros|kalibr] "
     "[--report DIR] [--threads N]\n"
     "                    [--rostopic TOPIC] [--camera-name NAME] "

@@ -6,9 +6,15 @@
 // with Ceres threaded as well (not bit-reproducible), the time of
 // cv::stereoCalibrate on the same correspondences, and the errors against
 // the truth.
+//
+// `bench_rig seeds N` instead calibrates N draws (frames and noise seeded
+// 1..N) with the deterministic options and prints, per draw and over all,
+// the rotation and translation errors against their stated sigma: the
+// sigma is a promise only if error^2 / sigma^2 averages about 1.
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -33,6 +39,7 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 constexpr int kFrames = 40;
 constexpr int kRepeats = 3;
+constexpr double kNoisePx = 0.03;
 
 struct Timing {
   double best_seconds = 1e30;
@@ -60,24 +67,29 @@ Timing Time(const std::vector<RigCameraInput>& inputs,
     timing.best_cpu_seconds = std::min(
         timing.best_cpu_seconds,
         static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC);
-    if (!ok)
-      std::fprintf(stderr, "calibration failed: %s\n", error.c_str());
+    if (!ok) std::fprintf(stderr, "calibration failed: %s\n", error.c_str());
   }
   return timing;
 }
 
-}  // namespace
-
-int main() {
+// The bench's scene: frames in which both cameras see the whole board.
+RigSceneSpec BenchScene(uint64_t frames_seed) {
   RigSceneSpec scene = puzzlecal::StereoPinholeRig();
   scene.random_frames.count = 3 * kFrames;
+  if (frames_seed != 0) scene.random_frames.seed = frames_seed;
   scene.random_frames.min_distance_m = 1.1;
   scene.random_frames.max_distance_m = 1.4;
   scene.random_frames.max_off_axis_deg = 8;
   scene.random_frames.max_roll_deg = 20;
   scene.min_visible_corners = scene.board.NumCorners();
+  return scene;
+}
+
+// The first kFrames frames of `scene` in which both cameras see the board.
+std::vector<RigCameraInput> BenchInputs(const RigSceneSpec& scene,
+                                        uint64_t noise_seed) {
   const std::vector<RigCameraInput> all =
-      puzzlecal::RigCorrespondences(scene, 0.03, 1);
+      puzzlecal::RigCorrespondences(scene, kNoisePx, noise_seed);
   std::vector<RigCameraInput> inputs = all;
   for (RigCameraInput& input : inputs) input.frames.clear();
   for (size_t f = 0; f < all[0].frames.size(); ++f) {
@@ -88,6 +100,69 @@ int main() {
     }
     for (int c = 0; c < 2; ++c) inputs[c].frames.push_back(all[c].frames[f]);
   }
+  return inputs;
+}
+
+// Errors of draws 1..n against their sigma.
+int RunSeeds(int n) {
+  RigCalibrationOptions options;
+  options.camera.num_threads = 2;
+  double sum_rotation_z2 = 0, sum_translation_z2 = 0, worst_rotation = 0;
+  int within_target = 0, ok_draws = 0;
+  std::printf("{\n  \"rig\": \"stereo_pinhole 640x480\",\n");
+  std::printf("  \"noise_px\": %.2f,\n  \"draws\": [\n", kNoisePx);
+  for (int seed = 1; seed <= n; ++seed) {
+    const RigSceneSpec scene = BenchScene(seed);
+    const std::vector<RigCameraInput> inputs = BenchInputs(scene, seed);
+    RigCalibrationResult result;
+    std::string error;
+    if (!puzzlecal::CalibrateRig(inputs, options, &result, &error)) {
+      std::fprintf(stderr, "draw %d: %s\n", seed, error.c_str());
+      continue;
+    }
+    ++ok_draws;
+    const auto& truth = scene.cameras[1].cam_from_rig;
+    const auto& est = result.cameras[1];
+    const double rotation = puzzlecal::RotationDifferenceDeg(
+        est.cam_from_rig.linear(), truth.linear());
+    const Eigen::Vector3d dt =
+        est.cam_from_rig.translation() - truth.translation();
+    // Translation error in units of its covariance (chi-square, 3 dof).
+    const double translation_z2 =
+        dt.dot(est.extrinsics_covariance.block<3, 3>(3, 3).ldlt().solve(dt));
+    const double rotation_z2 =
+        rotation * rotation /
+        (est.rotation_stddev_deg * est.rotation_stddev_deg);
+    sum_rotation_z2 += rotation_z2;
+    sum_translation_z2 += translation_z2 / 3;
+    worst_rotation = std::max(worst_rotation, rotation);
+    if (rotation < 0.005) ++within_target;
+    std::printf(
+        "    {\"seed\": %d, \"frames\": %zu, \"rotation_error_deg\": %.6f, "
+        "\"rotation_stddev_deg\": %.6f, \"translation_error_mm\": %.5f, "
+        "\"translation_chi2_3dof\": %.2f}%s\n",
+        seed, inputs[0].frames.size(), rotation, est.rotation_stddev_deg,
+        1000 * dt.norm(), translation_z2, seed < n ? "," : "");
+  }
+  std::printf("  ],\n");
+  std::printf("  \"ok_draws\": %d,\n", ok_draws);
+  std::printf("  \"rotation_error_over_sigma_rms\": %.3f,\n",
+              std::sqrt(sum_rotation_z2 / std::max(1, ok_draws)));
+  std::printf("  \"translation_chi2_per_dof_mean\": %.3f,\n",
+              sum_translation_z2 / std::max(1, ok_draws));
+  std::printf("  \"rotation_error_worst_deg\": %.6f,\n", worst_rotation);
+  std::printf("  \"draws_within_0_005_deg\": %d\n}\n", within_target);
+  return ok_draws == n ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "seeds") {
+    return RunSeeds(std::max(1, std::atoi(argv[2])));
+  }
+  const RigSceneSpec scene = BenchScene(0);
+  const std::vector<RigCameraInput> inputs = BenchInputs(scene, 1);
   const int frames = static_cast<int>(inputs[0].frames.size());
 
   RigCalibrationOptions deterministic;

@@ -60,7 +60,7 @@ if [ "$full" = 1 ]; then
   # model-selection scene, a second fisheye lattice, the program end to end
   # on a rendered stereo rig. Each path they take runs under the sanitizers
   # in a smaller test; together they took a third of this run.
-  asan_skip='^(ProjectionUncertainty[.](MatchesEmpiricalSpread|RotationRemovedMatchesEmpiricalSpread)|GridRenderTest[.](TiltSeries|SteepFisheyeCheckerboardIsOneComponent)|SelectModel[.]ChoosesRadtanForARadtanLens|CalibrateRigTest[.]StereoPinholeRendersInOpenCvFormat)$'
+  asan_skip='^(ProjectionUncertainty[.](MatchesEmpiricalSpread|RotationRemovedMatchesEmpiricalSpread)|GridRenderTest[.](TiltSeries|SteepFisheyeCheckerboardIsOneComponent)|SelectModel[.]ChoosesRadtanForARadtanLens|CalibrateRigTest[.]StereoPinholeRendersInOpenCvFormat|RigCalibrationTest[.]StatedSigmaDescribesTheErrorsOverDraws)$'
   (cd build-asan && ctest --output-on-failure --parallel "$(nproc)" --timeout 600 -E "$asan_skip")
   phase_done "ctest (Asan)"
 

@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <string>
 
 #include "sim/rig_scenes.h"
 #include "sim/scenes.h"
@@ -93,6 +95,46 @@ TEST(RigCalibrationTest, StereoPinholeMeetsTheFigures) {
   ExpectMatchesTruth(scene, result);
   EXPECT_NEAR(result.rms_px, kNoisePx, 0.02);
   EXPECT_FALSE(RigCalibrationReport(result).empty());
+}
+
+// The stated sigma of cam_from_rig is a promise about the errors: over
+// independent draws (frames and noise), the rotation error divided by its
+// sigma has an RMS near 1 (the sigma is the RMS length of the small
+// rotation), and the translation error's chi-square under its 3 x 3
+// covariance averages about 1 per degree of freedom. Ten draws: a ratio off
+// by a factor of 2 either way fails (the RMS of ten draws spreads by about
+// 25 % at the right sigma).
+TEST(RigCalibrationTest, StatedSigmaDescribesTheErrorsOverDraws) {
+  constexpr int kDraws = 10;
+  double sum_rotation_z2 = 0, sum_translation_chi2 = 0;
+  for (int draw = 1; draw <= kDraws; ++draw) {
+    SCOPED_TRACE("draw " + std::to_string(draw));
+    RigSceneSpec scene = StereoPinholeRig();
+    scene.random_frames.seed = 100 + draw;
+    const std::vector<RigCameraInput> inputs =
+        RigCorrespondences(scene, kNoisePx, draw);
+    const RigCalibrationResult result = CalibrateOrDie(inputs);
+    ASSERT_TRUE(result.covariance_ok);
+    const RigCameraResult& cam = result.cameras[1];
+    const Eigen::Isometry3d& truth = scene.cameras[1].cam_from_rig;
+    const double rotation_error =
+        RotationDifferenceDeg(cam.cam_from_rig.linear(), truth.linear());
+    sum_rotation_z2 += std::pow(rotation_error / cam.rotation_stddev_deg, 2);
+    const Eigen::Vector3d dt =
+        cam.cam_from_rig.translation() - truth.translation();
+    sum_translation_chi2 +=
+        dt.dot(cam.extrinsics_covariance.block<3, 3>(3, 3).ldlt().solve(dt));
+  }
+  const double rotation_ratio = std::sqrt(sum_rotation_z2 / kDraws);
+  const double translation_chi2_per_dof = sum_translation_chi2 / (3 * kDraws);
+  EXPECT_GT(rotation_ratio, 0.5);
+  EXPECT_LT(rotation_ratio, 2.0);
+  EXPECT_GT(translation_chi2_per_dof, 0.25);
+  EXPECT_LT(translation_chi2_per_dof, 4.0);
+  std::printf(
+      "rotation error / sigma RMS %.3f, translation chi-square per "
+      "dof %.3f over %d draws\n",
+      rotation_ratio, translation_chi2_per_dof, kDraws);
 }
 
 TEST(RigCalibrationTest, FisheyeAndPinholeTurned50DegreesMeetTheFigures) {
