@@ -1,9 +1,11 @@
 #include "sim/rig_scenes.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
@@ -130,6 +132,28 @@ std::vector<Eigen::Isometry3d> RigFramePoses(const RigSceneSpec& scene) {
                     PoseFromView(board, view));
   }
   return poses;
+}
+
+CamFromRigError CompareCamFromRig(const RigCameraResult& estimate,
+                                  const Eigen::Isometry3d& truth) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  CamFromRigError error;
+  error.rotation_deg =
+      RotationDifferenceDeg(estimate.cam_from_rig.linear(), truth.linear());
+  error.rotation_over_sigma =
+      estimate.rotation_stddev_deg > 0
+          ? error.rotation_deg / estimate.rotation_stddev_deg
+          : kInfinity;
+  const Eigen::Vector3d difference =
+      estimate.cam_from_rig.translation() - truth.translation();
+  error.translation_m = difference.norm();
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(
+      estimate.extrinsics_covariance.block<3, 3>(3, 3));
+  error.translation_chi2 =
+      ldlt.info() == Eigen::Success && ldlt.vectorD().minCoeff() > 0
+          ? difference.dot(ldlt.solve(difference))
+          : kInfinity;
+  return error;
 }
 
 std::vector<RigCameraInput> RigCorrespondences(const RigSceneSpec& scene,

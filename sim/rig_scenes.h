@@ -77,6 +77,21 @@ std::vector<RigCameraInput> RigCorrespondences(const RigSceneSpec& scene,
                                                double noise_px,
                                                uint64_t seed = 1);
 
+// How far a calibrated camera's cam_from_rig is from the truth, also in
+// the units of the covariance the calibration states for it.
+struct CamFromRigError {
+  double rotation_deg = 0;  // angle of the rotation between the two
+  // rotation_deg / rotation_stddev_deg (infinite without a stddev).
+  double rotation_over_sigma = 0;
+  double translation_m = 0;  // length of the translation difference
+  // Chi-square of the translation difference under the stated 3 x 3
+  // translation covariance (3 degrees of freedom; infinite when that
+  // covariance is not positive definite).
+  double translation_chi2 = 0;
+};
+CamFromRigError CompareCamFromRig(const RigCameraResult& estimate,
+                                  const Eigen::Isometry3d& truth);
+
 // What RenderRigScene wrote.
 struct RigRenderSummary {
   int num_frames = 0;

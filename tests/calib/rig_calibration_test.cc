@@ -54,11 +54,10 @@ void ExpectMatchesTruth(const RigSceneSpec& scene,
       continue;
     }
     const Eigen::Isometry3d& expected = scene.cameras[c].cam_from_rig;
-    const double rotation_error =
-        RotationDifferenceDeg(cam.cam_from_rig.linear(), expected.linear());
+    const CamFromRigError error = CompareCamFromRig(cam, expected);
+    const double rotation_error = error.rotation_deg;
     const double baseline = BaselineOf(expected);
-    const double translation_error =
-        (cam.cam_from_rig.translation() - expected.translation()).norm();
+    const double translation_error = error.translation_m;
     EXPECT_LT(rotation_error, kMaxRotationErrorDeg);
     EXPECT_LT(translation_error, kMaxTranslationErrorOfBaseline * baseline)
         << translation_error * 1000 << " mm of a " << baseline * 1000
@@ -115,15 +114,10 @@ TEST(RigCalibrationTest, StatedSigmaDescribesTheErrorsOverDraws) {
         RigCorrespondences(scene, kNoisePx, draw);
     const RigCalibrationResult result = CalibrateOrDie(inputs);
     ASSERT_TRUE(result.covariance_ok);
-    const RigCameraResult& cam = result.cameras[1];
-    const Eigen::Isometry3d& truth = scene.cameras[1].cam_from_rig;
-    const double rotation_error =
-        RotationDifferenceDeg(cam.cam_from_rig.linear(), truth.linear());
-    sum_rotation_z2 += std::pow(rotation_error / cam.rotation_stddev_deg, 2);
-    const Eigen::Vector3d dt =
-        cam.cam_from_rig.translation() - truth.translation();
-    sum_translation_chi2 +=
-        dt.dot(cam.extrinsics_covariance.block<3, 3>(3, 3).ldlt().solve(dt));
+    const CamFromRigError error =
+        CompareCamFromRig(result.cameras[1], scene.cameras[1].cam_from_rig);
+    sum_rotation_z2 += error.rotation_over_sigma * error.rotation_over_sigma;
+    sum_translation_chi2 += error.translation_chi2;
   }
   const double rotation_ratio = std::sqrt(sum_rotation_z2 / kDraws);
   const double translation_chi2_per_dof = sum_translation_chi2 / (3 * kDraws);
