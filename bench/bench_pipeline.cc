@@ -8,7 +8,7 @@
 //               of any PNG decoder that uses zlib: the unfiltering and the
 //               checks come on top);
 //   decode_opencv  cv::imdecode to grey (libpng, or libjpeg-turbo);
-//   load        LoadGreyImage, as the pipeline reads a photo (file, checks,
+//   load        ImageLoader::Load, as the pipeline reads a photo (file, checks,
 //               decoding);
 //   detect      CornerDetector::Detect (one detector kept across photos);
 //   grid_decode BuildGrid + DecodeBoard;
@@ -127,7 +127,8 @@ struct PhotoTimes {
 
 PhotoTimes MeasurePhoto(const std::string& file, const Board& board,
                         const PipelineOptions& options,
-                        CornerDetector* detector, cv::Mat* grey) {
+                        CornerDetector* detector, ImageLoader* loader,
+                        cv::Mat* grey) {
   PhotoTimes p;
   double t = ThreadMs();
   const std::vector<unsigned char> bytes = ReadBytes(file);
@@ -138,7 +139,7 @@ PhotoTimes MeasurePhoto(const std::string& file, const Board& board,
   p.decode_opencv = ThreadMs() - t;
   std::string error;
   t = ThreadMs();
-  if (!LoadGreyImage(file, options.load, grey, &error)) {
+  if (!loader->Load(file, grey, &error)) {
     std::fprintf(stderr, "%s\n", error.c_str());
     return p;
   }
@@ -247,13 +248,14 @@ int main(int argc, char** argv) {
   cv::setNumThreads(1);
   PipelineOptions options;
   CornerDetector detector(options.detector);
+  ImageLoader loader(options.load);
   std::vector<PhotoTimes> photos;
   std::vector<double> sb_ms;
   int sb_found = 0;
   for (size_t i = 0; i < listing.images.size(); ++i) {
     cv::Mat grey;
-    photos.push_back(
-        MeasurePhoto(listing.images[i], board, options, &detector, &grey));
+    photos.push_back(MeasurePhoto(listing.images[i], board, options, &detector,
+                                  &loader, &grey));
     const size_t step = std::max<size_t>(1, listing.images.size() / sb_photos);
     if (!grey.empty() && i % step == 0 &&
         static_cast<int>(sb_ms.size()) < sb_photos) {

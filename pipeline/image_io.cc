@@ -195,6 +195,7 @@ bool GreyPngData(const std::vector<unsigned char>& b, int* width, int* height,
     return false;
   }
   idat->clear();
+  idat->reserve(b.size());  // the IDAT chunks are part of the file
   for (size_t pos = 8; pos + 12 <= b.size();) {
     const size_t length = BigEndian(b, pos, 4);
     if (length > b.size() - pos - 12) return false;
@@ -218,39 +219,62 @@ bool GreyPngData(const std::vector<unsigned char>& b, int* width, int* height,
   return false;
 }
 
+}  // namespace
+
+// What an ImageLoader keeps between files.
+struct ImageLoader::Buffers {
+  std::vector<unsigned char> bytes;  // the file
+  std::vector<unsigned char> idat;   // a grey PNG's compressed pixels
+  std::vector<unsigned char> zeros;  // the row above the first
+  // The inflated rows, unfiltered in place into the grey image returned.
+  cv::Mat pixels;
+  std::unique_ptr<libdeflate_decompressor,
+                  decltype(&libdeflate_free_decompressor)>
+      inflater{nullptr, libdeflate_free_decompressor};
+};
+
+namespace {
+
 // 8-bit grey PNGs inflated by libdeflate, the filters undone here:
 // inflating is most of a PNG decoder's time, and libdeflate does it about
 // 2.3 times faster than zlib (which libpng, behind cv::imdecode, uses) on
 // 1600x1200 photos. The pixels are those of libpng. False for every other
 // PNG and for any error, which go to OpenCV (same pixels, same messages).
-bool DecodeGreyPng(const std::vector<unsigned char>& bytes, cv::Mat* grey) {
+// Decodes into `buffers->pixels`, or into a new buffer while an earlier
+// image still holds that one.
+bool DecodeGreyPng(const std::vector<unsigned char>& bytes,
+                   ImageLoader::Buffers* buffers, cv::Mat* grey) {
   int width = 0, height = 0;
-  std::vector<unsigned char> idat;
+  std::vector<unsigned char>& idat = buffers->idat;
   if (!GreyPngData(bytes, &width, &height, &idat)) return false;
   const size_t row = static_cast<size_t>(width) + 1;
-  cv::Mat buffer(1, static_cast<int>(row * height), CV_8UC1);
-  std::unique_ptr<libdeflate_decompressor,
-                  decltype(&libdeflate_free_decompressor)>
-      inflater(libdeflate_alloc_decompressor(), libdeflate_free_decompressor);
-  if (inflater == nullptr ||
-      libdeflate_zlib_decompress(inflater.get(), idat.data(), idat.size(),
-                                 buffer.data, buffer.total(),
+  const int size = static_cast<int>(row * height);
+  cv::Mat& pixels = buffers->pixels;
+  const bool shared = pixels.u != nullptr && pixels.u->refcount > 1;
+  if (shared || pixels.cols != size) pixels = cv::Mat(1, size, CV_8UC1);
+  if (buffers->inflater == nullptr) {
+    buffers->inflater.reset(libdeflate_alloc_decompressor());
+  }
+  if (buffers->inflater == nullptr ||
+      libdeflate_zlib_decompress(buffers->inflater.get(), idat.data(),
+                                 idat.size(), pixels.data, pixels.total(),
                                  nullptr) != LIBDEFLATE_SUCCESS) {
     return false;
   }
   // In place: row y moves from y (width + 1) + 1 to y width, never over
   // bytes still to be read.
-  unsigned char* data = buffer.data;
-  const std::vector<unsigned char> zeros(width, 0);
+  unsigned char* data = pixels.data;
+  buffers->zeros.assign(width, 0);
   for (int y = 0; y < height; ++y) {
     const unsigned char* prior =
-        y > 0 ? data + (y - 1) * static_cast<size_t>(width) : zeros.data();
+        y > 0 ? data + (y - 1) * static_cast<size_t>(width)
+              : buffers->zeros.data();
     if (!UnfilterRow(data[y * row], data + y * row + 1, prior, width,
                      data + y * static_cast<size_t>(width))) {
       return false;
     }
   }
-  *grey = buffer.colRange(0, width * height).reshape(1, height);
+  *grey = pixels.colRange(0, width * height).reshape(1, height);
   return true;
 }
 
@@ -333,8 +357,20 @@ bool ImageLoadOptions::Check(std::string* why) const {
 
 bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
                    cv::Mat* grey, std::string* error) {
+  return ImageLoader(options).Load(path, grey, error);
+}
+
+ImageLoader::ImageLoader(const ImageLoadOptions& options)
+    : options_(options), buffers_(std::make_unique<Buffers>()) {}
+ImageLoader::~ImageLoader() = default;
+ImageLoader::ImageLoader(ImageLoader&&) noexcept = default;
+ImageLoader& ImageLoader::operator=(ImageLoader&&) noexcept = default;
+
+bool ImageLoader::Load(const std::string& path, cv::Mat* grey,
+                       std::string* error) {
   *grey = cv::Mat();
-  std::vector<unsigned char> bytes;
+  const ImageLoadOptions& options = options_;
+  std::vector<unsigned char>& bytes = buffers_->bytes;
   if (!ReadFile(path, &bytes)) {
     *error = path + ": cannot open the file (missing or no read permission)";
     return false;
@@ -357,7 +393,7 @@ bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
              std::to_string(options.max_pixels) + " pixels";
     return false;
   }
-  if (header.png && DecodeGreyPng(bytes, grey)) return true;
+  if (header.png && DecodeGreyPng(bytes, buffers_.get(), grey)) return true;
   cv::Mat decoded;
   try {
     // JPEGs straight to grey: libjpeg-turbo then skips the chroma
@@ -372,8 +408,6 @@ bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
     *error = path + ": cannot decode the image (" + e.what() + ")";
     return false;
   }
-  bytes.clear();
-  bytes.shrink_to_fit();
   if (decoded.empty()) {
     *error = path + ": not a readable image (unknown format or corrupt data)";
     return false;

@@ -3,6 +3,7 @@
 
 // Finding and loading the photos of a calibration run.
 
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -39,6 +40,32 @@ struct ImageLoadOptions {
 // too large, empty).
 bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
                    cv::Mat* grey, std::string* error);
+
+// LoadGreyImage for many files: keeps its buffers (the file's bytes, the
+// compressed and the inflated data of 8-bit grey PNGs, the inflater) from
+// one file to the next, so a folder of same-size photos costs no allocation
+// and no page fault after the first (fresh buffers were 3 ms of a 1600x1200
+// PNG's 8 ms). A grey image it returned is never overwritten: while the
+// caller still holds it, the next Load decodes into a new buffer. One
+// loader serves one thread at a time.
+class ImageLoader {
+ public:
+  explicit ImageLoader(const ImageLoadOptions& options = {});
+  ~ImageLoader();
+  ImageLoader(ImageLoader&&) noexcept;
+  ImageLoader& operator=(ImageLoader&&) noexcept;
+  ImageLoader(const ImageLoader&) = delete;
+  ImageLoader& operator=(const ImageLoader&) = delete;
+
+  // As LoadGreyImage with this loader's options.
+  bool Load(const std::string& path, cv::Mat* grey, std::string* error);
+
+  struct Buffers;  // defined in image_io.cc
+
+ private:
+  ImageLoadOptions options_;
+  std::unique_ptr<Buffers> buffers_;
+};
 
 // Fails early when an output file cannot be written, before any work is
 // done: false with a message naming `path` when its folder does not exist or

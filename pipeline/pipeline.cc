@@ -156,13 +156,15 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
 
 ImageResult ProcessImageFile(const std::string& file, const Board& board,
                              const PipelineOptions& options,
-                             CornerDetector* detector) {
+                             CornerDetector* detector, ImageLoader* loader) {
   ImageResult result;
   result.file = file;
   const Timer timer;
   cv::Mat grey;
   std::string error;
-  const bool loaded = LoadGreyImage(file, options.load, &grey, &error);
+  const bool loaded = loader != nullptr
+                          ? loader->Load(file, &grey, &error)
+                          : LoadGreyImage(file, options.load, &grey, &error);
   result.seconds_load = timer.Seconds();
   if (!loaded) {
     result.outcome = ImageOutcome::kUnreadable;
@@ -186,8 +188,10 @@ std::vector<ImageResult> ProcessImageFiles(
   std::mutex done_mutex;
   auto worker = [&]() {
     CornerDetector detector(options.detector);
+    ImageLoader loader(options.load);
     for (size_t i = next++; i < files.size(); i = next++) {
-      results[i] = ProcessImageFile(files[i], board, options, &detector);
+      results[i] =
+          ProcessImageFile(files[i], board, options, &detector, &loader);
       if (on_done) {
         std::lock_guard<std::mutex> lock(done_mutex);
         on_done(i, results[i]);

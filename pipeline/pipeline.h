@@ -75,13 +75,16 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
                       CornerDetector* detector = nullptr);
 
 // Loads `file` and processes it; the image is released on return.
+// `loader` and `detector`, when given, are reused (made with options.load
+// and options.detector); else they are made for this file.
 ImageResult ProcessImageFile(const std::string& file, const Board& board,
                              const PipelineOptions& options,
-                             CornerDetector* detector = nullptr);
+                             CornerDetector* detector = nullptr,
+                             ImageLoader* loader = nullptr);
 
 // Processes `files` on `num_threads` workers (0 = all cores), each holding
-// one image and one CornerDetector at a time: while one worker reads and
-// decodes a file, the others detect in theirs, so reading overlaps
+// one image, one ImageLoader and one CornerDetector at a time: while one worker
+// reads and decodes a file, the others detect in theirs, so reading overlaps
 // detection. Results come in the order of `files` and do not depend on the
 // thread count (each image's result depends on that image alone).
 // `on_done(index, result)` is called (serialised) as each image finishes,

@@ -292,6 +292,51 @@ TEST_F(ImageIoTest, GreyPngsWithEveryFilterLoadExactly) {
   EXPECT_TRUE(grey.empty());
 }
 
+// One loader over a sequence of files (grey PNGs of two sizes, a colour
+// PNG, a JPEG, a corrupt file): each image equals what a fresh
+// LoadGreyImage gives, a failure leaves the loader usable, and an image the
+// caller still holds keeps its pixels when the next file is loaded.
+TEST_F(ImageIoTest, LoaderReusedAcrossFilesGivesTheSameImages) {
+  cv::Mat noise(40, 60, CV_8UC1), wide(31, 77, CV_8UC1);
+  cv::randu(noise, 0, 256);
+  cv::randu(wide, 0, 256);
+  cv::Mat colour;
+  cv::cvtColor(ramp_, colour, cv::COLOR_GRAY2BGR);
+  cv::imwrite(Path("0_ramp.png"), ramp_);
+  cv::imwrite(Path("1_noise.png"), noise);
+  cv::imwrite(Path("2_wide.png"), wide);
+  cv::imwrite(Path("3_colour.png"), colour);
+  cv::imwrite(Path("4_ramp.jpg"), ramp_);
+  WriteBytes("5_corrupt.png", ReadBytes("1_noise.png").substr(0, 60));
+  cv::imwrite(Path("6_ramp.png"), ramp_);
+  const std::string names[] = {"0_ramp.png",   "1_noise.png", "2_wide.png",
+                               "3_colour.png", "4_ramp.jpg",  "5_corrupt.png",
+                               "6_ramp.png"};
+  ImageLoader loader;
+  cv::Mat held, held_copy;
+  for (const std::string& name : names) {
+    cv::Mat by_loader, fresh;
+    std::string loader_error, fresh_error;
+    const bool loaded = loader.Load(Path(name), &by_loader, &loader_error);
+    ASSERT_EQ(loaded, LoadGreyImage(Path(name), {}, &fresh, &fresh_error))
+        << name;
+    EXPECT_EQ(loader_error, fresh_error) << name;
+    if (!loaded) {
+      EXPECT_TRUE(by_loader.empty()) << name;
+      EXPECT_NE(loader_error.find(name), std::string::npos) << loader_error;
+      continue;
+    }
+    ASSERT_EQ(by_loader.size(), fresh.size()) << name;
+    EXPECT_EQ(cv::norm(by_loader, fresh, cv::NORM_INF), 0.0) << name;
+    if (!held.empty()) {
+      EXPECT_EQ(cv::norm(held, held_copy, cv::NORM_INF), 0.0)
+          << "the image before " << name << " changed";
+    }
+    held = by_loader;
+    held_copy = by_loader.clone();
+  }
+}
+
 TEST_F(ImageIoTest, RefusesImagesAboveThePixelLimit) {
   cv::imwrite(Path("ramp.png"), ramp_);
   ImageLoadOptions options;
