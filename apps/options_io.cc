@@ -211,6 +211,7 @@ struct Fields<CalibrationOptions> {
     v.Field("outlier_iterations", o.outlier_iterations);
     v.Field("min_outlier_threshold_px", o.min_outlier_threshold_px);
     v.Field("coarse_stride", o.coarse_stride);
+    v.Field("initial_trust_region_radius", o.initial_trust_region_radius);
     v.Field("max_iterations", o.max_iterations);
     v.Field("function_tolerance", o.function_tolerance);
     v.Field("gradient_tolerance", o.gradient_tolerance);

@@ -91,6 +91,11 @@ struct CalibrationState {
   ceres::Solver::Summary summary;
   int iterations = 0;  // all solves
   int rounds = 0;      // outlier rejection rounds
+  // Where the next solve's trust region starts: the options' radius, then
+  // the radius the last solve ended with (a rejection round continues the
+  // solve it follows; restarting at a small radius would damp its steps
+  // for several iterations near the minimum).
+  double trust_region_radius = 0;
 
   // Filled by FillResult: the inlier sum of squares and free parameters.
   double sum2 = 0;
@@ -236,7 +241,39 @@ bool CheckViews(CalibrationState* s) {
 
 // Intrinsics and poses from calib/initialization.h on the finite
 // correspondences only; views without an initial pose drop out.
+double OrientationSpreadDeg(const std::vector<Eigen::Isometry3d>& poses,
+                            const std::vector<bool>& used);
+
+// Fails when the usable views are too few or too parallel to calibrate.
+bool CheckPosedViews(const CalibrationState& s) {
+  const int usable = CountUsed(s.view_used);
+  if (usable < s.options.min_views) return FailTooFewViews(s, usable);
+  if (s.result->orientation_spread_deg < s.options.min_orientation_spread_deg) {
+    return FailParallelViews(s, s.result->orientation_spread_deg);
+  }
+  return true;
+}
+
+// The caller's intrinsics and poses (options.initial_cam_from_board) as the
+// start.
+bool InitialiseFromGivenPoses(CalibrationState* s) {
+  const std::vector<Eigen::Isometry3d>& given =
+      s->options.initial_cam_from_board;
+  s->params = s->options.initial_params;
+  s->poses.assign(s->views.size(), Pose{});
+  for (size_t v = 0; v < s->views.size(); ++v) {
+    if (s->view_used[v]) s->poses[v] = PoseFromIsometry(given[v]);
+  }
+  s->result->initialization_method = "intrinsics and poses given by the caller";
+  s->result->orientation_spread_deg = OrientationSpreadDeg(given, s->view_used);
+  s->result->initialization_seconds = s->timer.Seconds();
+  return CheckPosedViews(*s);
+}
+
 bool Initialise(CalibrationState* s) {
+  if (!s->options.initial_cam_from_board.empty()) {
+    return InitialiseFromGivenPoses(s);
+  }
   const size_t num_views = s->views.size();
   std::vector<CalibrationView> clean(num_views);
   for (size_t v = 0; v < num_views; ++v) {
@@ -272,13 +309,7 @@ bool Initialise(CalibrationState* s) {
     }
     s->poses[v] = PoseFromIsometry(init.cam_from_board[v]);
   }
-  const int usable = CountUsed(s->view_used);
-  if (usable < s->options.min_views) return FailTooFewViews(*s, usable);
-  if (s->result->orientation_spread_deg <
-      s->options.min_orientation_spread_deg) {
-    return FailParallelViews(*s, s->result->orientation_spread_deg);
-  }
-  return true;
+  return CheckPosedViews(*s);
 }
 
 // The intrinsics held at their initial values, from the options.
@@ -403,9 +434,10 @@ int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
 // Stage 4: solve.
 
 ceres::Solver::Options SolverOptions(
-    const CalibrationOptions& options,
+    const CalibrationOptions& options, double trust_region_radius,
     std::shared_ptr<ceres::ParameterBlockOrdering> ordering) {
   ceres::Solver::Options solver_options;
+  solver_options.initial_trust_region_radius = trust_region_radius;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
   solver_options.linear_solver_ordering = std::move(ordering);
   solver_options.max_num_iterations = options.max_iterations;
@@ -416,6 +448,11 @@ ceres::Solver::Options SolverOptions(
   solver_options.logging_type = ceres::SILENT;
   return solver_options;
 }
+
+// The largest radius a solve continues with (Ceres's own bound is 1e16):
+// large enough for Gauss-Newton steps near a minimum, with room for the
+// radius to shrink within a few steps should one fail.
+constexpr double kMaxContinuedRadius = 1e12;
 
 // One Levenberg-Marquardt solve over the current inliers, starting from the
 // current estimate; `fixed[k]` holds intrinsic k.
@@ -429,9 +466,19 @@ void Solve(CalibrationState* s, const std::vector<bool>& fixed) {
     s->summary.message = "no corners left to fit";
     return;
   }
-  ceres::Solve(SolverOptions(s->options, ordering), s->problem.get(),
-               &s->summary);
+  if (s->trust_region_radius <= 0) {
+    s->trust_region_radius = s->options.initial_trust_region_radius;
+  }
+  ceres::Solve(SolverOptions(s->options, s->trust_region_radius, ordering),
+               s->problem.get(), &s->summary);
   s->iterations += static_cast<int>(s->summary.iterations.size());
+  if (!s->summary.iterations.empty()) {
+    s->trust_region_radius =
+        std::min(kMaxContinuedRadius,
+                 std::max(s->summary.iterations.back().trust_region_radius,
+                          s->options.initial_trust_region_radius));
+  }
+  s->result->trust_region_radius = s->trust_region_radius;
 }
 
 // The first solve, after one with the distortion held at zero when
@@ -900,6 +947,9 @@ const char* ViewOutcomeName(ViewOutcome outcome) {
 bool CalibrationOptions::Check(std::string* why) const {
   if (!(loss_scale_px > 0)) return Fail("loss_scale_px must be > 0", why);
   if (!(outlier_k >= 0)) return Fail("outlier_k must be >= 0", why);
+  if (!(initial_trust_region_radius > 0)) {
+    return Fail("initial_trust_region_radius must be > 0", why);
+  }
   if (outlier_iterations < 0) {
     return Fail("outlier_iterations must be >= 0", why);
   }
@@ -953,6 +1003,16 @@ bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
                CalibrationResult* result, std::string* error) {
   ResetResult(views, model, width, height, result);
   if (!CheckArguments(model, width, height, options, error)) return false;
+  if (!options.initial_cam_from_board.empty() &&
+      (options.initial_params.empty() ||
+       options.initial_cam_from_board.size() != views.size())) {
+    return Fail(
+        "calibration options: initial_cam_from_board needs "
+        "initial_params and one pose per view (" +
+            std::to_string(options.initial_cam_from_board.size()) +
+            " poses for " + std::to_string(views.size()) + " views)",
+        error);
+  }
   CalibrationOptions start = options;
   std::string start_method;
   if (!StartFromFarFieldModel(views, model, width, height, &start,

@@ -40,6 +40,12 @@ struct CalibrationOptions {
   // Starting intrinsics in the model's order; empty (the default) means
   // automatic initialisation.
   std::vector<double> initial_params;
+  // Starting poses with initial_params: one cam_from_board per input view,
+  // used instead of posing each view from the intrinsics. For a calibration
+  // of views that an earlier one already posed (the cross-validation
+  // halves start at the full solution, a few iterations from their own).
+  // Empty (the default): the initialisation poses every view.
+  std::vector<Eigen::Isometry3d> initial_cam_from_board;
 
   // Robust loss on each corner's pixel error. Default Huber.
   RobustLoss loss = RobustLoss::kHuber;
@@ -78,6 +84,14 @@ struct CalibrationOptions {
   // the start. >= 1.
   int coarse_stride = 1;
 
+  // Trust-region radius of the first solve (Ceres's default, 1e4); later
+  // solves (the outlier-rejection rounds) continue with the radius the
+  // solve before them ended with. A start already near the minimum (the
+  // cross-validation halves start at the full solution: their caller
+  // passes its trust_region_radius) can take a larger one: near a minimum
+  // a small radius damps the steps, and the cost then falls by a few
+  // times per iteration instead of converging quadratically. > 0.
+  double initial_trust_region_radius = 1e4;
   // Levenberg-Marquardt iterations per solve. Default 200 (the first solve
   // from a rough start can take more than 100 on wide-angle cameras).
   int max_iterations = 200;
@@ -210,6 +224,9 @@ struct CalibrationResult {
   double outlier_threshold_px = 0;
   int outlier_rounds = 0;  // solves after the first one
   int iterations = 0;      // Levenberg-Marquardt iterations, all solves
+  // The trust-region radius the last solve ended with (see
+  // CalibrationOptions::initial_trust_region_radius).
+  double trust_region_radius = 0;
   // Seconds from the start of Calibrate: to the end of the initialisation,
   // and to the end of the solve and the covariance; and the covariance step
   // alone.

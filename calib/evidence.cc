@@ -150,12 +150,16 @@ PixelMap CovarianceTraceMap(const Camera& camera,
 
 // The used views of `result` at even (half 0) or odd (half 1) positions.
 std::vector<CalibrationView> Half(const std::vector<CalibrationView>& views,
-                                  const CalibrationResult& result, int half) {
+                                  const CalibrationResult& result, int half,
+                                  std::vector<Eigen::Isometry3d>* poses) {
   std::vector<CalibrationView> out;
+  poses->clear();
   int position = 0;
   for (size_t v = 0; v < views.size(); ++v) {
     if (v >= result.view_used.size() || !result.view_used[v]) continue;
-    if (position++ % 2 == half) out.push_back(views[v]);
+    if (position++ % 2 != half) continue;
+    out.push_back(views[v]);
+    poses->push_back(result.cam_from_board[v]);
   }
   return out;
 }
@@ -500,19 +504,26 @@ bool CalibrateHalves(const std::vector<CalibrationView>& views,
   CalibrationOptions half_options = calibration;
   half_options.initial_params = camera.params;
   half_options.compute_covariance = true;
+  if (result.trust_region_radius > 0) {
+    half_options.initial_trust_region_radius = result.trust_region_radius;
+  }
   // The two halves side by side, each on its share of the threads (a
   // calibration's result does not depend on its thread count).
   const int workers = std::min(2, std::max(1, calibration.num_threads));
   half_options.num_threads = std::max(1, calibration.num_threads / workers);
-  std::vector<CalibrationView> half[2] = {Half(views, result, 0),
-                                          Half(views, result, 1)};
+  // Each half starts from the full solution's intrinsics and its views'
+  // poses: a few iterations from its own minimum.
+  CalibrationOptions options_of[2] = {half_options, half_options};
+  std::vector<CalibrationView> half[2] = {
+      Half(views, result, 0, &options_of[0].initial_cam_from_board),
+      Half(views, result, 1, &options_of[1].initial_cam_from_board)};
   out->views_a = static_cast<int>(half[0].size());
   out->views_b = static_cast<int>(half[1].size());
   std::string error[2];
   char ok[2] = {0, 0};
   ParallelFor(2, workers, [&](int h) {
     ok[h] = Calibrate(half[h], camera.model, camera.width, camera.height,
-                      half_options, &halves[h], &error[h]);
+                      options_of[h], &halves[h], &error[h]);
   });
   for (int h = 0; h < 2; ++h) {
     const std::string name = h == 0 ? "A" : "B";
