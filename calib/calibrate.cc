@@ -449,11 +449,6 @@ ceres::Solver::Options SolverOptions(
   return solver_options;
 }
 
-// The largest radius a solve continues with (Ceres's own bound is 1e16):
-// large enough for Gauss-Newton steps near a minimum, with room for the
-// radius to shrink within a few steps should one fail.
-constexpr double kMaxContinuedRadius = 1e12;
-
 // One Levenberg-Marquardt solve over the current inliers, starting from the
 // current estimate; `fixed[k]` holds intrinsic k.
 template <typename Model>
@@ -473,10 +468,8 @@ void Solve(CalibrationState* s, const std::vector<bool>& fixed) {
                s->problem.get(), &s->summary);
   s->iterations += static_cast<int>(s->summary.iterations.size());
   if (!s->summary.iterations.empty()) {
-    s->trust_region_radius =
-        std::min(kMaxContinuedRadius,
-                 std::max(s->summary.iterations.back().trust_region_radius,
-                          s->options.initial_trust_region_radius));
+    s->trust_region_radius = ContinuedTrustRegionRadius(
+        s->summary.iterations.back().trust_region_radius, s->options);
   }
   s->result->trust_region_radius = s->trust_region_radius;
 }
@@ -996,6 +989,16 @@ bool CalibrationOptions::Check(std::string* why) const {
   }
   if (!(max_rms_px > 0)) return Fail("max_rms_px must be > 0", why);
   return initialization.Check(why);
+}
+
+double ContinuedTrustRegionRadius(double last_radius,
+                                  const CalibrationOptions& options) {
+  // The upper bound (Ceres's own is 1e16) is large enough for Gauss-Newton
+  // steps near a minimum and leaves room for the radius to shrink within a
+  // few steps should one fail.
+  constexpr double kMaxContinuedRadius = 1e12;
+  return std::min(kMaxContinuedRadius,
+                  std::max(last_radius, options.initial_trust_region_radius));
 }
 
 bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,

@@ -247,6 +247,12 @@ struct CalibrationResult {
 // one line per view not used.
 std::string CalibrationReport(const CalibrationResult& result);
 
+// The trust-region radius a solve that continues an earlier one starts
+// with: the radius the earlier one ended with, at least
+// options.initial_trust_region_radius and at most 1e12.
+double ContinuedTrustRegionRadius(double last_radius,
+                                  const CalibrationOptions& options);
+
 // Calibrates `model` for images of width x height pixels. Returns false with
 // a reason (which says what to change) when the views are too few or
 // degenerate or the solve fails; `result` then holds what is known so far.

@@ -1,10 +1,9 @@
 #ifndef PUZZLECAL_CALIB_CALIBRATION_VIEW_H_
 #define PUZZLECAL_CALIB_CALIBRATION_VIEW_H_
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace puzzlecal {
 

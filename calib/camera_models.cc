@@ -3,7 +3,8 @@
 namespace puzzlecal {
 
 const char* CameraModelName(CameraModelId id) {
-  return DispatchCameraModel(id, [](auto model) { return decltype(model)::kName; });
+  return DispatchCameraModel(id,
+                             [](auto model) { return decltype(model)::kName; });
 }
 
 bool CameraModelIdFromName(const std::string& name, CameraModelId* id) {

@@ -145,6 +145,7 @@ struct SolveOutcome {
 };
 
 void SolveJoint(JointState* state, const CalibrationOptions& options,
+                double trust_region_radius,
                 std::unique_ptr<ceres::LossFunction>* loss,
                 SolveOutcome* outcome) {
   ceres::Problem::Options problem_options;
@@ -222,6 +223,7 @@ void SolveJoint(JointState* state, const CalibrationOptions& options,
     }
   }
   ceres::Solver::Options solver_options;
+  solver_options.initial_trust_region_radius = trust_region_radius;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
   solver_options.linear_solver_ordering = ordering;
   solver_options.max_num_iterations = options.max_iterations;
@@ -731,18 +733,27 @@ struct JointSolveRun {
 
 void SolveWithOutlierRejection(const CalibrationOptions& options,
                                JointState* state, JointSolveRun* run) {
-  SolveJoint(state, options, &run->loss, &run->outcome);
-  run->iterations += static_cast<int>(run->outcome.summary.iterations.size());
-  ComputeJointResiduals(*state, &run->residuals, &run->projects);
+  // Each rejection round continues with the radius the solve before it
+  // ended with (see CalibrationOptions::initial_trust_region_radius).
+  double radius = options.initial_trust_region_radius;
+  auto solve = [&] {
+    SolveJoint(state, options, radius, &run->loss, &run->outcome);
+    const auto& iterations = run->outcome.summary.iterations;
+    run->iterations += static_cast<int>(iterations.size());
+    if (!iterations.empty()) {
+      radius = ContinuedTrustRegionRadius(iterations.back().trust_region_radius,
+                                          options);
+    }
+    ComputeJointResiduals(*state, &run->residuals, &run->projects);
+  };
+  solve();
   while (options.outlier_k > 0 && run->rounds < options.outlier_iterations &&
          run->outcome.summary.IsSolutionUsable()) {
     if (!RejectJointOutliers(run->residuals, run->projects, options, state)) {
       break;
     }
     ++run->rounds;
-    SolveJoint(state, options, &run->loss, &run->outcome);
-    run->iterations += static_cast<int>(run->outcome.summary.iterations.size());
-    ComputeJointResiduals(*state, &run->residuals, &run->projects);
+    solve();
   }
 }
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -302,9 +302,9 @@ TEST(CalibrateTest, GrossErrorsAmongHeavyTailedOnesAreRemoved) {
       view_rejected += result.inlier[v][i] ? 0 : 1;
     }
     used += result.view_used[v] ? 1 : 0;
-    EXPECT_DOUBLE_EQ(result.view_rejected_fraction[v],
-                     static_cast<double>(view_rejected) /
-                         data.views[v].image_points.size());
+    EXPECT_DOUBLE_EQ(
+        result.view_rejected_fraction[v],
+        static_cast<double>(view_rejected) / data.views[v].image_points.size());
   }
   EXPECT_EQ(used, static_cast<int>(data.views.size()));
   EXPECT_EQ(missed, 0);
@@ -425,8 +425,7 @@ TEST(CalibrateTest, CameraFileIsByteIdenticalForOneAndTwoThreads) {
     options.num_threads = threads;
     CalibrationResult& result = results[threads - 1];
     std::string error;
-    ASSERT_TRUE(RunCalibration(data, scene, options, &result, &error))
-        << error;
+    ASSERT_TRUE(RunCalibration(data, scene, options, &result, &error)) << error;
     ASSERT_GE(result.outlier_rounds, 1);
     const std::string path =
         dir + "/threads_" + std::to_string(threads) + ".yaml";
@@ -571,6 +570,90 @@ TEST(CalibrateTest, BadCorrespondencesAreSkippedWithAReason) {
   EXPECT_NE(report.find("view 1 (synthetic_1) not used: "), std::string::npos)
       << report;
   EXPECT_EQ(result.FullReport(), report);
+}
+
+// A calibration that starts where an earlier one ended (its intrinsics,
+// poses and final trust-region radius, as the cross-validation halves do)
+// is a few Gauss-Newton steps from its minimum; the same start with
+// Ceres's default radius damps the steps and needs more. Both reach the fit
+// the automatic start finds: the same parameters where the views determine
+// them (the half of the rational scene leaves its six radial terms a flat
+// valley, where only the fits can be compared).
+TEST(CalibrateTest, ContinuingFromASolutionTakesFewIterations) {
+  for (int model = 0; model < 3; ++model) {
+    const SyntheticScene scene = SceneFor(model);
+    SyntheticData data = MakeSyntheticData(scene);
+    const bool determined =
+        scene.camera.model != CameraModelId::kPinholeRational;
+    SCOPED_TRACE(CameraModelName(scene.camera.model));
+    CalibrationResult full;
+    std::string error;
+    ASSERT_TRUE(
+        RunCalibration(data, scene, CalibrationOptions(), &full, &error))
+        << error;
+    ASSERT_GT(full.trust_region_radius, 0);
+    // The even views, started from the full solution.
+    SyntheticData half;
+    CalibrationOptions continued;
+    continued.initial_params = full.camera.params;
+    continued.outlier_k = 0;
+    for (size_t v = 0; v < data.views.size(); v += 2) {
+      half.views.push_back(data.views[v]);
+      continued.initial_cam_from_board.push_back(full.cam_from_board[v]);
+    }
+    CalibrationResult from_default_radius, from_final_radius, automatic;
+    ASSERT_TRUE(
+        RunCalibration(half, scene, continued, &from_default_radius, &error))
+        << error;
+    continued.initial_trust_region_radius = full.trust_region_radius;
+    ASSERT_TRUE(
+        RunCalibration(half, scene, continued, &from_final_radius, &error))
+        << error;
+    CalibrationOptions fresh;
+    fresh.outlier_k = 0;
+    ASSERT_TRUE(RunCalibration(half, scene, fresh, &automatic, &error))
+        << error;
+    EXPECT_EQ(from_final_radius.initialization_method,
+              "intrinsics and poses given by the caller");
+    EXPECT_LT(from_final_radius.iterations, from_default_radius.iterations);
+    // At least as good a fit (in the rational scene's valley the automatic
+    // start stops 0.2 % higher).
+    EXPECT_LE(from_final_radius.rms_px, automatic.rms_px * (1 + 1e-4));
+    if (determined) {
+      EXPECT_LE(from_final_radius.iterations, 4);
+      ASSERT_EQ(automatic.param_stddev.size(), automatic.camera.params.size());
+      for (size_t k = 0; k < automatic.camera.params.size(); ++k) {
+        EXPECT_NEAR(from_final_radius.camera.params[k],
+                    automatic.camera.params[k],
+                    1e-3 * automatic.param_stddev[k])
+            << k;
+      }
+    }
+    std::printf("%s: %d iterations continued, %d from radius 1e4\n",
+                CameraModelName(scene.camera.model),
+                from_final_radius.iterations, from_default_radius.iterations);
+  }
+}
+
+TEST(CalibrateTest, GivenPosesMustMatchTheViews) {
+  const SyntheticScene scene = SceneFor(0);
+  const SyntheticData data = MakeSyntheticData(scene);
+  CalibrationResult result;
+  std::string error;
+  CalibrationOptions options;
+  options.initial_cam_from_board = data.cam_from_board;
+  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
+  EXPECT_NE(error.find("initial_cam_from_board needs initial_params"),
+            std::string::npos)
+      << error;
+  options.initial_params = scene.camera.params;
+  options.initial_cam_from_board.pop_back();
+  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
+  EXPECT_NE(error.find("one pose per view"), std::string::npos) << error;
+  options = CalibrationOptions();
+  options.initial_trust_region_radius = 0;
+  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
+  EXPECT_NE(error.find("initial_trust_region_radius"), std::string::npos);
 }
 
 TEST(CalibrateTest, InvalidOptionsAndInputsAreRejected) {
