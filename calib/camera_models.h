@@ -281,15 +281,19 @@ struct KannalaBrandtNoncentralModel {
   static constexpr int kNumParams = 10;
   static constexpr std::array<const char*, kNumParams> kParamNames = {
       "fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4", "e1", "e2"};
-  // Newton steps of SolveTheta on the plain values, always all of them, so
-  // that a value is the same function of the input wherever it is
-  // evaluated. Newton starts at the central angle atan2(r, z), off by about
-  // z0 sin(theta) / distance, and the error then squares each step. In the
-  // hardest case noncentral_test checks (twice the measured deltille shift,
-  // points 3 cm away, up to 110 degrees) the start is 0.8 rad off and the
-  // steps leave 0.24, 0.03, 5e-4, 2e-7, 4e-14, 2e-15 rad: seven leave the
-  // value converged, and one more step in T carries the derivatives.
+  // Newton steps of SolveTheta on the plain values at most. Newton starts at
+  // the central angle atan2(r, z), off by about z0 sin(theta) / distance,
+  // and the error then squares each step. In the hardest case
+  // noncentral_test checks (twice the measured deltille shift, points 3 cm
+  // away, up to 110 degrees) the start is 0.8 rad off and the steps leave
+  // 0.24, 0.03, 5e-4, 2e-7, 4e-14, 2e-15 rad: seven leave the value
+  // converged, and one more step in T carries the derivatives. The steps
+  // stop early once one is below kThetaConvergedStep: the error left is
+  // then about its square, below the last bit (on the deltille photos,
+  // 3-5 steps instead of 7). Either way the result is a fixed function of
+  // the input, wherever it is evaluated.
   static constexpr int kThetaIterations = 7;
+  static constexpr double kThetaConvergedStep = 1e-9;
 
   template <typename T>
   static T PupilZ(const T* params, const T& theta) {
@@ -307,18 +311,18 @@ struct KannalaBrandtNoncentralModel {
 
   // The angle theta of the ray that passes through a point at distance r > 0
   // from the axis and height z: the root of h(theta) = theta -
-  // atan2(r, z - z0(theta)), by kThetaIterations Newton steps on the plain
-  // values and one last step in T. For a ceres::Jet that last step, taken
-  // at the root, gives the derivative the implicit function theorem gives
-  // (d theta = -dh / h'), so the dual numbers go through one step instead of
-  // all of them. `residual` returns |h| and `slope` h' = 1 - r z0' / (r^2 +
-  // (z - z0)^2) at the end; slope <= 0 means the point lies inside the
-  // lens' caustic (nearer than any pupil position can be seen from), where
-  // no ray reaches it.
+  // atan2(r, z - z0(theta)), by Newton steps on the plain values (see
+  // kThetaIterations) and one last step in T. For a ceres::Jet that last
+  // step, taken at the root, gives the derivative the implicit function
+  // theorem gives (d theta = -dh / h'), so the dual numbers go through one
+  // step instead of all of them. `residual` returns |h| and `slope` h' = 1 -
+  // r z0' / (r^2 + (z - z0)^2) at the end (plain values: they are only
+  // compared); slope <= 0 means the point lies inside the lens' caustic
+  // (nearer than any pupil position can be seen from), where no ray reaches
+  // it.
   template <typename T>
-  static T SolveTheta(const T* params, const T& r, const T& z, T* residual,
-                      T* slope) {
-    using std::abs;
+  static T SolveTheta(const T* params, const T& r, const T& z, double* residual,
+                      double* slope) {
     using std::atan2;
     double pupil[kNumParams] = {};  // PupilZ reads only the pupil terms
     pupil[kPupilBegin] = internal::ScalarPart(params[kPupilBegin]);
@@ -331,7 +335,9 @@ struct KannalaBrandtNoncentralModel {
       const double h = theta_value - std::atan2(r_value, w);
       const double dh = 1.0 - r_value * PupilZSlope(pupil, theta_value) /
                                   (r_value * r_value + w * w);
-      theta_value = theta_value - h / dh;
+      const double step = h / dh;
+      theta_value -= step;
+      if (!(std::abs(step) >= kThetaConvergedStep)) break;
     }
     T theta(theta_value);
     {
@@ -340,9 +346,11 @@ struct KannalaBrandtNoncentralModel {
       const T dh = T(1) - r * PupilZSlope(params, theta) / (r * r + w * w);
       theta = theta - h / dh;
     }
-    const T w = z - PupilZ(params, theta);
-    *residual = abs(theta - atan2(r, w));
-    *slope = T(1) - r * PupilZSlope(params, theta) / (r * r + w * w);
+    theta_value = internal::ScalarPart(theta);
+    const double w = z_value - PupilZ(pupil, theta_value);
+    *residual = std::abs(theta_value - std::atan2(r_value, w));
+    *slope = 1.0 - r_value * PupilZSlope(pupil, theta_value) /
+                       (r_value * r_value + w * w);
     return theta;
   }
 
@@ -363,9 +371,9 @@ struct KannalaBrandtNoncentralModel {
     } else {
       if (!(r2 > T(0))) return false;
       const T r = sqrt(r2);
-      T residual, slope;
+      double residual, slope;
       const T theta = SolveTheta(params, r, z, &residual, &slope);
-      if (!(residual < T(1e-9)) || !(slope > T(0))) return false;
+      if (!(residual < 1e-9) || !(slope > 0)) return false;
       const T scale = KannalaBrandtModel::DistortTheta(params, theta) / r;
       mx = x * scale;
       my = y * scale;
