@@ -290,7 +290,7 @@ struct KannalaBrandtNoncentralModel {
   // converged, and one more step in T carries the derivatives. The steps
   // stop early once one is below kThetaConvergedStep: the error left is
   // then about its square, below the last bit (on the deltille photos,
-  // 3-5 steps instead of 7). Either way the result is a fixed function of
+  // 2-5 steps instead of 7). Either way the result is a fixed function of
   // the input, wherever it is evaluated.
   static constexpr int kThetaIterations = 7;
   static constexpr double kThetaConvergedStep = 1e-9;
