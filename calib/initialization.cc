@@ -51,20 +51,21 @@ bool SolveDlt(const std::vector<Eigen::Vector3d>& board_norm,
               const std::vector<Eigen::Vector3d>& rays,
               const std::vector<bool>& use, Eigen::Matrix3d* h) {
   Eigen::Matrix<double, 9, 9> ata = Eigen::Matrix<double, 9, 9>::Zero();
-  Eigen::Matrix<double, 3, 9> rows;
   for (size_t i = 0; i < rays.size(); ++i) {
     if (!use[i]) continue;
     const Eigen::Vector3d& x = board_norm[i];
     const Eigen::Vector3d& d = rays[i];
-    rows.setZero();
-    // d x (H x): three rows, rank two.
-    rows.block<1, 3>(0, 3) = -d.z() * x.transpose();
-    rows.block<1, 3>(0, 6) = d.y() * x.transpose();
-    rows.block<1, 3>(1, 0) = d.z() * x.transpose();
-    rows.block<1, 3>(1, 6) = -d.x() * x.transpose();
-    rows.block<1, 3>(2, 0) = -d.y() * x.transpose();
-    rows.block<1, 3>(2, 3) = d.x() * x.transpose();
-    ata.noalias() += rows.transpose() * rows;
+    // d x (H x) = [d]_x (I kron x') h: three rows, rank two, whose
+    // contribution to A'A is ([d]_x' [d]_x) kron (x x'), with
+    // [d]_x' [d]_x = |d|^2 I - d d'.
+    const Eigen::Matrix3d cross =
+        d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose();
+    const Eigen::Matrix3d xx = x * x.transpose();
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) {
+        ata.block<3, 3>(3 * a, 3 * b) += cross(a, b) * xx;
+      }
+    }
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eig(ata);
   if (eig.info() != Eigen::Success) return false;
