@@ -57,7 +57,8 @@ struct CalibrationState {
         options(options_in),
         result(result_in),
         error(error_in),
-        names(CameraModelParamNames(model_in)) {}
+        names(CameraModelParamNames(model_in)),
+        trust_region_radius(options_in.initial_trust_region_radius) {}
 
   // Inputs.
   const std::vector<CalibrationView>& views;
@@ -95,7 +96,7 @@ struct CalibrationState {
   // the radius the last solve ended with (a rejection round continues the
   // solve it follows; restarting at a small radius would damp its steps
   // for several iterations near the minimum).
-  double trust_region_radius = 0;
+  double trust_region_radius;
 
   // Filled by FillResult: the inlier sum of squares and free parameters.
   double sum2 = 0;
@@ -239,8 +240,6 @@ bool CheckViews(CalibrationState* s) {
 // ---------------------------------------------------------------------------
 // Stage 2: initialise.
 
-// Intrinsics and poses from calib/initialization.h on the finite
-// correspondences only; views without an initial pose drop out.
 double OrientationSpreadDeg(const std::vector<Eigen::Isometry3d>& poses,
                             const std::vector<bool>& used);
 
@@ -270,6 +269,9 @@ bool InitialiseFromGivenPoses(CalibrationState* s) {
   return CheckPosedViews(*s);
 }
 
+// Intrinsics and poses from calib/initialization.h on the finite
+// correspondences only (or the caller's, when given); views without an
+// initial pose drop out.
 bool Initialise(CalibrationState* s) {
   if (!s->options.initial_cam_from_board.empty()) {
     return InitialiseFromGivenPoses(s);
@@ -460,9 +462,6 @@ void Solve(CalibrationState* s, const std::vector<bool>& fixed) {
     s->summary = ceres::Solver::Summary();
     s->summary.message = "no corners left to fit";
     return;
-  }
-  if (s->trust_region_radius <= 0) {
-    s->trust_region_radius = s->options.initial_trust_region_radius;
   }
   ceres::Solve(SolverOptions(s->options, s->trust_region_radius, ordering),
                s->problem.get(), &s->summary);
@@ -829,8 +828,8 @@ bool CheckArguments(CameraModelId model, int width, int height,
 // calibration of its far-field model (kannala-brandt for
 // kannala-brandt-noncentral) with the pupil shift at 0: `options` gets
 // initial_params and the central solve's final trust-region radius from it,
-// and `method` says so. Unchanged (and `method`
-// empty) for central models and given initial_params.
+// and `method` says so. Unchanged (and `method` empty) for central models
+// and given initial_params.
 bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
                             CameraModelId model, int width, int height,
                             CalibrationOptions* options, std::string* method,

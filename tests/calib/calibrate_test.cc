@@ -635,27 +635,6 @@ TEST(CalibrateTest, ContinuingFromASolutionTakesFewIterations) {
   }
 }
 
-TEST(CalibrateTest, GivenPosesMustMatchTheViews) {
-  const SyntheticScene scene = SceneFor(0);
-  const SyntheticData data = MakeSyntheticData(scene);
-  CalibrationResult result;
-  std::string error;
-  CalibrationOptions options;
-  options.initial_cam_from_board = data.cam_from_board;
-  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
-  EXPECT_NE(error.find("initial_cam_from_board needs initial_params"),
-            std::string::npos)
-      << error;
-  options.initial_params = scene.camera.params;
-  options.initial_cam_from_board.pop_back();
-  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
-  EXPECT_NE(error.find("one pose per view"), std::string::npos) << error;
-  options = CalibrationOptions();
-  options.initial_trust_region_radius = 0;
-  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
-  EXPECT_NE(error.find("initial_trust_region_radius"), std::string::npos);
-}
-
 TEST(CalibrateTest, InvalidOptionsAndInputsAreRejected) {
   const SyntheticScene scene = SceneFor(0);
   const SyntheticData data = MakeSyntheticData(scene);
@@ -672,6 +651,21 @@ TEST(CalibrateTest, InvalidOptionsAndInputsAreRejected) {
   EXPECT_FALSE(Calibrate(data.views, CameraModelId::kPinholeRadtan, 0, 480,
                          CalibrationOptions(), &result, &error));
   EXPECT_NE(error.find("image size"), std::string::npos);
+  options = CalibrationOptions();
+  options.initial_trust_region_radius = 0;
+  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
+  EXPECT_NE(error.find("initial_trust_region_radius"), std::string::npos);
+  // Given poses need given intrinsics and one pose per view.
+  options = CalibrationOptions();
+  options.initial_cam_from_board = data.cam_from_board;
+  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
+  EXPECT_NE(error.find("initial_cam_from_board needs initial_params"),
+            std::string::npos)
+      << error;
+  options.initial_params = scene.camera.params;
+  options.initial_cam_from_board.pop_back();
+  EXPECT_FALSE(RunCalibration(data, scene, options, &result, &error));
+  EXPECT_NE(error.find("one pose per view"), std::string::npos) << error;
 }
 
 TEST(CalibrateTest, RobustLossNames) {
