@@ -20,6 +20,7 @@
 #include "apps/subcommand.h"
 #include "pipeline/image_io.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/png_writer.h"
 #include "report/overlay.h"
 #include "util/atomic_file.h"
 
@@ -142,7 +143,8 @@ bool WriteOverlay(const cv::Mat& grey, const std::vector<LabelledCorner>& rows,
           std::to_string(c.label.x()) + "," + std::to_string(c.label.y());
     }
   }
-  return WritePng(path, DrawOverlay(grey, overlay, OverlayOptions()), error);
+  return WritePngFile(path, DrawOverlay(grey, overlay, OverlayOptions()),
+                      error);
 }
 
 void EmitImage(const ImageResult& image, bool have_board, YAML::Emitter* out) {

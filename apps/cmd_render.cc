@@ -4,13 +4,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
 #include "apps/common_flags.h"
 #include "apps/config_io.h"
 #include "apps/subcommand.h"
+#include "pipeline/png_writer.h"
 #include "sim/scenes.h"
 #include "util/atomic_file.h"
 
@@ -59,14 +59,8 @@ int RenderInto(const SceneSpec& scene) {
   std::vector<std::string> files;
   for (const SceneView& view : views) {
     const std::string file = scene.name + "_" + view.name + ".png";
-    std::vector<uchar> png;
-    if (!cv::imencode(".png", view.image, png)) {
-      std::cerr << "puzzlecal render: cannot encode " << file << "\n";
-      return kExitOutputError;
-    }
     const std::string path = (std::filesystem::path(FLAGS_out) / file).string();
-    if (!WriteFileAtomically(path, std::string(png.begin(), png.end()),
-                             &error)) {
+    if (!WritePngFile(path, view.image, &error)) {
       std::cerr << "puzzlecal render: " << error << "\n";
       return kExitOutputError;
     }

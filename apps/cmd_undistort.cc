@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -13,6 +12,7 @@
 #include "apps/subcommand.h"
 #include "calib/camera_yaml.h"
 #include "pipeline/image_io.h"
+#include "pipeline/png_writer.h"
 #include "pipeline/undistort.h"
 #include "util/atomic_file.h"
 
@@ -81,10 +81,11 @@ int RunUndistort() {
   MakeUndistortMaps(source, chosen.target, options, &map_x, &map_y);
 
   int written = 0, failed = 0;
+  ImageLoader loader;
   for (const std::string& file : listing.images) {
-    const cv::Mat image = cv::imread(file, cv::IMREAD_UNCHANGED);
-    if (image.empty()) {
-      std::cerr << file << ": not readable as an image; skipped\n";
+    cv::Mat image;
+    if (!loader.LoadUnchanged(file, &image, &error)) {
+      std::cerr << error << "; skipped\n";
       ++failed;
       continue;
     }
@@ -98,14 +99,10 @@ int RunUndistort() {
     cv::Mat undistorted;
     cv::remap(image, undistorted, map_x, map_y, cv::INTER_LINEAR,
               cv::BORDER_CONSTANT, cv::Scalar::all(0));
-    std::vector<uchar> bytes;
     const std::string out =
         (fs::path(FLAGS_out) / fs::path(file).stem()).string() + ".png";
-    if (!cv::imencode(".png", undistorted, bytes) ||
-        !WriteFileAtomically(out, std::string(bytes.begin(), bytes.end()),
-                             &error)) {
-      std::cerr << "puzzlecal undistort: cannot write '" << out << "'"
-                << (error.empty() ? "" : ": " + error) << "\n";
+    if (!WritePngFile(out, undistorted, &error)) {
+      std::cerr << "puzzlecal undistort: " << error << "\n";
       return kExitOutputError;
     }
     ++written;

@@ -12,9 +12,11 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the IMREAD_ flags
 #include <opencv2/imgproc.hpp>
 #include <system_error>
+
+#include "pipeline/opencv_decoder.h"
 
 namespace puzzlecal {
 namespace {
@@ -366,9 +368,9 @@ ImageLoader::~ImageLoader() = default;
 ImageLoader::ImageLoader(ImageLoader&&) noexcept = default;
 ImageLoader& ImageLoader::operator=(ImageLoader&&) noexcept = default;
 
-bool ImageLoader::Load(const std::string& path, cv::Mat* grey,
-                       std::string* error) {
-  *grey = cv::Mat();
+bool ImageLoader::Decode(const std::string& path, bool grey_jpeg,
+                         cv::Mat* decoded, std::string* error) {
+  *decoded = cv::Mat();
   const ImageLoadOptions& options = options_;
   std::vector<unsigned char>& bytes = buffers_->bytes;
   if (!ReadFile(path, &bytes)) {
@@ -393,32 +395,51 @@ bool ImageLoader::Load(const std::string& path, cv::Mat* grey,
              std::to_string(options.max_pixels) + " pixels";
     return false;
   }
-  if (header.png && DecodeGreyPng(bytes, buffers_.get(), grey)) return true;
-  cv::Mat decoded;
+  if (header.png && DecodeGreyPng(bytes, buffers_.get(), decoded)) return true;
   try {
     // JPEGs straight to grey: libjpeg-turbo then skips the chroma
     // (upsampling and colour conversion), 2.7 times faster on a 1600x1200
     // colour photo. EXIF orientation is not applied to any format: the
     // calibration needs the sensor's own pixel frame.
-    decoded = cv::imdecode(
-        bytes, header.jpeg
-                   ? cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION
-                   : cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
+    std::string why;
+    if (!DecodeWithOpenCv(
+            bytes,
+            header.jpeg && grey_jpeg
+                ? cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION
+                : cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH,
+            decoded, &why)) {
+      *error = path + ": " + why;
+      return false;
+    }
   } catch (const cv::Exception& e) {
     *error = path + ": cannot decode the image (" + e.what() + ")";
     return false;
   }
-  if (decoded.empty()) {
+  if (decoded->empty()) {
     *error = path + ": not a readable image (unknown format or corrupt data)";
     return false;
   }
   if (options.max_pixels > 0 &&
-      static_cast<long long>(decoded.total()) > options.max_pixels) {
-    *error = path + ": image of " + std::to_string(decoded.cols) + "x" +
-             std::to_string(decoded.rows) + " pixels exceeds the limit of " +
+      static_cast<long long>(decoded->total()) > options.max_pixels) {
+    *error = path + ": image of " + std::to_string(decoded->cols) + "x" +
+             std::to_string(decoded->rows) + " pixels exceeds the limit of " +
              std::to_string(options.max_pixels) + " pixels";
+    *decoded = cv::Mat();
     return false;
   }
+  return true;
+}
+
+bool ImageLoader::LoadUnchanged(const std::string& path, cv::Mat* image,
+                                std::string* error) {
+  return Decode(path, /*grey_jpeg=*/false, image, error);
+}
+
+bool ImageLoader::Load(const std::string& path, cv::Mat* grey,
+                       std::string* error) {
+  *grey = cv::Mat();
+  cv::Mat decoded;
+  if (!Decode(path, /*grey_jpeg=*/true, &decoded, error)) return false;
   cv::Mat single;
   switch (decoded.channels()) {
     case 1:

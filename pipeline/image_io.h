@@ -59,10 +59,19 @@ class ImageLoader {
 
   // As LoadGreyImage with this loader's options.
   bool Load(const std::string& path, cv::Mat* grey, std::string* error);
+  // The image as stored: its channels (BGR order) and depth kept, no EXIF
+  // orientation applied; the same checks and messages as Load.
+  bool LoadUnchanged(const std::string& path, cv::Mat* image,
+                     std::string* error);
 
   struct Buffers;  // defined in image_io.cc
 
  private:
+  // The file's pixels: 8-bit grey PNGs decoded here, every other image by
+  // OpenCV (JPEGs straight to grey when `grey_jpeg`); sizes checked.
+  bool Decode(const std::string& path, bool grey_jpeg, cv::Mat* decoded,
+              std::string* error);
+
   ImageLoadOptions options_;
   std::unique_ptr<Buffers> buffers_;
 };

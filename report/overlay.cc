@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "util/atomic_file.h"
@@ -148,20 +147,6 @@ cv::Mat DrawOverlay(const cv::Mat& photo, const Overlay& overlay,
   }
   if (bottom > 0) DrawLegend(&canvas, overlay.legend, canvas.rows - 15);
   return canvas;
-}
-
-bool WritePng(const std::string& path, const cv::Mat& image,
-              std::string* error) {
-  std::vector<uchar> bytes;
-  bool encoded = false;
-  try {
-    encoded = !image.empty() && cv::imencode(".png", image, bytes);
-  } catch (const cv::Exception& e) {
-    return Fail("cannot encode " + path + " as PNG: " + e.what(), error);
-  }
-  if (!encoded) return Fail("cannot encode " + path + " as PNG", error);
-  return WriteFileAtomically(path, std::string(bytes.begin(), bytes.end()),
-                             error);
 }
 
 }  // namespace puzzlecal

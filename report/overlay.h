@@ -55,11 +55,6 @@ struct OverlayOptions {
 cv::Mat DrawOverlay(const cv::Mat& photo, const Overlay& overlay,
                     const OverlayOptions& options);
 
-// Encodes `image` as PNG and writes it atomically (temporary name, then
-// rename). False with a message naming the path on failure.
-bool WritePng(const std::string& path, const cv::Mat& image,
-              std::string* error);
-
 }  // namespace puzzlecal
 
 #endif  // PUZZLECAL_REPORT_OVERLAY_H_

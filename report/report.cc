@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "pipeline/png_writer.h"
 #include "report/overlay.h"
 #include "report/plot.h"
 #include "util/atomic_file.h"
@@ -1524,7 +1525,7 @@ bool WriteEvidenceCharts(const std::string& dir, const std::string& prefix,
   data.height = height;
   const std::filesystem::path folder(dir);
   auto write_png = [&](const std::string& name, const cv::Mat& image) {
-    if (!WritePng((folder / name).string(), image, error)) return false;
+    if (!WritePngFile((folder / name).string(), image, error)) return false;
     if (files != nullptr) files->push_back(name);
     return true;
   };
@@ -1576,7 +1577,7 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
   const ReportData data = GatherData(input);
   std::vector<std::string> png_files;
   auto write_png = [&](const std::string& name, const cv::Mat& image) {
-    if (!WritePng((folder / name).string(), image, error)) return false;
+    if (!WritePngFile((folder / name).string(), image, error)) return false;
     summary->files.push_back(name);
     png_files.push_back(name);
     return true;

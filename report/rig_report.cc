@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pipeline/image_io.h"
+#include "pipeline/png_writer.h"
 #include "report/overlay.h"
 #include "report/plot.h"
 #include "util/atomic_file.h"
@@ -336,7 +337,8 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
   const cv::Mat pair =
       RectifiedPairImage(first, second, result.cameras[0].camera,
                          result.cameras[1].camera, rect, options);
-  return WritePng((fs::path(dir) / "rectified_pair.png").string(), pair, error);
+  return WritePngFile((fs::path(dir) / "rectified_pair.png").string(), pair,
+                      error);
 }
 
 }  // namespace puzzlecal

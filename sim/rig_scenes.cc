@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <random>
 
+#include "pipeline/png_writer.h"
 #include "sim/pixel_rays.h"
 #include "sim/scenes.h"
 
@@ -243,13 +243,8 @@ bool RenderRigScene(const RigSceneSpec& scene, const std::string& dir,
                     render_summary.reason);
       }
       const fs::path file = folder / RigFrameFileName(static_cast<int>(f));
-      bool written = false;
-      try {
-        written = cv::imwrite(file.string(), image);
-      } catch (const cv::Exception& e) {
-        written = false;
-      }
-      if (!written) return fail("cannot write '" + file.string() + "'");
+      std::string why;
+      if (!WritePngFile(file.string(), image, &why)) return fail(why);
       ++local.images_per_camera[c];
       ++images_per_frame[f];
     }
