@@ -26,12 +26,19 @@
 // a fisheye folder), as `calibrate` runs it: the solve and the evidence
 // (cross-validation halves), their seconds and iterations, and the whole
 // `calibrate` per photo (the 2-thread folder run plus both) against SB.
+// Last, the program itself (the `puzzlecal` built beside this bench, when
+// found): `puzzlecal version` (the program's start alone, best of 5) and
+// `puzzlecal calibrate --threads 2 --model kannala-brandt-noncentral` of
+// the folder, wall time from the shell (start, images, calibration,
+// evidence, camera file; no report), per photo and against SB.
 //
 // Usage: bench_pipeline [folder] [sb_photos] [cols rows]
 //   folder: default the deltille photos (skipped with a message when
 //   absent); sb_photos: photos given to findChessboardCornersSB (default
 //   4); cols rows: inner corners of the board (default 11 8).
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -39,6 +46,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -225,6 +233,55 @@ CalibrationRun RunCalibration(const std::vector<CalibrationView>& views,
   return run;
 }
 
+// The `puzzlecal` program built beside this bench (<build>/apps/), or empty.
+std::string ProgramBesideThisBench() {
+  std::error_code ec;
+  const std::filesystem::path self =
+      std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  const std::filesystem::path program =
+      self.parent_path().parent_path() / "apps" / "puzzlecal";
+  return std::filesystem::exists(program, ec) ? program.string() : "";
+}
+
+// Wall milliseconds of a shell command (-1 when it fails).
+double CommandMs(const std::string& command) {
+  const double t = WallMs();
+  const int status = std::system(command.c_str());
+  const double ms = WallMs() - t;
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? ms : -1.0;
+}
+
+// The program's start and its whole `calibrate` of the folder.
+struct ProgramRun {
+  double start_ms = -1;      // `puzzlecal version`, best of 5
+  double calibrate_ms = -1;  // the whole calibrate command
+};
+
+ProgramRun RunProgram(const std::string& folder, const Board& board) {
+  ProgramRun run;
+  const std::string program = ProgramBesideThisBench();
+  if (program.empty()) return run;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("puzzlecal_bench_pipeline_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string board_file = (dir / "board.yaml").string();
+  std::ofstream(board_file) << "type: checkerboard\ncols: " << board.cols
+                            << "\nrows: " << board.rows
+                            << "\ntile_size_m: " << board.tile_size_m << "\n";
+  for (int k = 0; k < 5; ++k) {
+    const double ms = CommandMs("'" + program + "' version >/dev/null");
+    if (ms >= 0 && (run.start_ms < 0 || ms < run.start_ms)) run.start_ms = ms;
+  }
+  run.calibrate_ms = CommandMs(
+      "'" + program + "' calibrate --images '" + folder + "' --board '" +
+      board_file + "' --model kannala-brandt-noncentral --threads 2 --out '" +
+      (dir / "camera.yaml").string() + "' --quiet >/dev/null 2>&1");
+  std::filesystem::remove_all(dir);
+  return run;
+}
+
 }  // namespace
 }  // namespace puzzlecal
 
@@ -332,6 +389,17 @@ int main(int argc, char** argv) {
         sb / whole_ms[m], m == 0 ? "," : "");
   }
   std::printf("  ],\n");
+  const ProgramRun program = RunProgram(folder, board);
+  const double program_ms_per_photo =
+      program.calibrate_ms / listing.images.size();
+  std::printf(
+      "  \"program\": {\"found\": %s, \"start_ms\": %.1f, "
+      "\"calibrate_noncentral_threads_2_ms\": %.0f, "
+      "\"calibrate_ms_per_photo\": %.2f, \"calibrate_speedup_over_sb\": "
+      "%.1f},\n",
+      program.calibrate_ms >= 0 ? "true" : "false", program.start_ms,
+      program.calibrate_ms, program_ms_per_photo,
+      program.calibrate_ms > 0 ? sb / program_ms_per_photo : 0.0);
   std::printf(
       "  \"speedup_over_sb\": {\"photo_to_ids_one_thread\": %.1f, "
       "\"detect_only\": %.1f, \"folder_threads_1_wall\": %.1f, "
