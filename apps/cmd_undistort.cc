@@ -14,7 +14,6 @@
 #include "pipeline/image_io.h"
 #include "pipeline/png_writer.h"
 #include "pipeline/undistort.h"
-#include "util/atomic_file.h"
 
 // Defined by `compare` (a camera file in any of the four formats).
 DECLARE_string(camera);

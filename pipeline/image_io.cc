@@ -17,6 +17,7 @@
 #include <system_error>
 
 #include "pipeline/opencv_decoder.h"
+#include "pipeline/png_filters.h"
 
 namespace puzzlecal {
 namespace {
@@ -169,11 +170,8 @@ bool UnfilterRow(int filter, const unsigned char* raw,
       return true;
     case 4:  // Paeth
       for (int i = 0; i < width; ++i) {
-        const int a = i > 0 ? out[i - 1] : 0, b = prior[i];
-        const int c = i > 0 ? prior[i - 1] : 0;
-        const int pa = std::abs(b - c), pb = std::abs(a - c);
-        const int pc = std::abs(a + b - 2 * c);
-        out[i] = raw[i] + (pa <= pb && pa <= pc ? a : pb <= pc ? b : c);
+        out[i] = raw[i] + PaethPredictor(i > 0 ? out[i - 1] : 0, prior[i],
+                                         i > 0 ? prior[i - 1] : 0);
       }
       return true;
     default:

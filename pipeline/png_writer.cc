@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include "pipeline/png_filters.h"
 #include "util/atomic_file.h"
 #include "util/failure.h"
 
@@ -61,12 +62,6 @@ void PngRow(const cv::Mat& image, int y, unsigned char* out) {
       sample[1] = static_cast<unsigned char>(v & 0xff);
     }
   }
-}
-
-int PaethPredictor(int a, int b, int c) {
-  const int pa = std::abs(b - c), pb = std::abs(a - c);
-  const int pc = std::abs(a + b - 2 * c);
-  return pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
 }
 
 // Filters `row` (with `prior`, the row above in PNG order, zeros for the

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "util/atomic_file.h"
 #include "util/failure.h"
 
 namespace puzzlecal {
