@@ -166,8 +166,20 @@ double ViewFitCost(const Camera& camera,
   return cost;
 }
 
+// An evenly spread subset of at most `max_views` of `used`.
+std::vector<const CalibrationView*> SpreadSubset(
+    const std::vector<const CalibrationView*>& used, int max_views) {
+  std::vector<const CalibrationView*> subset;
+  for (size_t i : EvenlySpreadIndices(used.size(), max_views)) {
+    subset.push_back(used[i]);
+  }
+  return subset;
+}
+
 // 1D search for f (fx = fy = f, centred principal point, no distortion):
-// log-spaced scan, then golden section around the best candidate.
+// log-spaced scan on an evenly spread subset of the views (it only brackets
+// the minimum), then golden section on all of them around the best
+// candidate.
 double SearchFocalLength(CameraModelId model, int width, int height,
                          const std::vector<const CalibrationView*>& views,
                          const InitializationOptions& options,
@@ -178,15 +190,18 @@ double SearchFocalLength(CameraModelId model, int width, int height,
   const int steps = options.focal_search_steps;
   InitializationOptions search_options = options;
   search_options.reweight_iterations = options.focal_search_reweight_iterations;
-  auto cost_at = [&](double log_f) {
+  auto cost_at = [&](double log_f,
+                     const std::vector<const CalibrationView*>& fit_views) {
     return ViewFitCost(CandidateCamera(model, width, height, std::exp(log_f)),
-                       views, search_options);
+                       fit_views, search_options);
   };
+  const std::vector<const CalibrationView*> scan_views =
+      SpreadSubset(views, options.focal_search_scan_max_views);
   int best = 0;
   double best_value = std::numeric_limits<double>::infinity();
   const double step = (log_max - log_min) / (steps - 1);
   for (int k = 0; k < steps; ++k) {
-    const double value = cost_at(log_min + k * step);
+    const double value = cost_at(log_min + k * step, scan_views);
     if (value < best_value) {
       best_value = value;
       best = k;
@@ -196,24 +211,28 @@ double SearchFocalLength(CameraModelId model, int width, int height,
   double b = log_min + std::min(steps - 1, best + 1) * step;
   const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
   double c = b - ratio * (b - a), d = a + ratio * (b - a);
-  double fc = cost_at(c), fd = cost_at(d);
+  double fc = cost_at(c, views), fd = cost_at(d, views);
   for (int it = 0; it < options.focal_search_refine_iterations; ++it) {
     if (fc < fd) {
       b = d;
       d = c;
       fd = fc;
       c = b - ratio * (b - a);
-      fc = cost_at(c);
+      fc = cost_at(c, views);
     } else {
       a = c;
       c = d;
       fc = fd;
       d = a + ratio * (b - a);
-      fd = cost_at(d);
+      fd = cost_at(d, views);
     }
   }
   double log_f = fc < fd ? c : d;
   double value = std::min(fc, fd);
+  // The scan's best on the same views as the golden section's.
+  if (scan_views.size() < views.size()) {
+    best_value = cost_at(log_min + best * step, views);
+  }
   if (best_value < value) {  // the scan point itself was better
     log_f = log_min + best * step;
     value = best_value;
@@ -459,6 +478,10 @@ bool InitializationOptions::Check(std::string* why) const {
   if (focal_search_max_views < 1) {
     return Fail("initialization.focal_search_max_views must be >= 1", why);
   }
+  if (focal_search_scan_max_views < 1) {
+    return Fail("initialization.focal_search_scan_max_views must be >= 1",
+                why);
+  }
   if (pose_refine_iterations < 0) {
     return Fail("initialization.pose_refine_iterations must be >= 0", why);
   }
@@ -637,16 +660,6 @@ void PoseAllViews(const Camera& camera,
     }
   });
   for (size_t i = 0; i < views.size(); ++i) result->view_ok[i] = ok[i] != 0;
-}
-
-// An evenly spread subset of at most `max_views` of `used`.
-std::vector<const CalibrationView*> SpreadSubset(
-    const std::vector<const CalibrationView*>& used, int max_views) {
-  std::vector<const CalibrationView*> subset;
-  for (size_t i : EvenlySpreadIndices(used.size(), max_views)) {
-    subset.push_back(used[i]);
-  }
-  return subset;
 }
 
 // The distortion-free starting camera: the focal-length search with a
