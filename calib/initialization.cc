@@ -479,8 +479,7 @@ bool InitializationOptions::Check(std::string* why) const {
     return Fail("initialization.focal_search_max_views must be >= 1", why);
   }
   if (focal_search_scan_max_views < 1) {
-    return Fail("initialization.focal_search_scan_max_views must be >= 1",
-                why);
+    return Fail("initialization.focal_search_scan_max_views must be >= 1", why);
   }
   if (pose_refine_iterations < 0) {
     return Fail("initialization.pose_refine_iterations must be >= 0", why);
