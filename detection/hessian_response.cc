@@ -109,22 +109,18 @@ int FindSaddlePeaks(const cv::Mat& blurred, float trace_weight_k,
 
 namespace {
 
-// The last 2 radius + 1 response rows and their horizontal 3-maxima, kept
-// in a ring of rows inside the caller's buffer, one row of flags (a byte
-// per pixel) and the same flags as bits (bit l of byte i: pixel 8 i + l;
-// bytes up to a multiple of 8).
+// The last 2 radius + 1 response rows, kept in a ring of rows inside the
+// caller's buffer, and one row of flags as bits (bit l of byte i: pixel
+// 8 i + l; bytes up to a multiple of 8).
 class ResponseRing {
  public:
   ResponseRing(int width, int radius, std::vector<float>* buffer)
       : width_(width), ring_(2 * radius + 1) {
     const size_t row_size = static_cast<size_t>(width);
     const size_t bit_bytes = BitBytes(width);
-    buffer->resize(2 * ring_ * row_size + row_size + bit_bytes / 4);
+    buffer->resize(ring_ * row_size + bit_bytes / 4);
     response_ = buffer->data();
-    max3_ = buffer->data() + ring_ * row_size;
-    flags_ = reinterpret_cast<uint8_t*>(buffer->data() + 2 * ring_ * row_size);
-    bits_ = reinterpret_cast<uint8_t*>(buffer->data() + 2 * ring_ * row_size +
-                                       row_size);
+    bits_ = reinterpret_cast<uint8_t*>(buffer->data() + ring_ * row_size);
   }
 
   // Bytes of the bit flags of a row: whole 64-pixel words.
@@ -133,8 +129,6 @@ class ResponseRing {
   }
 
   float* Row(int y) const { return response_ + Offset(y); }
-  float* Max3(int y) const { return max3_ + Offset(y); }
-  uint8_t* Flags() const { return flags_; }
   uint8_t* Bits() const { return bits_; }
 
  private:
@@ -144,13 +138,11 @@ class ResponseRing {
   int width_;
   int ring_;
   float* response_;
-  float* max3_;
-  uint8_t* flags_;
   uint8_t* bits_;
 };
 
-// Response row `y` into the ring, its samples for the median (see
-// PeakRows) and its horizontal 3-maxima.
+// Response row `y` into the ring and its samples for the median (see
+// PeakRows).
 inline void AddResponseRow(const cv::Mat& blurred, int y, float k,
                            const PeakRows& part, int row_begin, int row_end,
                            const ResponseRing& ring) {
@@ -163,95 +155,92 @@ inline void AddResponseRow(const cv::Mat& blurred, int y, float k,
       part.samples->push_back(out[x]);
     }
   }
-  float* __restrict max3 = ring.Max3(y);
-  max3[0] = out[0];
-  max3[width - 1] = out[width - 1];
-  for (int x = 1; x < width - 1; ++x) {
-    max3[x] = std::max(std::max(out[x - 1], out[x]), out[x + 1]);
-  }
 }
 
-// Flags the pixels of row y above the threshold that equal the maximum of
-// their 3x3 neighbourhood, without branches (most of the image is
-// neither). Returns the number of pixels above the threshold.
-inline int FlagLocalMaxima(const ResponseRing& ring, int y, int width,
-                           float threshold) {
-  const float* __restrict row = ring.Row(y);
-  const float* __restrict m_up = ring.Max3(y - 1);
-  const float* __restrict m_row = ring.Max3(y);
-  const float* __restrict m_down = ring.Max3(y + 1);
-  uint8_t* __restrict flags = ring.Flags();
+// Whether no pixel of the 3x3 neighbourhood of interior pixel x (rows
+// `up`, `row`, `down`), of value v, exceeds it.
+inline bool IsMaximumOf3x3(const float* up, const float* row, const float* down,
+                           int x, float v) {
+  return !(up[x - 1] > v || up[x] > v || up[x + 1] > v || row[x - 1] > v ||
+           row[x + 1] > v || down[x - 1] > v || down[x] > v || down[x + 1] > v);
+}
+
+// Sets the flag bits (in `bits`, cleared by the caller) of the pixels x in
+// [begin, end) of the middle row above the threshold and the maximum of
+// their 3x3 neighbourhood (ties included); returns the number above the
+// threshold.
+// Pixels 0 and width - 1 are never flagged nor counted.
+inline int FlagLocalMaximaScalar(const float* up, const float* row,
+                                 const float* down, int width, int begin,
+                                 int end, float threshold, uint8_t* bits) {
   int count = 0;
-  for (int x = 1; x < width - 1; ++x) {
+  for (int x = std::max(begin, 1); x < std::min(end, width - 1); ++x) {
     const float v = row[x];
-    const float m = std::max(std::max(m_up[x], m_row[x]), m_down[x]);
-    const int is_above = v > threshold;
-    count += is_above;
-    flags[x] = static_cast<uint8_t>(is_above & (v >= m));
+    if (!(v > threshold)) continue;
+    ++count;
+    if (IsMaximumOf3x3(up, row, down, x, v)) {
+      bits[x / 8] = static_cast<uint8_t>(bits[x / 8] | (1u << (x % 8)));
+    }
   }
-  flags[0] = 0;
-  flags[width - 1] = 0;
   return count;
-}
-
-// The byte flags of a row as bits (see ResponseRing).
-inline void PackFlags(const uint8_t* flags, int width, uint8_t* bits) {
-  const size_t bytes = ResponseRing::BitBytes(width);
-  std::memset(bits, 0, bytes);
-  int x = 0;
-  for (; x + 8 <= width; x += 8) {
-    uint64_t word;
-    std::memcpy(&word, flags + x, sizeof word);
-    // Flags are 0 or 1: the multiplication gathers byte l into bit l of
-    // the top byte (no carries).
-    bits[x / 8] = static_cast<uint8_t>(
-        ((word & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56);
-  }
-  for (; x < width; ++x) {
-    bits[x / 8] = static_cast<uint8_t>(bits[x / 8] | (flags[x] << (x % 8)));
-  }
 }
 
 #ifdef PUZZLECAL_FLAGS_AVX2
-// FlagLocalMaxima writing bits straight from the vector comparisons (the
-// same comparisons, so the same flags and count).
-__attribute__((target("avx2"))) int FlagLocalMaximaBitsAvx2(
-    const ResponseRing& ring, int y, int width, float threshold) {
-  const float* __restrict row = ring.Row(y);
-  const float* __restrict m_up = ring.Max3(y - 1);
-  const float* __restrict m_row = ring.Max3(y);
-  const float* __restrict m_down = ring.Max3(y + 1);
-  uint8_t* __restrict bits = ring.Bits();
-  std::memset(bits, 0, ResponseRing::BitBytes(width));
+// Flag bits of the 8 pixels from x on (1 <= x, x + 9 <= width), given
+// their comparison with the threshold (`v`, `above`).
+__attribute__((target("avx2"))) inline uint8_t MaximaOf8(const float* up,
+                                                         const float* row,
+                                                         const float* down,
+                                                         int x, __m256 v,
+                                                         int above) {
+  __m256 m =
+      _mm256_max_ps(_mm256_loadu_ps(up + x - 1), _mm256_loadu_ps(up + x));
+  m = _mm256_max_ps(m, _mm256_loadu_ps(up + x + 1));
+  m = _mm256_max_ps(m, _mm256_loadu_ps(row + x - 1));
+  m = _mm256_max_ps(m, _mm256_loadu_ps(row + x + 1));
+  m = _mm256_max_ps(m, _mm256_loadu_ps(down + x - 1));
+  m = _mm256_max_ps(m, _mm256_loadu_ps(down + x));
+  m = _mm256_max_ps(m, _mm256_loadu_ps(down + x + 1));
+  // Not exceeded by any neighbour: v >= their maximum.
+  const int is_max = _mm256_movemask_ps(_mm256_cmp_ps(v, m, _CMP_GE_OQ));
+  return static_cast<uint8_t>(above & is_max);
+}
+
+// The same, 8 pixels per vector comparison, 32 compared before a branch;
+// the 3x3 maxima only for the blocks of 32 with a pixel above the
+// threshold (nearly all have none). The first 8 pixels and the last ones
+// go through the scalar code (their neighbourhoods leave the row).
+__attribute__((target("avx2"))) int FlagLocalMaximaAvx2(
+    const float* up, const float* row, const float* down, int width,
+    float threshold, uint8_t* bits) {
   const __m256 t = _mm256_set1_ps(threshold);
-  int count = 0;
-  int x = 0;
-  for (; x + 8 <= width; x += 8) {
+  int count =
+      FlagLocalMaximaScalar(up, row, down, width, 0, 8, threshold, bits);
+  int x = 8;
+  for (; x + 33 <= width; x += 32) {
+    __m256 v[4];
+    __m256 any = _mm256_setzero_ps();
+    __m256 above[4];
+    for (int g = 0; g < 4; ++g) {
+      v[g] = _mm256_loadu_ps(row + x + 8 * g);
+      above[g] = _mm256_cmp_ps(v[g], t, _CMP_GT_OQ);
+      any = _mm256_or_ps(any, above[g]);
+    }
+    if (_mm256_testz_ps(any, any)) continue;
+    for (int g = 0; g < 4; ++g) {
+      const int mask = _mm256_movemask_ps(above[g]);
+      count += __builtin_popcount(mask);
+      bits[x / 8 + g] = MaximaOf8(up, row, down, x + 8 * g, v[g], mask);
+    }
+  }
+  for (; x + 9 <= width; x += 8) {
     const __m256 v = _mm256_loadu_ps(row + x);
-    // std::max(a, b) is b when a < b, else a: _mm256_max_ps(b, a).
-    const __m256 m = _mm256_max_ps(
-        _mm256_loadu_ps(m_down + x),
-        _mm256_max_ps(_mm256_loadu_ps(m_row + x), _mm256_loadu_ps(m_up + x)));
-    const __m256 is_above = _mm256_cmp_ps(v, t, _CMP_GT_OQ);
-    const __m256 is_max = _mm256_cmp_ps(v, m, _CMP_GE_OQ);
-    count += __builtin_popcount(_mm256_movemask_ps(is_above));
-    bits[x / 8] = static_cast<uint8_t>(
-        _mm256_movemask_ps(_mm256_and_ps(is_above, is_max)));
+    const int mask = _mm256_movemask_ps(_mm256_cmp_ps(v, t, _CMP_GT_OQ));
+    count += __builtin_popcount(mask);
+    bits[x / 8] = MaximaOf8(up, row, down, x, v, mask);
   }
-  for (; x < width; ++x) {
-    const float v = row[x];
-    const float m = std::max(std::max(m_up[x], m_row[x]), m_down[x]);
-    const int is_above = v > threshold;
-    count += is_above;
-    bits[x / 8] =
-        static_cast<uint8_t>(bits[x / 8] | ((is_above & (v >= m)) << (x % 8)));
-  }
-  // Pixels 0 and width - 1 are never flagged nor counted.
-  count -= (row[0] > threshold) + (row[width - 1] > threshold);
-  bits[0] = static_cast<uint8_t>(bits[0] & ~1u);
-  const int last = width - 1;
-  bits[last / 8] = static_cast<uint8_t>(bits[last / 8] & ~(1u << (last % 8)));
-  return count;
+  return count +
+         FlagLocalMaximaScalar(up, row, down, width, x, width, threshold, bits);
 }
 
 bool HasAvx2() {
@@ -260,16 +249,23 @@ bool HasAvx2() {
 }
 #endif
 
-// The flags of row y as bits (ring.Bits()); returns the number of pixels
-// above the threshold (see FlagLocalMaxima).
-inline int FlagLocalMaximaBits(const ResponseRing& ring, int y, int width,
-                               float threshold) {
+// The flags of row y as bits (ring.Bits()): pixels above the threshold
+// that no pixel of their 3x3 neighbourhood exceeds. Returns the number of
+// pixels above the threshold (pixels 0 and width - 1 excepted: they have no
+// 3x3 neighbourhood).
+inline int FlagLocalMaxima(const ResponseRing& ring, int y, int width,
+                           float threshold) {
+  uint8_t* bits = ring.Bits();
+  std::memset(bits, 0, ResponseRing::BitBytes(width));
+  const float* up = ring.Row(y - 1);
+  const float* row = ring.Row(y);
+  const float* down = ring.Row(y + 1);
 #ifdef PUZZLECAL_FLAGS_AVX2
-  if (HasAvx2()) return FlagLocalMaximaBitsAvx2(ring, y, width, threshold);
+  if (HasAvx2()) {
+    return FlagLocalMaximaAvx2(up, row, down, width, threshold, bits);
+  }
 #endif
-  const int count = FlagLocalMaxima(ring, y, width, threshold);
-  PackFlags(ring.Flags(), width, ring.Bits());
-  return count;
+  return FlagLocalMaximaScalar(up, row, down, width, 0, width, threshold, bits);
 }
 
 // Whether the flagged pixel (x, y) of value v is the maximum of its
@@ -348,7 +344,7 @@ PUZZLECAL_VECTOR_CLONES int FindSaddlePeaksInRows(
     }
     const int y = y_new - radius;  // the row whose window is complete
     if (y < 1 || y > height - 2 || y < row_begin || y >= row_end) continue;
-    above += FlagLocalMaximaBits(ring, y, width, threshold);
+    above += FlagLocalMaxima(ring, y, width, threshold);
     const float* row = ring.Row(y);
     for (int i0 = 0; i0 < bit_bytes; i0 += 8) {
       // Skip 64 flags at once (almost all are zero); then the flagged
