@@ -253,6 +253,7 @@ struct Fields<InitializationOptions> {
     v.Field("focal_search_truncation_px", o.focal_search_truncation_px);
     v.Field("focal_search_max_views", o.focal_search_max_views);
     v.Field("focal_search_scan_max_views", o.focal_search_scan_max_views);
+    v.Field("focal_search_scan_candidates", o.focal_search_scan_candidates);
     v.Field("max_focal_aspect", o.max_focal_aspect);
     v.Field("pose_refine_iterations", o.pose_refine_iterations);
     v.Field("pose_refine_loss_px", o.pose_refine_loss_px);

@@ -176,10 +176,28 @@ std::vector<const CalibrationView*> SpreadSubset(
   return subset;
 }
 
+// The scan steps whose cost is a local minimum (not above either
+// neighbour's), the lowest first, at most `count` of them.
+std::vector<int> LowestLocalMinima(const std::vector<double>& cost, int count) {
+  std::vector<int> minima;
+  const int n = static_cast<int>(cost.size());
+  for (int k = 0; k < n; ++k) {
+    if ((k == 0 || cost[k] <= cost[k - 1]) &&
+        (k == n - 1 || cost[k] <= cost[k + 1])) {
+      minima.push_back(k);
+    }
+  }
+  std::stable_sort(minima.begin(), minima.end(),
+                   [&](int i, int j) { return cost[i] < cost[j]; });
+  if (static_cast<int>(minima.size()) > count) minima.resize(count);
+  return minima;
+}
+
 // 1D search for f (fx = fy = f, centred principal point, no distortion):
 // log-spaced scan on an evenly spread subset of the views (it only brackets
-// the minimum), then golden section on all of them around the best
-// candidate.
+// the minimum; its lowest local minima are scored again on all views, so a
+// subset that misjudges which basin is deepest does not pick the bracket),
+// then golden section on all of them around the best candidate.
 double SearchFocalLength(CameraModelId model, int width, int height,
                          const std::vector<const CalibrationView*>& views,
                          const InitializationOptions& options,
@@ -197,11 +215,19 @@ double SearchFocalLength(CameraModelId model, int width, int height,
   };
   const std::vector<const CalibrationView*> scan_views =
       SpreadSubset(views, options.focal_search_scan_max_views);
+  const double step = (log_max - log_min) / (steps - 1);
+  std::vector<double> scan_cost(steps);
+  for (int k = 0; k < steps; ++k) {
+    scan_cost[k] = cost_at(log_min + k * step, scan_views);
+  }
+  // The best scan step, its cost on all views.
   int best = 0;
   double best_value = std::numeric_limits<double>::infinity();
-  const double step = (log_max - log_min) / (steps - 1);
-  for (int k = 0; k < steps; ++k) {
-    const double value = cost_at(log_min + k * step, scan_views);
+  const bool subset = scan_views.size() < views.size();
+  for (int k : LowestLocalMinima(
+           scan_cost, subset ? options.focal_search_scan_candidates : 1)) {
+    const double value =
+        subset ? cost_at(log_min + k * step, views) : scan_cost[k];
     if (value < best_value) {
       best_value = value;
       best = k;
@@ -229,10 +255,6 @@ double SearchFocalLength(CameraModelId model, int width, int height,
   }
   double log_f = fc < fd ? c : d;
   double value = std::min(fc, fd);
-  // The scan's best on the same views as the golden section's.
-  if (scan_views.size() < views.size()) {
-    best_value = cost_at(log_min + best * step, views);
-  }
   if (best_value < value) {  // the scan point itself was better
     log_f = log_min + best * step;
     value = best_value;
@@ -480,6 +502,10 @@ bool InitializationOptions::Check(std::string* why) const {
   }
   if (focal_search_scan_max_views < 1) {
     return Fail("initialization.focal_search_scan_max_views must be >= 1", why);
+  }
+  if (focal_search_scan_candidates < 1) {
+    return Fail("initialization.focal_search_scan_candidates must be >= 1",
+                why);
   }
   if (pose_refine_iterations < 0) {
     return Fail("initialization.pose_refine_iterations must be >= 0", why);

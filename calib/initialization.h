@@ -63,6 +63,10 @@ struct InitializationOptions {
   // (it costs steps x views pose fits, the bulk of the search). Default 16.
   // >= 1.
   int focal_search_scan_max_views = 16;
+  // When the scan ran on a subset, this many of its lowest local minima are
+  // scored on all search views, and the best of them centres the golden
+  // section's bracket. Default 3. >= 1.
+  int focal_search_scan_candidates = 3;
   // Zhang's full solution (fx, fy, cx, cy free) is kept as a candidate only
   // when fx / fy lies in [1 / max_focal_aspect, max_focal_aspect] and the
   // principal point inside the image. Default 2. >= 1.

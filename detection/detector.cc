@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "detection/corner_filters.h"
+#include "detection/grey_blur.h"
 #include "detection/hessian_response.h"
 #include "detection/subpixel.h"
 #include "detection/vector_clones.h"
@@ -420,6 +421,7 @@ struct CornerDetector::Buffers {
   cv::Mat band;                  // blurred rows of a band of level 0
   std::vector<float> response_rows;  // ring of response rows
   std::vector<float> row;            // one row of the downsampling
+  std::vector<float> blur_row;       // one row of the 8-bit blur
   std::vector<float> scratch;        // response and noise samples
   std::vector<ResponsePeak> peaks;   // of one band or one level
   GradientRefineScratch gradient;    // gradient-orthogonality patches
@@ -621,11 +623,17 @@ void DetectionPass::MakeBlurKernels() {
 
 // Grey rows [a, b) of the input, normalised and blurred, into `out`: one
 // separable pass from the input type straight to float, with the
-// normalisation folded into the kernel. On a band the filter reads the
-// input rows around it, so a band equals those rows of the whole image.
+// normalisation folded into the kernel (grey_blur.h for 8-bit input and
+// the default 5-tap kernel, cv::sepFilter2D otherwise). On a band the
+// filter reads the input rows around it, so a band equals those rows of
+// the whole image.
 void DetectionPass::BlurRows(int a, int b, cv::Mat* out) const {
   const cv::Mat band = single_->rowRange(a, b);
-  if (options_.blur_sigma_px > 0.0) {
+  if (options_.blur_sigma_px > 0.0 && single_->type() == CV_8UC1 &&
+      IsSymmetricKernel5(kernel_scaled_) && IsSymmetricKernel5(kernel_)) {
+    out->create(b - a, width_, CV_32FC1);
+    BlurGreyRows5(*single_, a, b, kernel_scaled_, kernel_, &b_.blur_row, out);
+  } else if (options_.blur_sigma_px > 0.0) {
     cv::sepFilter2D(band, *out, CV_32F, kernel_scaled_, kernel_,
                     cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
   } else {

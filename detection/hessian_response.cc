@@ -4,12 +4,11 @@
 #include <cstdint>
 #include <cstring>
 
-#if defined(__GNUC__) && defined(__x86_64__)
-#include <immintrin.h>
-#define PUZZLECAL_FLAGS_AVX2 1
-#endif
-
 #include "detection/vector_clones.h"
+
+#ifdef PUZZLECAL_AVX2_INTRINSICS
+#include <immintrin.h>
+#endif
 
 namespace puzzlecal {
 
@@ -185,7 +184,7 @@ inline int FlagLocalMaximaScalar(const float* up, const float* row,
   return count;
 }
 
-#ifdef PUZZLECAL_FLAGS_AVX2
+#ifdef PUZZLECAL_AVX2_INTRINSICS
 // Flag bits of the 8 pixels from x on (1 <= x, x + 9 <= width), given
 // their comparison with the threshold (`v`, `above`).
 __attribute__((target("avx2"))) inline uint8_t MaximaOf8(const float* up,
@@ -243,10 +242,6 @@ __attribute__((target("avx2"))) int FlagLocalMaximaAvx2(
          FlagLocalMaximaScalar(up, row, down, width, x, width, threshold, bits);
 }
 
-bool HasAvx2() {
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-}
 #endif
 
 // The flags of row y as bits (ring.Bits()): pixels above the threshold
@@ -260,8 +255,8 @@ inline int FlagLocalMaxima(const ResponseRing& ring, int y, int width,
   const float* up = ring.Row(y - 1);
   const float* row = ring.Row(y);
   const float* down = ring.Row(y + 1);
-#ifdef PUZZLECAL_FLAGS_AVX2
-  if (HasAvx2()) {
+#ifdef PUZZLECAL_AVX2_INTRINSICS
+  if (CpuHasAvx2()) {
     return FlagLocalMaximaAvx2(up, row, down, width, threshold, bits);
   }
 #endif

@@ -12,4 +12,16 @@
 #define PUZZLECAL_VECTOR_CLONES
 #endif
 
+// Hand-written 256-bit code (functions marked __attribute__((target("avx2"))),
+// called only when CpuHasAvx2()) on GCC and Clang for x86-64.
+#if defined(__GNUC__) && defined(__x86_64__)
+#define PUZZLECAL_AVX2_INTRINSICS 1
+namespace puzzlecal {
+inline bool CpuHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+}  // namespace puzzlecal
+#endif
+
 #endif  // PUZZLECAL_DETECTION_VECTOR_CLONES_H_

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tests/calib/synthetic_views.h"
+#include "util/statistics.h"
 
 namespace puzzlecal {
 namespace {
@@ -20,9 +21,9 @@ using testing::SyntheticScene;
 // and cut by the image border (the recipe of the bundled sample set).
 SyntheticScene WideAngleScene() {
   SyntheticScene scene;
-  scene.camera = MakeCamera(CameraModelId::kPinholeRadtan, 800, 600,
-                            {400.0, 400.4, 409.8, 294.1, -0.2, 0.01, 0.0006,
-                             -0.0004, 0.0003});
+  scene.camera = MakeCamera(
+      CameraModelId::kPinholeRadtan, 800, 600,
+      {400.0, 400.4, 409.8, 294.1, -0.2, 0.01, 0.0006, -0.0004, 0.0003});
   scene.board_cols = 23;
   scene.board_rows = 16;
   scene.num_views = 15;
@@ -148,6 +149,44 @@ TEST(InitializationTest, FocalScanOnASubsetFindsTheFullScansFocalLength) {
   EXPECT_NEAR(f_full / scene.camera.params[0], 1.0, 0.06);
 }
 
+// When the scan's subset misjudges which basin is deepest, its lowest
+// local minima scored on all views pick the right bracket. Views of two
+// lenses (focal lengths f and 1.6 f): the spread subset holds mostly the
+// first lens's views, all views mostly the second's.
+TEST(InitializationTest, FocalScanCandidatesAreScoredOnAllViews) {
+  SyntheticScene scene = FisheyeScene();
+  scene.num_views = 40;
+  const SyntheticData first = MakeSyntheticData(scene);
+  SyntheticScene longer = scene;
+  longer.camera.params[0] *= 1.6;
+  longer.camera.params[1] *= 1.6;
+  longer.seed += 1;
+  const SyntheticData second = MakeSyntheticData(longer);
+  InitializationOptions options;
+  options.start_refine_iterations = 0;  // the search's own camera
+  const std::vector<size_t> in_subset =
+      EvenlySpreadIndices(scene.num_views, options.focal_search_scan_max_views);
+  SyntheticData mixed = second;
+  for (size_t k = 0; k < in_subset.size(); ++k) {
+    if (k % 4 != 0) mixed.views[in_subset[k]] = first.views[in_subset[k]];
+  }
+  InitializationOptions full_scan = options;
+  full_scan.focal_search_scan_max_views = full_scan.focal_search_max_views;
+  InitializationOptions one_candidate = options;
+  one_candidate.focal_search_scan_candidates = 1;
+  const double f_full =
+      Initialise(mixed, scene.camera, full_scan).camera.params[0];
+  const double f_one =
+      Initialise(mixed, scene.camera, one_candidate).camera.params[0];
+  const double f_default =
+      Initialise(mixed, scene.camera, options).camera.params[0];
+  // The full scan follows the majority (the longer lens); the subset alone
+  // follows the first lens; its candidates scored on all views do not.
+  EXPECT_NEAR(f_full / longer.camera.params[0], 1.0, 0.1);
+  EXPECT_NEAR(f_one / scene.camera.params[0], 1.0, 0.1);
+  EXPECT_NEAR(f_default / f_full, 1.0, 2e-3);
+}
+
 TEST(InitializationTest, GivenIntrinsicsAreKept) {
   const SyntheticScene scene = WideAngleScene();
   const SyntheticData data = MakeSyntheticData(scene);
@@ -182,6 +221,9 @@ TEST(InitializationTest, CheckRejectsBadStartRefineOptions) {
   EXPECT_FALSE(options.Check(&why));
   options = InitializationOptions();
   options.focal_search_scan_max_views = 0;
+  EXPECT_FALSE(options.Check(&why));
+  options = InitializationOptions();
+  options.focal_search_scan_candidates = 0;
   EXPECT_FALSE(options.Check(&why));
 }
 
