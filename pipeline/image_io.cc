@@ -147,13 +147,14 @@ HeaderInfo InspectHeader(const std::vector<unsigned char>& b) {
 }
 
 // Undoes the PNG filter of one row of `width` one-byte pixels: `raw` (the
-// filtered bytes, after the filter-type byte) into `out`, `prior` the row
-// above (zeros for the first). False for an unknown filter type.
+// filtered bytes, after the filter-type byte) into `out` (which may be
+// `raw` itself), `prior` the row above (zeros for the first). False for an
+// unknown filter type.
 bool UnfilterRow(int filter, const unsigned char* raw,
                  const unsigned char* prior, int width, unsigned char* out) {
   switch (filter) {
     case 0:  // None
-      std::memmove(out, raw, width);
+      if (out != raw) std::memmove(out, raw, width);
       return true;
     case 1:  // Sub
       out[0] = raw[0];
@@ -261,20 +262,20 @@ bool DecodeGreyPng(const std::vector<unsigned char>& bytes,
                                  nullptr) != LIBDEFLATE_SUCCESS) {
     return false;
   }
-  // In place: row y moves from y (width + 1) + 1 to y width, never over
-  // bytes still to be read.
+  // In place: each row stays behind its filter-type byte (no 2 MB moved),
+  // and the image is the view of the rows without those bytes (a row step
+  // of width + 1).
   unsigned char* data = pixels.data;
   buffers->zeros.assign(width, 0);
   for (int y = 0; y < height; ++y) {
+    unsigned char* pixel_row = data + y * row + 1;
     const unsigned char* prior =
-        y > 0 ? data + (y - 1) * static_cast<size_t>(width)
-              : buffers->zeros.data();
-    if (!UnfilterRow(data[y * row], data + y * row + 1, prior, width,
-                     data + y * static_cast<size_t>(width))) {
+        y > 0 ? pixel_row - row : buffers->zeros.data();
+    if (!UnfilterRow(pixel_row[-1], pixel_row, prior, width, pixel_row)) {
       return false;
     }
   }
-  *grey = pixels.colRange(0, width * height).reshape(1, height);
+  *grey = pixels.reshape(1, height).colRange(1, width + 1);
   return true;
 }
 
