@@ -252,6 +252,8 @@ struct Fields<InitializationOptions> {
             o.focal_search_reweight_iterations);
     v.Field("focal_search_truncation_px", o.focal_search_truncation_px);
     v.Field("focal_search_max_views", o.focal_search_max_views);
+    v.Field("focal_search_max_corners_per_view",
+            o.focal_search_max_corners_per_view);
     v.Field("focal_search_scan_max_views", o.focal_search_scan_max_views);
     v.Field("focal_search_scan_candidates", o.focal_search_scan_candidates);
     v.Field("max_focal_aspect", o.max_focal_aspect);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include "calib/reprojection_error.h"
 #include "util/failure.h"
@@ -176,6 +177,33 @@ std::vector<const CalibrationView*> SpreadSubset(
   return subset;
 }
 
+// The views with at most `max_corners` corners each (evenly spread over
+// their corner lists), copies in `storage` where a view has more; the
+// input pointers when none has.
+std::vector<const CalibrationView*> ThinnedViews(
+    const std::vector<const CalibrationView*>& views, int max_corners,
+    std::vector<CalibrationView>* storage) {
+  storage->clear();
+  storage->reserve(views.size());  // the pointers below stay valid
+  std::vector<const CalibrationView*> thinned;
+  for (const CalibrationView* view : views) {
+    const size_t n = view->board_points.size();
+    if (n <= static_cast<size_t>(max_corners)) {
+      thinned.push_back(view);
+      continue;
+    }
+    CalibrationView fewer;
+    fewer.name = view->name;
+    for (size_t i : EvenlySpreadIndices(n, max_corners)) {
+      fewer.board_points.push_back(view->board_points[i]);
+      fewer.image_points.push_back(view->image_points[i]);
+    }
+    storage->push_back(std::move(fewer));
+    thinned.push_back(&storage->back());
+  }
+  return thinned;
+}
+
 // The scan steps whose cost is a local minimum (not above either
 // neighbour's), the lowest first, at most `count` of them.
 std::vector<int> LowestLocalMinima(const std::vector<double>& cost, int count) {
@@ -199,9 +227,12 @@ std::vector<int> LowestLocalMinima(const std::vector<double>& cost, int count) {
 // subset that misjudges which basin is deepest does not pick the bracket),
 // then golden section on all of them around the best candidate.
 double SearchFocalLength(CameraModelId model, int width, int height,
-                         const std::vector<const CalibrationView*>& views,
+                         const std::vector<const CalibrationView*>& all_views,
                          const InitializationOptions& options,
                          double* best_cost) {
+  std::vector<CalibrationView> thinned;
+  const std::vector<const CalibrationView*> views = ThinnedViews(
+      all_views, options.focal_search_max_corners_per_view, &thinned);
   const double diagonal = std::hypot(width, height);
   const double log_min = std::log(options.focal_search_min_ratio * diagonal);
   const double log_max = std::log(options.focal_search_max_ratio * diagonal);
@@ -259,7 +290,8 @@ double SearchFocalLength(CameraModelId model, int width, int height,
     log_f = log_min + best * step;
     value = best_value;
   }
-  *best_cost = value;
+  // The cost that competes with the other starts: on every corner.
+  *best_cost = thinned.empty() ? value : cost_at(log_f, all_views);
   return std::exp(log_f);
 }
 
@@ -502,6 +534,10 @@ bool InitializationOptions::Check(std::string* why) const {
   }
   if (focal_search_scan_max_views < 1) {
     return Fail("initialization.focal_search_scan_max_views must be >= 1", why);
+  }
+  if (focal_search_max_corners_per_view < 8) {
+    return Fail("initialization.focal_search_max_corners_per_view must be >= 8",
+                why);
   }
   if (focal_search_scan_candidates < 1) {
     return Fail("initialization.focal_search_scan_candidates must be >= 1",

@@ -58,6 +58,13 @@ struct InitializationOptions {
   // At most this many views (evenly spread over the input) take part in the
   // focal search; all views get a pose afterwards. Default 60.
   int focal_search_max_views = 60;
+  // Of each of those views, at most this many corners (evenly spread over
+  // its corner list) take part in the search: a board's pose through a
+  // candidate camera is fixed by far fewer than a large board has (a 23 x
+  // 16 board: 368), and the search costs in proportion to them. The cost
+  // that competes with the closed forms is taken on all corners. Default
+  // 48. >= 8.
+  int focal_search_max_corners_per_view = 48;
   // Of those, at most this many (evenly spread) take part in the scan,
   // which only brackets the minimum for the golden section on all of them
   // (it costs steps x views pose fits, the bulk of the search). Default 16.

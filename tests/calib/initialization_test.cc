@@ -225,6 +225,9 @@ TEST(InitializationTest, CheckRejectsBadStartRefineOptions) {
   options = InitializationOptions();
   options.focal_search_scan_candidates = 0;
   EXPECT_FALSE(options.Check(&why));
+  options = InitializationOptions();
+  options.focal_search_max_corners_per_view = 7;
+  EXPECT_FALSE(options.Check(&why));
 }
 
 }  // namespace
