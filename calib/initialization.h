@@ -65,10 +65,10 @@ struct InitializationOptions {
   // that competes with the closed forms is taken on all corners. Default
   // 48. >= 8.
   int focal_search_max_corners_per_view = 48;
-  // Of those, at most this many (evenly spread) take part in the scan,
-  // which only brackets the minimum for the golden section on all of them
-  // (it costs steps x views pose fits, the bulk of the search). Default 16.
-  // >= 1.
+  // Of the search views, at most this many (evenly spread) take part in the
+  // scan, which only brackets the minimum for the golden section on all of
+  // them (the scan costs steps x views pose fits, the bulk of the search).
+  // Default 16. >= 1.
   int focal_search_scan_max_views = 16;
   // When the scan ran on a subset, this many of its lowest local minima are
   // scored on all search views, and the best of them centres the golden
