@@ -628,16 +628,15 @@ void DetectionPass::MakeBlurKernels() {
 // filter reads the input rows around it, so a band equals those rows of
 // the whole image.
 void DetectionPass::BlurRows(int a, int b, cv::Mat* out) const {
-  const cv::Mat band = single_->rowRange(a, b);
-  if (options_.blur_sigma_px > 0.0 && single_->type() == CV_8UC1 &&
-      IsSymmetricKernel5(kernel_scaled_) && IsSymmetricKernel5(kernel_)) {
+  if (!(options_.blur_sigma_px > 0.0)) {
+    single_->rowRange(a, b).convertTo(*out, CV_32F, 1.0 / s_.normalizer);
+  } else if (single_->type() == CV_8UC1 && IsSymmetricKernel5(kernel_scaled_) &&
+             IsSymmetricKernel5(kernel_)) {
     out->create(b - a, width_, CV_32FC1);
     BlurGreyRows5(*single_, a, b, kernel_scaled_, kernel_, &b_.blur_row, out);
-  } else if (options_.blur_sigma_px > 0.0) {
-    cv::sepFilter2D(band, *out, CV_32F, kernel_scaled_, kernel_,
-                    cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
   } else {
-    band.convertTo(*out, CV_32F, 1.0 / s_.normalizer);
+    cv::sepFilter2D(single_->rowRange(a, b), *out, CV_32F, kernel_scaled_,
+                    kernel_, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
   }
 }
 

@@ -41,6 +41,13 @@ void VerticalScalar(const uint8_t* const rows[5], int begin, int width,
   }
 }
 
+// The two values before the first and after the last of a row of `width`
+// (the horizontal pass's replicated border).
+inline void ReplicateBorder(float* t, int width) {
+  t[-2] = t[-1] = t[0];
+  t[width] = t[width + 1] = t[width - 1];
+}
+
 // Horizontal pass of pixels [begin, width) of `in` (two replicated values
 // before its first and after its last pixel) into `out`.
 void HorizontalScalar(const float* in, int begin, int width, const Taps& taps,
@@ -91,8 +98,7 @@ __attribute__((target("avx2"))) void BlurRowAvx2(const uint8_t* const rows[5],
                                  HighToFloat(inner), HighToFloat(p[2])));
   }
   VerticalScalar(rows, x, width, ty, t);
-  t[-2] = t[-1] = t[0];
-  t[width] = t[width + 1] = t[width - 1];
+  ReplicateBorder(t, width);
   const __m256 b0 = _mm256_set1_ps(tx.outer), b1 = _mm256_set1_ps(tx.inner),
                b2 = _mm256_set1_ps(tx.middle);
   x = 0;
@@ -112,8 +118,7 @@ void BlurRowScalar(const uint8_t* const rows[5], int width, const Taps& ty,
                    const Taps& tx, float* padded, float* out) {
   float* t = padded + 2;
   VerticalScalar(rows, 0, width, ty, t);
-  t[-2] = t[-1] = t[0];
-  t[width] = t[width + 1] = t[width - 1];
+  ReplicateBorder(t, width);
   HorizontalScalar(t, 0, width, tx, out);
 }
 

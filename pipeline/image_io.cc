@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -146,33 +145,28 @@ HeaderInfo InspectHeader(const std::vector<unsigned char>& b) {
   return info;
 }
 
-// Undoes the PNG filter of one row of `width` one-byte pixels: `raw` (the
-// filtered bytes, after the filter-type byte) into `out` (which may be
-// `raw` itself), `prior` the row above (zeros for the first). False for an
-// unknown filter type.
-bool UnfilterRow(int filter, const unsigned char* raw,
-                 const unsigned char* prior, int width, unsigned char* out) {
+// Undoes, in place, the PNG filter of one row of `width` one-byte pixels
+// (`row`: the filtered bytes after the filter-type byte), `prior` the row
+// above (zeros for the first). False for an unknown filter type.
+bool UnfilterRow(int filter, unsigned char* row, const unsigned char* prior,
+                 int width) {
   switch (filter) {
     case 0:  // None
-      if (out != raw) std::memmove(out, raw, width);
       return true;
     case 1:  // Sub
-      out[0] = raw[0];
-      for (int i = 1; i < width; ++i) out[i] = raw[i] + out[i - 1];
+      for (int i = 1; i < width; ++i) row[i] += row[i - 1];
       return true;
     case 2:  // Up
-      for (int i = 0; i < width; ++i) out[i] = raw[i] + prior[i];
+      for (int i = 0; i < width; ++i) row[i] += prior[i];
       return true;
     case 3:  // Average
-      out[0] = raw[0] + (prior[0] >> 1);
-      for (int i = 1; i < width; ++i) {
-        out[i] = raw[i] + ((out[i - 1] + prior[i]) >> 1);
-      }
+      row[0] += prior[0] >> 1;
+      for (int i = 1; i < width; ++i) row[i] += (row[i - 1] + prior[i]) >> 1;
       return true;
     case 4:  // Paeth
       for (int i = 0; i < width; ++i) {
-        out[i] = raw[i] + PaethPredictor(i > 0 ? out[i - 1] : 0, prior[i],
-                                         i > 0 ? prior[i - 1] : 0);
+        row[i] += PaethPredictor(i > 0 ? row[i - 1] : 0, prior[i],
+                                 i > 0 ? prior[i - 1] : 0);
       }
       return true;
     default:
@@ -271,7 +265,7 @@ bool DecodeGreyPng(const std::vector<unsigned char>& bytes,
     unsigned char* pixel_row = data + y * row + 1;
     const unsigned char* prior =
         y > 0 ? pixel_row - row : buffers->zeros.data();
-    if (!UnfilterRow(pixel_row[-1], pixel_row, prior, width, pixel_row)) {
+    if (!UnfilterRow(pixel_row[-1], pixel_row, prior, width)) {
       return false;
     }
   }
