@@ -5,8 +5,8 @@
 #include <string>
 
 #include "apps/common_flags.h"
-#include "apps/config_io.h"
 #include "apps/subcommand.h"
+#include "formats/board_file.h"
 #include "sim/print_board.h"
 #include "util/atomic_file.h"
 

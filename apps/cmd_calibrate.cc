@@ -18,15 +18,15 @@
 #include <vector>
 
 #include "apps/common_flags.h"
-#include "apps/config_io.h"
 #include "apps/options_io.h"
 #include "apps/subcommand.h"
 #include "calib/calibrate.h"
-#include "calib/camera_yaml.h"
-#include "calib/evidence.h"
-#include "calib/model_selection.h"
-#include "calib/verdict.h"
-#include "pipeline/image_io.h"
+#include "evidence/evidence.h"
+#include "evidence/model_selection.h"
+#include "evidence/verdict.h"
+#include "formats/board_file.h"
+#include "formats/camera_yaml.h"
+#include "formats/image_io.h"
 #include "pipeline/pipeline.h"
 #include "report/report.h"
 #include "util/timer.h"
@@ -362,7 +362,7 @@ int DetectAll(const CalibrateRequest& request, CalibrationRun* run) {
 }
 
 // --model auto: the candidate with the lowest held-out error
-// (calib/model_selection.h), which must fit the format. Returns kExitOk or
+// (evidence/model_selection.h), which must fit the format. Returns kExitOk or
 // the exit code.
 int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
   std::string error;
@@ -387,7 +387,7 @@ int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
 
 // The model (--model auto chooses it), the calibration, its evidence
 // (halves, uncertainty, binned residuals) and the verdict made from it
-// (calib/evidence.h, calib/verdict.h). A failed calibration is kept in
+// (evidence/evidence.h, evidence/verdict.h). A failed calibration is kept in
 // run->calibration_error (the report shows it); returns kExitOk or the exit
 // code of a failed model selection.
 int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {

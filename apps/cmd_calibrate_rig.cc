@@ -14,15 +14,15 @@
 #include <vector>
 
 #include "apps/common_flags.h"
-#include "apps/config_io.h"
 #include "apps/options_io.h"
 #include "apps/subcommand.h"
-#include "calib/camera_yaml.h"
-#include "calib/evidence.h"
 #include "calib/rig_calibration.h"
-#include "calib/rig_yaml.h"
-#include "calib/verdict.h"
-#include "pipeline/image_io.h"
+#include "evidence/evidence.h"
+#include "evidence/verdict.h"
+#include "formats/board_file.h"
+#include "formats/camera_yaml.h"
+#include "formats/image_io.h"
+#include "formats/rig_yaml.h"
 #include "pipeline/pipeline.h"
 #include "report/rig_report.h"
 #include "util/timer.h"
@@ -252,8 +252,8 @@ int DetectCamera(const RigRequest& request, size_t c,
 }
 
 // Each camera's own calibration judged as `calibrate` judges one camera
-// (halves, uncertainty, binned residuals; calib/evidence.h,
-// calib/verdict.h), once, for the report and the output alike.
+// (halves, uncertainty, binned residuals; evidence/evidence.h,
+// evidence/verdict.h), once, for the report and the output alike.
 struct CameraJudgements {
   std::vector<Evidence> evidence;  // one per camera
   std::vector<Verdict> verdicts;

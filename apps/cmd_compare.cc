@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "apps/common_flags.h"
-#include "apps/config_io.h"
 #include "apps/subcommand.h"
-#include "calib/camera_models.h"
-#include "calib/camera_yaml.h"
+#include "camera/camera_models.h"
+#include "formats/camera_yaml.h"
+#include "sim/scene_file.h"
 
 DEFINE_string(camera, "", "Camera file (any format puzzlecal writes).");
 DEFINE_string(truth, "", "truth.yaml written by `puzzlecal render`.");

@@ -15,12 +15,12 @@
 #include <vector>
 
 #include "apps/common_flags.h"
-#include "apps/config_io.h"
 #include "apps/options_io.h"
 #include "apps/subcommand.h"
-#include "pipeline/image_io.h"
+#include "formats/board_file.h"
+#include "formats/image_io.h"
+#include "formats/png_writer.h"
 #include "pipeline/pipeline.h"
-#include "pipeline/png_writer.h"
 #include "report/overlay.h"
 #include "util/atomic_file.h"
 

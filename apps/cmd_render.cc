@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "apps/common_flags.h"
-#include "apps/config_io.h"
 #include "apps/subcommand.h"
-#include "pipeline/png_writer.h"
+#include "formats/png_writer.h"
+#include "sim/scene_file.h"
 #include "sim/scenes.h"
 #include "util/atomic_file.h"
 

@@ -10,9 +10,9 @@
 
 #include "apps/common_flags.h"
 #include "apps/subcommand.h"
-#include "calib/camera_yaml.h"
-#include "pipeline/image_io.h"
-#include "pipeline/png_writer.h"
+#include "formats/camera_yaml.h"
+#include "formats/image_io.h"
+#include "formats/png_writer.h"
 #include "pipeline/undistort.h"
 
 // Defined by `compare` (a camera file in any of the four formats).

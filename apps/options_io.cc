@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/yaml_emit.h"
-#include "calib/yaml_fields.h"
+#include "formats/yaml_emit.h"
+#include "formats/yaml_fields.h"
 #include "util/enum_names.h"
 
 namespace puzzlecal {
@@ -582,11 +582,11 @@ constexpr char kHeader[] =
     "# detection/detector.h (DetectorOptions), grid grid/grid.h "
     "(GridOptions),\n"
     "# decode decode/decoder.h and decode/edge_bits.h (DecodeOptions,\n"
-    "# EdgeBitOptions), load pipeline/image_io.h (ImageLoadOptions),\n"
+    "# EdgeBitOptions), load formats/image_io.h (ImageLoadOptions),\n"
     "# pipeline pipeline/pipeline.h (PipelineOptions), calibration\n"
     "# calib/calibrate.h and\n"
-    "# calib/initialization.h, evidence calib/evidence.h, verdict\n"
-    "# calib/verdict.h, model_selection calib/model_selection.h, rig\n"
+    "# calib/initialization.h, evidence evidence/evidence.h, verdict\n"
+    "# evidence/verdict.h, model_selection evidence/model_selection.h, rig\n"
     "# calib/rig_calibration.h (its camera options are the calibration\n"
     "# section). --threads and --format's fixed parameters are flags only.\n";
 

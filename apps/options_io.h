@@ -21,10 +21,10 @@
 #include <string>
 
 #include "calib/calibrate.h"
-#include "calib/evidence.h"
-#include "calib/model_selection.h"
 #include "calib/rig_calibration.h"
-#include "calib/verdict.h"
+#include "evidence/evidence.h"
+#include "evidence/model_selection.h"
+#include "evidence/verdict.h"
 #include "pipeline/pipeline.h"
 
 namespace puzzlecal {

@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "calib/calibrate.h"
+#include "sim/synthetic_views.h"
 #include "tests/calib/opencv_reference.h"
-#include "tests/calib/synthetic_views.h"
 
 namespace {
 
@@ -26,9 +26,9 @@ using puzzlecal::CalibrationOptions;
 using puzzlecal::CalibrationResult;
 using puzzlecal::Camera;
 using puzzlecal::CameraModelId;
-using puzzlecal::testing::MakeSyntheticData;
-using puzzlecal::testing::SyntheticData;
-using puzzlecal::testing::SyntheticScene;
+using puzzlecal::sim::MakeSyntheticData;
+using puzzlecal::sim::SyntheticData;
+using puzzlecal::sim::SyntheticScene;
 
 SyntheticScene Scene(CameraModelId model, int views, int cols, int rows) {
   SyntheticScene scene;
@@ -37,7 +37,7 @@ SyntheticScene Scene(CameraModelId model, int views, int cols, int rows) {
   scene.board_rows = rows;
   scene.tile = 0.33 / (cols - 1);  // same board width for both sizes
   if (model == CameraModelId::kKannalaBrandt) {
-    scene.camera = puzzlecal::testing::TruthFisheye190();
+    scene.camera = puzzlecal::sim::TruthFisheye190();
     scene.max_direction_deg = 85;
     scene.max_corner_angle_deg = 95;
     scene.min_visible_fraction = 0.3;
@@ -47,8 +47,8 @@ SyntheticScene Scene(CameraModelId model, int views, int cols, int rows) {
     scene.max_distance = 1.6;
   } else {
     scene.camera = model == CameraModelId::kPinholeRadtan
-                       ? puzzlecal::testing::TruthRadtan()
-                       : puzzlecal::testing::TruthRational();
+                       ? puzzlecal::sim::TruthRadtan()
+                       : puzzlecal::sim::TruthRational();
     scene.max_direction_deg = 32;
     scene.min_visible_fraction = 1.0;
   }

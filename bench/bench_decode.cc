@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "decode/decoder.h"
-#include "decode/puzzleboard.h"
+#include "target/puzzleboard.h"
 #include "tests/decode/truth_components.h"
 
 namespace puzzlecal {

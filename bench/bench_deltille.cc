@@ -52,8 +52,8 @@
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "calib/camera_yaml.h"
 #include "calib/initialization.h"
+#include "formats/camera_yaml.h"
 #include "pipeline/pipeline.h"
 #include "tests/grid/grid_test_util.h"
 #include "tests/support/deltille_data.h"

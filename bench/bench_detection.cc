@@ -5,23 +5,22 @@
 //
 // Usage: bench_detection [runs]
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <cstdlib>
-#include <string>
-#include <vector>
-
-#include <Eigen/Geometry>
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
-#include "calib/camera_models.h"
-#include "decode/board.h"
+#include "camera/camera_models.h"
 #include "detection/detector.h"
 #include "grid/grid.h"
 #include "sim/render.h"
+#include "target/board.h"
 #include "tests/support/deltille_data.h"
 
 namespace puzzlecal {

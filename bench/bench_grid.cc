@@ -16,7 +16,7 @@
 #include <random>
 #include <vector>
 
-#include "calib/camera_models.h"
+#include "camera/camera_models.h"
 #include "grid/grid.h"
 
 namespace puzzlecal {

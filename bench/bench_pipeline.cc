@@ -57,13 +57,13 @@
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "calib/evidence.h"
-#include "decode/board.h"
 #include "decode/decoder.h"
 #include "detection/detector.h"
+#include "evidence/evidence.h"
+#include "formats/image_io.h"
 #include "grid/grid.h"
-#include "pipeline/image_io.h"
 #include "pipeline/pipeline.h"
+#include "target/board.h"
 #include "tests/support/deltille_data.h"
 #include "util/statistics.h"
 

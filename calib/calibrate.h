@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "calib/calibration_view.h"
-#include "calib/camera_models.h"
 #include "calib/initialization.h"
+#include "camera/calibration_view.h"
+#include "camera/camera_models.h"
 
 namespace puzzlecal {
 

@@ -26,8 +26,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/calibration_view.h"
-#include "calib/camera_models.h"
+#include "camera/calibration_view.h"
+#include "camera/camera_models.h"
 
 namespace puzzlecal {
 

@@ -24,8 +24,8 @@
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "calib/calibration_view.h"
-#include "calib/camera_models.h"
+#include "camera/calibration_view.h"
+#include "camera/camera_models.h"
 
 namespace puzzlecal {
 

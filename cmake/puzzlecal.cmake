@@ -1,22 +1,28 @@
 include(GNUInstallDirs)
 
-# puzzlecal_add_library(NAME SOURCES ... DEPS ...)
+# puzzlecal_add_library(NAME SOURCES ... PUBLIC ... PRIVATE ...)
 # One library target per folder; includes are full paths from the repository
-# root ("grid/grid.h"). Each library and its folder's headers are
-# installed (`cmake --install`) and exported as puzzlecal::NAME through the
+# root ("grid/grid.h"). PUBLIC: what the folder's headers expose (a user of
+# the library needs it too); PRIVATE: what only its .cc files use, so that a
+# folder above links only what it reaches through headers. Each library and
+# its folder's headers are installed (`cmake --install`, headers under
+# include/puzzlecal/<folder>/) and exported as puzzlecal::NAME through the
 # puzzlecal CMake package (find_package(puzzlecal)).
 function(puzzlecal_add_library name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC;PRIVATE" ${ARGN})
+  # Installed headers include each other as "camera/camera_models.h", so
+  # include/puzzlecal is on the path too; users write <puzzlecal/...>.
   set(includes $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
-               $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+               $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
+               $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/puzzlecal>)
   if(ARG_SOURCES)
     add_library(${name} STATIC ${ARG_SOURCES})
     target_include_directories(${name} PUBLIC ${includes})
-    target_link_libraries(${name} PUBLIC ${ARG_DEPS})
-  else()  # headers only, so far
+    target_link_libraries(${name} PUBLIC ${ARG_PUBLIC} PRIVATE ${ARG_PRIVATE})
+  else()  # headers only
     add_library(${name} INTERFACE)
     target_include_directories(${name} INTERFACE ${includes})
-    target_link_libraries(${name} INTERFACE ${ARG_DEPS})
+    target_link_libraries(${name} INTERFACE ${ARG_PUBLIC})
   endif()
   add_library(puzzlecal::${name} ALIAS ${name})
   install(TARGETS ${name} EXPORT puzzlecalTargets
@@ -24,7 +30,7 @@ function(puzzlecal_add_library name)
           LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
   file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
   install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/
-          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/${folder}
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/puzzlecal/${folder}
           FILES_MATCHING PATTERN "*.h")
 endfunction()
 

@@ -13,8 +13,8 @@ function(run)
 endfunction()
 
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
-foreach(file bin/puzzlecal include/calib/calibrate.h
-        include/detection/detector.h lib/cmake/puzzlecal/puzzlecalConfig.cmake)
+foreach(file bin/puzzlecal include/puzzlecal/calib/calibrate.h
+        include/puzzlecal/detection/detector.h lib/cmake/puzzlecal/puzzlecalConfig.cmake)
   if(NOT EXISTS ${WORK_DIR}/prefix/${file})
     message(FATAL_ERROR "not installed: ${file}")
   endif()

@@ -44,17 +44,16 @@
 // board ids instead (absolute_ids true), chosen among the board's symmetric
 // equivalents as the one whose +col axis points most to the image's +x.
 
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-
-#include "decode/board.h"
 #include "decode/edge_bits.h"
 #include "decode/position_search.h"
 #include "detection/corner.h"
 #include "grid/grid_component.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 

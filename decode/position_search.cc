@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "decode/puzzleboard.h"
+#include "target/puzzleboard.h"
 
 namespace puzzlecal {
 namespace {

@@ -14,11 +14,10 @@
 // disagreeing edges), so all 4 x 251,001 torus positions are scored at once
 // and the positions inside the printed board are enumerated exactly.
 
+#include <Eigen/Core>
 #include <vector>
 
-#include <Eigen/Core>
-
-#include "decode/board.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 

@@ -1,7 +1,7 @@
 #ifndef PUZZLECAL_FUZZ_CAMERA_YAML_CASE_H_
 #define PUZZLECAL_FUZZ_CAMERA_YAML_CASE_H_
 
-// Fuzz case (d): the camera file reader (calib/camera_yaml.h ReadCameraFile,
+// Fuzz case (d): the camera file reader (formats/camera_yaml.h ReadCameraFile,
 // all four formats). A file that loads must hold a usable camera (the
 // model's number of finite parameters, a positive image size) that the
 // writers can format again and the reader read back to the same model and
@@ -12,8 +12,8 @@
 #include <cstdint>
 #include <string>
 
-#include "calib/camera_models.h"
-#include "calib/camera_yaml.h"
+#include "camera/camera_models.h"
+#include "formats/camera_yaml.h"
 #include "fuzz/yaml_file.h"
 
 namespace puzzlecal {

@@ -1,19 +1,20 @@
 #ifndef PUZZLECAL_FUZZ_CONFIG_YAML_CASE_H_
 #define PUZZLECAL_FUZZ_CONFIG_YAML_CASE_H_
 
-// Fuzz case (c): the board and scene YAML readers (apps/config_io.h).
-// Byte 0 chooses the reader (even: LoadBoardFile, odd: LoadSceneFile); the
-// other bytes are the file. A file that loads must describe a valid board /
-// scene; a refused one must say why, naming the file.
+// Fuzz case (c): the board and scene YAML readers (formats/board_file.h,
+// sim/scene_file.h). Byte 0 chooses the reader (even: LoadBoardFile, odd:
+// LoadSceneFile); the other bytes are the file. A file that loads must describe
+// a valid board / scene; a refused one must say why, naming the file.
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
-#include "apps/config_io.h"
-#include "decode/board.h"
+#include "formats/board_file.h"
 #include "fuzz/yaml_file.h"
+#include "sim/scene_file.h"
 #include "sim/scenes.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace fuzz {

@@ -15,24 +15,23 @@
 //     corners get raw doubles;
 //  then the lattice parameters and the per-corner bytes.
 
+#include <Eigen/Core>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-
-#include "decode/board.h"
 #include "decode/decoder.h"
 #include "detection/corner.h"
 #include "fuzz/byte_reader.h"
 #include "grid/grid.h"
 #include "grid/grid_component.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace fuzz {

@@ -9,14 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "calib/calibration_view.h"
-#include "decode/board.h"
+#include "camera/calibration_view.h"
 #include "decode/decoder.h"
 #include "detection/corner.h"
 #include "detection/detector.h"
+#include "formats/image_io.h"
 #include "grid/grid.h"
 #include "grid/grid_component.h"
-#include "pipeline/image_io.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 

@@ -8,7 +8,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "calib/camera_models.h"
+#include "camera/camera_models.h"
 
 namespace puzzlecal {
 

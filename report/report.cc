@@ -9,7 +9,7 @@
 #include <set>
 #include <sstream>
 
-#include "pipeline/png_writer.h"
+#include "formats/png_writer.h"
 #include "report/overlay.h"
 #include "report/plot.h"
 #include "util/atomic_file.h"
@@ -708,7 +708,7 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
 }
 
 // ---------------------------------------------------------------------------
-// Evidence plots (calib/evidence.h).
+// Evidence plots (evidence/evidence.h).
 
 // The map at image pixel (x, y): bilinear between the four samples around
 // it, or the nearest of them when one has no value.

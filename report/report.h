@@ -8,12 +8,12 @@
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "calib/calibration_view.h"
-#include "calib/evidence.h"
-#include "calib/verdict.h"
-#include "decode/board.h"
-#include "pipeline/image_io.h"
+#include "camera/calibration_view.h"
+#include "evidence/evidence.h"
+#include "evidence/verdict.h"
+#include "formats/image_io.h"
 #include "pipeline/pipeline.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 
@@ -104,8 +104,8 @@ struct ReportInput {
   double seconds_calibrate = -1;
   double seconds_total = -1;
   int threads = 0;
-  // Evidence on the calibration and its verdict (calib/evidence.h,
-  // calib/verdict.h); null when not computed. The verdict heads
+  // Evidence on the calibration and its verdict (evidence/evidence.h,
+  // evidence/verdict.h); null when not computed. The verdict heads
   // summary.md; the evidence adds a section (EvidenceMarkdown) and its
   // charts (WriteEvidenceCharts).
   const Evidence* evidence = nullptr;
@@ -136,7 +136,7 @@ std::string ReportMarkdown(const ReportInput& input,
                            const ReportOptions& options,
                            const std::vector<std::string>& png_files);
 
-// The evidence part of a report (calib/evidence.h), shared by the
+// The evidence part of a report (evidence/evidence.h), shared by the
 // single-camera report and the rig report (one per camera).
 
 // File names of the evidence charts (the rig report puts the camera's name

@@ -8,8 +8,8 @@
 #include <sstream>
 #include <vector>
 
-#include "pipeline/image_io.h"
-#include "pipeline/png_writer.h"
+#include "formats/image_io.h"
+#include "formats/png_writer.h"
 #include "report/overlay.h"
 #include "report/plot.h"
 #include "util/atomic_file.h"

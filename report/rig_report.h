@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "calib/camera_models.h"
-#include "calib/evidence.h"
 #include "calib/rig_calibration.h"
-#include "calib/rig_yaml.h"
-#include "calib/verdict.h"
+#include "camera/camera_models.h"
+#include "evidence/evidence.h"
+#include "evidence/verdict.h"
+#include "formats/rig_yaml.h"
 #include "report/report.h"
 
 namespace puzzlecal {
@@ -41,8 +41,8 @@ struct RigReportInput {
   std::vector<std::vector<std::string>> files;
   // Per camera (the order of result->cameras): the evidence on the camera's
   // own calibration and its verdict, as `calibrate` judges one camera
-  // (calib/evidence.h, calib/verdict.h). Empty when not computed (a failed
-  // calibration); otherwise one non-null entry per camera each.
+  // (evidence/evidence.h, evidence/verdict.h). Empty when not computed (a
+  // failed calibration); otherwise one non-null entry per camera each.
   std::vector<const Evidence*> evidence;
   std::vector<const Verdict*> verdicts;
   double seconds_images = 0;  // detection, grid and decode, wall clock

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "decode/puzzleboard.h"
+#include "target/puzzleboard.h"
 
 namespace puzzlecal {
 namespace {

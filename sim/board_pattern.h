@@ -9,9 +9,9 @@
 #include <array>
 #include <cstdint>
 
-#include "decode/board.h"
-#include "decode/puzzleboard_codes.h"
 #include "sim/render.h"
+#include "target/board.h"
+#include "target/puzzleboard_codes.h"
 
 namespace puzzlecal {
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/camera_models.h"
+#include "camera/camera_models.h"
 
 namespace puzzlecal {
 

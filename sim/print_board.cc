@@ -11,7 +11,7 @@
 #include <sstream>
 #include <vector>
 
-#include "decode/puzzleboard.h"
+#include "target/puzzleboard.h"
 #include "util/enum_names.h"
 
 namespace puzzlecal {

@@ -12,7 +12,7 @@
 
 #include <string>
 
-#include "decode/board.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 

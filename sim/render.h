@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "calib/camera_models.h"
-#include "decode/board.h"
+#include "camera/camera_models.h"
 #include "sim/pixel_rays.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 

@@ -8,7 +8,7 @@
 #include <limits>
 #include <random>
 
-#include "pipeline/png_writer.h"
+#include "formats/png_writer.h"
 #include "sim/pixel_rays.h"
 #include "sim/scenes.h"
 

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "calib/camera_models.h"
 #include "calib/rig_calibration.h"
-#include "decode/board.h"
+#include "camera/camera_models.h"
 #include "sim/render.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 

@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "calib/camera_models.h"
-#include "decode/board.h"
+#include "camera/camera_models.h"
 #include "sim/render.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 

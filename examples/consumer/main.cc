@@ -5,16 +5,16 @@
 //
 // Prints the intrinsics and the RMS; exits 1 when there is no calibration.
 
+#include <puzzlecal/calib/calibrate.h>
+#include <puzzlecal/decode/decoder.h>
+#include <puzzlecal/detection/detector.h>
+#include <puzzlecal/grid/grid.h>
+#include <puzzlecal/target/board.h>
+
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include "calib/calibrate.h"
-#include "decode/board.h"
-#include "decode/decoder.h"
-#include "detection/detector.h"
-#include "grid/grid.h"
 
 int main(int argc, char** argv) {
   using namespace puzzlecal;

@@ -32,9 +32,9 @@
 #include <vector>
 
 #include "apps/subcommand.h"
-#include "calib/camera_models.h"
-#include "decode/board.h"
+#include "camera/camera_models.h"
 #include "sim/render.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace {

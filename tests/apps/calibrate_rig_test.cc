@@ -25,7 +25,7 @@
 
 #include "apps/subcommand.h"
 #include "calib/rig_calibration.h"
-#include "calib/rig_yaml.h"
+#include "formats/rig_yaml.h"
 #include "sim/rig_scenes.h"
 #include "util/string_format.h"
 

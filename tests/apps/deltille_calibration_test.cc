@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "apps/config_io.h"
 #include "calib/calibrate.h"
-#include "calib/camera_yaml.h"
-#include "calib/evidence.h"
-#include "calib/verdict.h"
-#include "pipeline/image_io.h"
+#include "evidence/evidence.h"
+#include "evidence/verdict.h"
+#include "formats/board_file.h"
+#include "formats/camera_yaml.h"
+#include "formats/image_io.h"
 #include "pipeline/pipeline.h"
 #include "tests/support/deltille_data.h"
 

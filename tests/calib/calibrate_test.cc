@@ -11,17 +11,17 @@
 #include <thread>
 #include <vector>
 
-#include "calib/camera_models.h"
-#include "calib/camera_yaml.h"
+#include "camera/camera_models.h"
+#include "formats/camera_yaml.h"
+#include "sim/synthetic_views.h"
 #include "tests/calib/opencv_reference.h"
-#include "tests/calib/synthetic_views.h"
 
 namespace puzzlecal {
 namespace {
 
-using testing::MakeSyntheticData;
-using testing::SyntheticData;
-using testing::SyntheticScene;
+using sim::MakeSyntheticData;
+using sim::SyntheticData;
+using sim::SyntheticScene;
 
 // Number of free parameters: intrinsics plus six per used view.
 int NumFreeParams(const CalibrationResult& result) {
@@ -63,7 +63,7 @@ SyntheticScene PinholeScene(const Camera& camera) {
 
 SyntheticScene FisheyeScene() {
   SyntheticScene scene;
-  scene.camera = testing::TruthFisheye190();
+  scene.camera = sim::TruthFisheye190();
   scene.num_views = 20;
   scene.max_direction_deg = 85;
   scene.max_corner_angle_deg = 95;
@@ -87,9 +87,9 @@ class AccuracyTest : public ::testing::TestWithParam<int> {};
 SyntheticScene SceneFor(int index) {
   switch (index) {
     case 0:
-      return PinholeScene(testing::TruthRadtan());
+      return PinholeScene(sim::TruthRadtan());
     case 1:
-      return PinholeScene(testing::TruthRational());
+      return PinholeScene(sim::TruthRational());
     default:
       return FisheyeScene();
   }
@@ -317,7 +317,7 @@ TEST(CalibrateTest, GrossErrorsAmongHeavyTailedOnesAreRemoved) {
 }
 
 TEST(CalibrateTest, PartialViewsAreUsedFully) {
-  SyntheticScene scene = PinholeScene(testing::TruthRadtan());
+  SyntheticScene scene = PinholeScene(sim::TruthRadtan());
   scene.max_direction_deg = 50;  // boards cut by the image border
   scene.min_visible_fraction = 0.25;
   const SyntheticData data = MakeSyntheticData(scene);

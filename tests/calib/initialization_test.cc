@@ -6,16 +6,16 @@
 #include <string>
 #include <vector>
 
-#include "tests/calib/synthetic_views.h"
+#include "sim/synthetic_views.h"
 #include "util/statistics.h"
 
 namespace puzzlecal {
 namespace {
 
-using testing::MakeCamera;
-using testing::MakeSyntheticData;
-using testing::SyntheticData;
-using testing::SyntheticScene;
+using sim::MakeCamera;
+using sim::MakeSyntheticData;
+using sim::SyntheticData;
+using sim::SyntheticScene;
 
 // A 90-degree wide-angle lens with barrel distortion, boards close, off-axis
 // and cut by the image border (the recipe of the bundled sample set).
@@ -39,7 +39,7 @@ SyntheticScene WideAngleScene() {
 
 SyntheticScene FisheyeScene() {
   SyntheticScene scene;
-  scene.camera = testing::TruthFisheye190();
+  scene.camera = sim::TruthFisheye190();
   scene.num_views = 30;
   scene.max_direction_deg = 85;
   scene.max_corner_angle_deg = 95;

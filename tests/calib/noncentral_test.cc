@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "calib/camera_models.h"
+#include "camera/camera_models.h"
 #include "sim/render.h"
 #include "sim/scenes.h"
 

@@ -4,14 +4,13 @@
 // OpenCV's calibration on the same correspondences, for side-by-side
 // comparisons in the calib/ tests and bench/bench_calib.cc.
 
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core.hpp>
-
-#include "calib/calibration_view.h"
-#include "calib/camera_models.h"
+#include "camera/calibration_view.h"
+#include "camera/camera_models.h"
 
 namespace puzzlecal {
 namespace testing {

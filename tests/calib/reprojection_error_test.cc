@@ -14,8 +14,8 @@
 #include <random>
 #include <vector>
 
-#include "calib/camera_models.h"
-#include "tests/calib/synthetic_views.h"
+#include "camera/camera_models.h"
+#include "sim/synthetic_views.h"
 
 namespace puzzlecal {
 namespace {
@@ -23,13 +23,13 @@ namespace {
 std::vector<double> ParamsOf(CameraModelId id) {
   switch (id) {
     case CameraModelId::kPinholeRadtan:
-      return testing::TruthRadtan().params;
+      return sim::TruthRadtan().params;
     case CameraModelId::kPinholeRational:
-      return testing::TruthRational().params;
+      return sim::TruthRational().params;
     case CameraModelId::kKannalaBrandt:
-      return testing::TruthFisheye190().params;
+      return sim::TruthFisheye190().params;
     case CameraModelId::kKannalaBrandtNoncentral: {
-      std::vector<double> params = testing::TruthFisheye190().params;
+      std::vector<double> params = sim::TruthFisheye190().params;
       params.push_back(0.001);   // e1, metres
       params.push_back(0.0003);  // e2
       return params;

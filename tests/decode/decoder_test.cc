@@ -12,7 +12,7 @@
 #include <set>
 #include <string>
 
-#include "decode/puzzleboard.h"
+#include "target/puzzleboard.h"
 #include "tests/decode/truth_components.h"
 
 namespace puzzlecal {

@@ -13,11 +13,11 @@
 #include <random>
 #include <vector>
 
-#include "calib/camera_models.h"
-#include "decode/board.h"
+#include "camera/camera_models.h"
 #include "detection/corner.h"
 #include "grid/grid_component.h"
 #include "sim/render.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace decode_testing {

@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "calib/camera_models.h"
-#include "decode/board.h"
+#include "camera/camera_models.h"
 #include "sim/render.h"
 #include "sim/scenes.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace {

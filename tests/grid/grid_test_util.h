@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/camera_models.h"
+#include "camera/camera_models.h"
 #include "detection/corner.h"
 #include "grid/grid_component.h"
 

@@ -17,10 +17,10 @@
 #include <utility>
 #include <vector>
 
-#include "decode/board.h"
 #include "detection/detector.h"
 #include "grid/grid.h"
 #include "sim/render.h"
+#include "target/board.h"
 #include "tests/grid/grid_test_util.h"
 
 namespace puzzlecal {

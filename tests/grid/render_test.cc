@@ -13,9 +13,9 @@
 #include <cstdio>
 #include <vector>
 
-#include "decode/board.h"
 #include "detection/detector.h"
 #include "grid/grid.h"
+#include "target/board.h"
 #include "tests/grid/grid_test_util.h"
 
 namespace puzzlecal {

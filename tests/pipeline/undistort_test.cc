@@ -22,10 +22,10 @@
 #include <string>
 #include <vector>
 
-#include "calib/camera_yaml.h"
-#include "decode/board.h"
+#include "formats/camera_yaml.h"
 #include "pipeline/pipeline.h"
 #include "sim/render.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace {

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "calib/evidence.h"
-#include "calib/verdict.h"
+#include "evidence/evidence.h"
+#include "evidence/verdict.h"
 #include "report/report.h"
-#include "tests/calib/synthetic_views.h"
+#include "sim/synthetic_views.h"
 
 namespace puzzlecal {
 namespace {
@@ -29,13 +29,13 @@ std::string ReadText(const fs::path& path) {
 }
 
 TEST(ReportEvidence, VerdictHeadsTheSummaryAndPlotsAreWritten) {
-  testing::SyntheticScene scene;
-  scene.camera = testing::TruthFisheye190();
+  sim::SyntheticScene scene;
+  scene.camera = sim::TruthFisheye190();
   scene.num_views = 16;
   scene.noise_px = 0.2;
   scene.max_direction_deg = 45;
   scene.min_visible_fraction = 0.6;
-  const testing::SyntheticData data = testing::MakeSyntheticData(scene);
+  const sim::SyntheticData data = sim::MakeSyntheticData(scene);
   CalibrationResult result;
   std::string error;
   ASSERT_TRUE(Calibrate(data.views, scene.camera.model, scene.camera.width,

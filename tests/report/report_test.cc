@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "calib/camera_models.h"
-#include "decode/board.h"
+#include "camera/camera_models.h"
 #include "sim/render.h"
-#include "tests/calib/synthetic_views.h"
+#include "sim/synthetic_views.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace {
@@ -76,7 +76,7 @@ Board CheckerBoard(double tile) {
 // Synthetic calibration with known truth, rendered view images on disk and
 // the input of WriteReport, as `puzzlecal calibrate` would assemble it.
 struct SyntheticRun {
-  testing::SyntheticData data;
+  sim::SyntheticData data;
   Camera truth;
   CalibrationResult result;
   bool calibrated = false;
@@ -84,10 +84,10 @@ struct SyntheticRun {
   ReportInput input;
 };
 
-void MakeRun(const testing::SyntheticScene& scene, const fs::path& image_dir,
+void MakeRun(const sim::SyntheticScene& scene, const fs::path& image_dir,
              bool render, SyntheticRun* run) {
   run->truth = scene.camera;
-  run->data = testing::MakeSyntheticData(scene);
+  run->data = sim::MakeSyntheticData(scene);
   const Board board = CheckerBoard(scene.tile);
   run->input.board = board;
   // Two images that yielded nothing come first, as a folder listing would.
@@ -139,9 +139,9 @@ void MakeRun(const testing::SyntheticScene& scene, const fs::path& image_dir,
   run->input.threads = 2;
 }
 
-testing::SyntheticScene SmallRadtanScene() {
-  testing::SyntheticScene scene;
-  scene.camera = testing::MakeCamera(
+sim::SyntheticScene SmallRadtanScene() {
+  sim::SyntheticScene scene;
+  scene.camera = sim::MakeCamera(
       CameraModelId::kPinholeRadtan, 640, 480,
       {410.0, 409.3, 321.2, 238.6, -0.28, 0.09, 0.0006, -0.0004, -0.012});
   scene.num_views = 8;
@@ -330,8 +330,8 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
 
 TEST(ReportTest, FisheyeRunWithMissingImagesStillWritesEverything) {
   const fs::path dir = FreshDir("fisheye");
-  testing::SyntheticScene scene;
-  scene.camera = testing::MakeCamera(
+  sim::SyntheticScene scene;
+  scene.camera = sim::MakeCamera(
       CameraModelId::kKannalaBrandt, 800, 600,
       {247.5, 247.1, 400.9, 299.2, 0.02, -0.005, 0.001, -0.0002});
   scene.num_views = 10;
@@ -382,10 +382,10 @@ TEST(ReportTest, FisheyeRunWithMissingImagesStillWritesEverything) {
 
 // The distortion map's shift, cross-checked against OpenCV's undistortion.
 TEST(ReportTest, DistortionShiftAgreesWithOpenCv) {
-  const Camera radtan = testing::MakeCamera(
+  const Camera radtan = sim::MakeCamera(
       CameraModelId::kPinholeRadtan, 640, 480,
       {410.0, 409.3, 321.2, 238.6, -0.28, 0.09, 0.0006, -0.0004, -0.012});
-  const Camera fisheye = testing::MakeCamera(
+  const Camera fisheye = sim::MakeCamera(
       CameraModelId::kKannalaBrandt, 800, 600,
       {247.5, 247.1, 400.9, 299.2, 0.02, -0.005, 0.001, -0.0002});
   for (const Camera& camera : {radtan, fisheye}) {

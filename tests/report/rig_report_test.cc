@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "calib/evidence.h"
 #include "calib/rig_calibration.h"
-#include "calib/verdict.h"
+#include "evidence/evidence.h"
+#include "evidence/verdict.h"
 #include "sim/rig_scenes.h"
 #include "util/string_format.h"
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "apps/config_io.h"
-#include "decode/puzzleboard.h"
+#include "formats/board_file.h"
 #include "pipeline/pipeline.h"
+#include "target/puzzleboard.h"
 
 namespace puzzlecal {
 namespace {

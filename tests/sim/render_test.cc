@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "decode/puzzleboard.h"
 #include "sim/scenes.h"
+#include "target/puzzleboard.h"
 
 namespace puzzlecal {
 namespace {

@@ -1,0 +1,799 @@
+#include "evidence/evidence.h"
+
+#include <ceres/jet.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "util/failure.h"
+#include "util/parallel_for.h"
+
+namespace puzzlecal {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kDeg = M_PI / 180.0;
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+std::string Printf(const char* format, double a, double b = 0, double c = 0,
+                   double d = 0, double e = 0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), format, a, b, c, d, e);
+  return buffer;
+}
+
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return kNaN;
+  const size_t k = std::min(values.size() - 1,
+                            static_cast<size_t>(q * (values.size() - 1) + 0.5));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+// Every map and figure here is of the far field: a ray's direction, as
+// Unproject gives it. Camera::Project takes a point, and a unit ray as a
+// point is one metre away, where a non-central lens still shows its pupil
+// shift (a 4 mm shift at 90 degrees moves such a point by about 1 px on a
+// 300 px fisheye). So directions are projected as points this far along
+// them (metres), where the shift moves them by about 1e-6 px; central models
+// give the same pixel at any distance.
+constexpr double kFarDistanceM = 1e6;
+
+bool ProjectDirection(const Camera& camera, const Eigen::Vector3d& ray,
+                      Eigen::Vector2d* pixel) {
+  return camera.Project(kFarDistanceM * ray, pixel);
+}
+
+double FieldAngleDeg(const Eigen::Vector3d& ray) {
+  return std::atan2(ray.head<2>().norm(), ray.z()) / kDeg;
+}
+
+// d pixel / d intrinsics (jacobian, 2 x n) and d pixel / d point (point, 2 x
+// 3, by the ray) of Model::Project of the far point along `ray`, by
+// automatic differentiation.
+template <typename Model>
+bool ProjectionJacobians(const double* params, const Eigen::Vector3d& ray,
+                         Eigen::MatrixXd* jacobian,
+                         Eigen::Matrix<double, 2, 3>* point) {
+  constexpr int kN = Model::kNumParams;
+  using JetT = ceres::Jet<double, kN + 3>;
+  JetT p[kN];
+  for (int k = 0; k < kN; ++k) p[k] = JetT(params[k], k);
+  // The far point along the ray (see kFarDistanceM), differentiated by the
+  // ray itself.
+  const JetT x[3] = {kFarDistanceM * JetT(ray.x(), kN),
+                     kFarDistanceM * JetT(ray.y(), kN + 1),
+                     kFarDistanceM * JetT(ray.z(), kN + 2)};
+  JetT pixel[2];
+  if (!Model::Project(p, x, pixel)) return false;
+  jacobian->resize(2, kN);
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < kN; ++k) (*jacobian)(r, k) = pixel[r].v[k];
+    for (int k = 0; k < 3; ++k) (*point)(r, k) = pixel[r].v[kN + k];
+  }
+  return jacobian->allFinite() && point->allFinite();
+}
+
+// At `pixel`: J = d pixel / d intrinsics with the ray held fixed, and G =
+// d pixel / d omega for a small rotation omega of the ray (ray + omega x ray).
+bool PixelJacobians(const Camera& camera, const Eigen::Vector2d& pixel,
+                    Eigen::MatrixXd* jacobian, Eigen::Matrix<double, 2, 3>* g) {
+  Eigen::Vector3d ray;
+  if (!camera.Unproject(pixel, &ray).converged) return false;
+  Eigen::Matrix<double, 2, 3> point;
+  const bool ok = DispatchCameraModel(camera.model, [&](auto model) {
+    return ProjectionJacobians<decltype(model)>(camera.params.data(), ray,
+                                                jacobian, &point);
+  });
+  if (!ok) return false;
+  Eigen::Matrix3d cross;  // omega x ray = -[ray]_x omega
+  cross << 0, ray.z(), -ray.y(), -ray.z(), 0, ray.x(), ray.y(), -ray.x(), 0;
+  *g = point * cross;
+  return true;
+}
+
+// The grid of a map for `camera`, with each sample's field angle.
+PixelMap EmptyMap(const Camera& camera, int step) {
+  PixelMap map;
+  map.step_px = step;
+  map.cols = (camera.width - 1 + step - 1) / step + 1;
+  map.rows = (camera.height - 1 + step - 1) / step + 1;
+  map.values.assign(map.cols * map.rows, kNaN);
+  map.angle_deg.assign(map.cols * map.rows, kNaN);
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) {
+      Eigen::Vector3d ray;
+      const Eigen::Vector2d pixel(std::min(i * step, camera.width - 1),
+                                  std::min(j * step, camera.height - 1));
+      if (camera.Unproject(pixel, &ray).converged) {
+        map.angle_deg[j * map.cols + i] = FieldAngleDeg(ray);
+      }
+    }
+  }
+  return map;
+}
+
+Eigen::Vector2d MapPixel(const PixelMap& map, const Camera& camera, int i,
+                         int j) {
+  return Eigen::Vector2d(std::min(i * map.step_px, camera.width - 1),
+                         std::min(j * map.step_px, camera.height - 1));
+}
+
+// A map of sqrt(tr(C(p)) * factor) for the camera's covariance.
+PixelMap CovarianceTraceMap(const Camera& camera,
+                            const Eigen::MatrixXd& covariance, int step,
+                            double factor, const Eigen::MatrixXd* gauge) {
+  PixelMap map = EmptyMap(camera, step);
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) {
+      Eigen::Matrix2d cov;
+      if (ProjectionCovariance(camera, covariance, MapPixel(map, camera, i, j),
+                               &cov, gauge)) {
+        map.values[j * map.cols + i] =
+            std::sqrt(std::max(0.0, cov.trace() * factor));
+      }
+    }
+  }
+  return map;
+}
+
+// The used views of `result` at even (half 0) or odd (half 1) positions.
+std::vector<CalibrationView> Half(const std::vector<CalibrationView>& views,
+                                  const CalibrationResult& result, int half,
+                                  std::vector<Eigen::Isometry3d>* poses) {
+  std::vector<CalibrationView> out;
+  poses->clear();
+  int position = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (v >= result.view_used.size() || !result.view_used[v]) continue;
+    if (position++ % 2 != half) continue;
+    out.push_back(views[v]);
+    poses->push_back(result.cam_from_board[v]);
+  }
+  return out;
+}
+
+ResidualBin MakeBin(double lo, double hi, const std::vector<double>& radial,
+                    const std::vector<double>& tangential) {
+  ResidualBin bin;
+  bin.lo = lo;
+  bin.hi = hi;
+  bin.count = static_cast<int>(radial.size());
+  if (bin.count == 0) return bin;
+  double sum2 = 0;
+  for (size_t k = 0; k < radial.size(); ++k) {
+    sum2 += radial[k] * radial[k] + tangential[k] * tangential[k];
+  }
+  bin.rms_px = std::sqrt(sum2 / (2.0 * bin.count));
+  auto mean_se = [](const std::vector<double>& x, double* mean, double* se) {
+    double sum = 0;
+    for (double value : x) sum += value;
+    *mean = sum / x.size();
+    double ss = 0;
+    for (double value : x) ss += (value - *mean) * (value - *mean);
+    *se = x.size() > 1 ? std::sqrt(ss / (x.size() - 1) / x.size()) : kNaN;
+  };
+  mean_se(radial, &bin.mean_radial_px, &bin.se_radial_px);
+  mean_se(tangential, &bin.mean_tangential_px, &bin.se_tangential_px);
+  return bin;
+}
+
+}  // namespace
+
+bool EvidenceOptions::Check(std::string* why) const {
+  if (grid_step_px < 1) return Fail("grid_step_px must be >= 1", why);
+  if (!(band_width_deg > 0)) return Fail("band_width_deg must be > 0", why);
+  if (distance_bins < 1) return Fail("distance_bins must be >= 1", why);
+  if (min_bin_count < 1) return Fail("min_bin_count must be >= 1", why);
+  if (report_azimuths < 1) return Fail("report_azimuths must be >= 1", why);
+  for (double angle : report_angles_deg) {
+    if (!(angle > 0 && angle < 180)) {
+      return Fail("report_angles_deg must lie in (0, 180)", why);
+    }
+  }
+  return true;
+}
+
+bool ProjectionCovariance(const Camera& camera,
+                          const Eigen::MatrixXd& covariance,
+                          const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov,
+                          const Eigen::MatrixXd* gauge) {
+  const int n = CameraModelNumParams(camera.model);
+  if (static_cast<int>(camera.params.size()) != n || covariance.rows() != n ||
+      covariance.cols() != n) {
+    return false;
+  }
+  Eigen::MatrixXd jacobian;
+  Eigen::Matrix<double, 2, 3> g;
+  if (!PixelJacobians(camera, pixel, &jacobian, &g)) return false;
+  if (gauge != nullptr && gauge->rows() == 3 && gauge->cols() == n) {
+    jacobian -= g * *gauge;
+  }
+  *cov = jacobian * covariance * jacobian.transpose();
+  return cov->allFinite();
+}
+
+Eigen::MatrixXd RotationGauge(const Camera& camera, int step_px,
+                              double max_angle_deg) {
+  const int n = CameraModelNumParams(camera.model);
+  if (static_cast<int>(camera.params.size()) != n || camera.width <= 0 ||
+      camera.height <= 0 || step_px < 1) {
+    return Eigen::MatrixXd();
+  }
+  const PixelMap map = EmptyMap(camera, step_px);
+  Eigen::Matrix3d gtg = Eigen::Matrix3d::Zero();
+  Eigen::MatrixXd gtj = Eigen::MatrixXd::Zero(3, n);
+  int count = 0;
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) {
+      const double angle = map.angle_deg[j * map.cols + i];
+      if (!std::isfinite(angle) || angle > max_angle_deg) continue;
+      Eigen::MatrixXd jacobian;
+      Eigen::Matrix<double, 2, 3> g;
+      if (!PixelJacobians(camera, MapPixel(map, camera, i, j), &jacobian, &g)) {
+        continue;
+      }
+      gtg += g.transpose() * g;
+      gtj += g.transpose() * jacobian;
+      ++count;
+    }
+  }
+  if (count < 3) return Eigen::MatrixXd();
+  const Eigen::FullPivLU<Eigen::Matrix3d> lu(gtg);
+  if (!lu.isInvertible()) return Eigen::MatrixXd();
+  return lu.solve(gtj);
+}
+
+std::vector<AngleBand> SummarizeByAngle(const PixelMap& map,
+                                        double band_width_deg,
+                                        double max_angle_deg) {
+  std::vector<AngleBand> bands;
+  if (!(band_width_deg > 0) || !(max_angle_deg > 0)) return bands;
+  const int count =
+      static_cast<int>(std::ceil(max_angle_deg / band_width_deg - 1e-9));
+  for (int b = 0; b < count; ++b) {
+    AngleBand band;
+    band.lo_deg = b * band_width_deg;
+    band.hi_deg = std::min(max_angle_deg, (b + 1) * band_width_deg);
+    std::vector<double> values;
+    for (size_t k = 0; k < map.values.size(); ++k) {
+      const double angle = map.angle_deg[k];
+      if (!std::isfinite(map.values[k]) || !std::isfinite(angle)) continue;
+      const bool last = b + 1 == count;
+      if (angle >= band.lo_deg &&
+          (angle < band.hi_deg || (last && angle <= band.hi_deg))) {
+        values.push_back(map.values[k]);
+      }
+    }
+    band.count = static_cast<int>(values.size());
+    band.median = Quantile(values, 0.5);
+    band.p95 = Quantile(values, 0.95);
+    bands.push_back(band);
+  }
+  return bands;
+}
+
+SystematicResiduals ComputeSystematicResiduals(
+    const std::vector<CalibrationView>& views, const CalibrationResult& result,
+    const EvidenceOptions& options) {
+  SystematicResiduals out;
+  const Camera& camera = result.camera;
+  if (camera.params.size() < 4) return out;
+  const Eigen::Vector2d principal(camera.params[2], camera.params[3]);
+  struct Sample {
+    double angle_deg, distance_m, radial, tangential;
+  };
+  std::vector<Sample> samples;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (v >= result.view_used.size() || !result.view_used[v]) continue;
+    if (v >= result.residuals.size() || v >= result.inlier.size() ||
+        v >= result.cam_from_board.size()) {
+      continue;
+    }
+    const CalibrationView& view = views[v];
+    for (size_t i = 0; i < result.residuals[v].size(); ++i) {
+      if (i >= result.inlier[v].size() || !result.inlier[v][i]) continue;
+      if (i >= view.board_points.size()) continue;
+      const Eigen::Vector3d point =
+          result.cam_from_board[v] * view.board_points[i];
+      const Eigen::Vector2d offset = view.image_points[i] - principal;
+      const double norm = offset.norm();
+      if (!(norm > 1e-9) || !point.allFinite()) continue;
+      const Eigen::Vector2d radial_dir = offset / norm;
+      // Counter-clockwise on the screen (y down): (x, y) -> (y, -x).
+      const Eigen::Vector2d tangential_dir(radial_dir.y(), -radial_dir.x());
+      const Eigen::Vector2d& r = result.residuals[v][i];
+      samples.push_back({FieldAngleDeg(point), point.norm(), r.dot(radial_dir),
+                         r.dot(tangential_dir)});
+      out.max_angle_deg = std::max(out.max_angle_deg, samples.back().angle_deg);
+    }
+  }
+  if (samples.empty()) return out;
+  // By field angle: fixed-width bins up to the widest corner. A last bin
+  // narrower than a quarter of the width (a sliver holding the few widest
+  // corners, with no usable statistics) joins the one before it.
+  int angle_bins = std::max(
+      1, static_cast<int>(
+             std::ceil(out.max_angle_deg / options.band_width_deg - 1e-9)));
+  if (angle_bins > 1 &&
+      out.max_angle_deg - (angle_bins - 1) * options.band_width_deg <
+          0.25 * options.band_width_deg) {
+    --angle_bins;
+  }
+  for (int b = 0; b < angle_bins; ++b) {
+    const bool last = b + 1 == angle_bins;
+    const double lo = b * options.band_width_deg;
+    const double hi = last ? out.max_angle_deg : lo + options.band_width_deg;
+    std::vector<double> radial, tangential;
+    for (const Sample& s : samples) {
+      if (s.angle_deg >= lo &&
+          (s.angle_deg < hi || (last && s.angle_deg <= hi))) {
+        radial.push_back(s.radial);
+        tangential.push_back(s.tangential);
+      }
+    }
+    out.by_angle.push_back(MakeBin(lo, hi, radial, tangential));
+  }
+  // By distance: quantile edges, so the bins hold about equal counts.
+  std::vector<double> distances;
+  for (const Sample& s : samples) distances.push_back(s.distance_m);
+  std::sort(distances.begin(), distances.end());
+  std::vector<double> edges;
+  for (int b = 0; b <= options.distance_bins; ++b) {
+    const size_t k = std::min(distances.size() - 1,
+                              b * distances.size() / options.distance_bins);
+    edges.push_back(b == options.distance_bins ? distances.back()
+                                               : distances[k]);
+  }
+  for (int b = 0; b < options.distance_bins; ++b) {
+    if (!(edges[b + 1] > edges[b])) continue;
+    std::vector<double> radial, tangential;
+    for (const Sample& s : samples) {
+      const bool last = b + 1 == options.distance_bins;
+      if (s.distance_m >= edges[b] &&
+          (s.distance_m < edges[b + 1] ||
+           (last && s.distance_m <= edges[b + 1]))) {
+        radial.push_back(s.radial);
+        tangential.push_back(s.tangential);
+      }
+    }
+    out.by_distance.push_back(
+        MakeBin(edges[b], edges[b + 1], radial, tangential));
+  }
+  return out;
+}
+
+ProjectionUncertainty ComputeProjectionUncertainty(
+    const CalibrationResult& result, double max_angle_deg,
+    const EvidenceOptions& options) {
+  ProjectionUncertainty out;
+  const Camera& camera = result.camera;
+  if (!result.covariance_ok || camera.width <= 0 || camera.height <= 0) {
+    return out;
+  }
+  out.gauge = RotationGauge(camera, options.grid_step_px, max_angle_deg);
+  out.rotation_removed = out.gauge.size() > 0;
+  out.sigma_px =
+      CovarianceTraceMap(camera, result.covariance, options.grid_step_px, 0.5,
+                         out.rotation_removed ? &out.gauge : nullptr);
+  out.bands =
+      SummarizeByAngle(out.sigma_px, options.band_width_deg, max_angle_deg);
+  auto sigma_at = [&](const Eigen::Vector2d& pixel,
+                      const Eigen::MatrixXd* gauge, double* sigma) {
+    Eigen::Matrix2d cov;
+    if (!ProjectionCovariance(camera, result.covariance, pixel, &cov, gauge)) {
+      return false;
+    }
+    *sigma = std::sqrt(std::max(0.0, 0.5 * cov.trace()));
+    return true;
+  };
+  const Eigen::MatrixXd* gauge = out.rotation_removed ? &out.gauge : nullptr;
+  UncertaintyPoint centre;
+  centre.label = "centre";
+  const Eigen::Vector2d principal(camera.params[2], camera.params[3]);
+  centre.in_image = sigma_at(principal, gauge, &centre.sigma_px) &&
+                    sigma_at(principal, nullptr, &centre.camera_frame_sigma_px);
+  out.points.push_back(centre);
+  std::vector<std::pair<std::string, double>> angles;
+  for (double angle : options.report_angles_deg) {
+    angles.emplace_back(Printf("%.0f deg", angle), angle);
+  }
+  if (max_angle_deg > 0) {
+    angles.emplace_back(Printf("rim (%.1f deg)", max_angle_deg), max_angle_deg);
+  }
+  for (const auto& [label, angle] : angles) {
+    UncertaintyPoint point;
+    point.label = label;
+    point.angle_deg = angle;
+    for (int a = 0; a < options.report_azimuths; ++a) {
+      const double phi = 2 * M_PI * a / options.report_azimuths;
+      const Eigen::Vector3d ray(std::sin(angle * kDeg) * std::cos(phi),
+                                std::sin(angle * kDeg) * std::sin(phi),
+                                std::cos(angle * kDeg));
+      Eigen::Vector2d pixel;
+      if (!ProjectDirection(camera, ray, &pixel) || pixel.x() < 0 ||
+          pixel.y() < 0 || pixel.x() > camera.width - 1 ||
+          pixel.y() > camera.height - 1) {
+        continue;
+      }
+      double sigma, fixed_frame;
+      if (!sigma_at(pixel, gauge, &sigma) ||
+          !sigma_at(pixel, nullptr, &fixed_frame)) {
+        continue;
+      }
+      point.sigma_px = point.in_image ? std::max(point.sigma_px, sigma) : sigma;
+      point.camera_frame_sigma_px =
+          point.in_image ? std::max(point.camera_frame_sigma_px, fixed_frame)
+                         : fixed_frame;
+      point.in_image = true;
+    }
+    out.points.push_back(point);
+  }
+  out.ok = true;
+  return out;
+}
+
+namespace {
+
+// The Mahalanobis distance of the difference of two calibrations' free
+// intrinsics under the sum of their covariances, and the number of free
+// intrinsics (0 and 0 when the sum is singular).
+void IntrinsicsChiSquare(const CalibrationResult& a, const CalibrationResult& b,
+                         double* chi2, int* dof) {
+  *chi2 = 0;
+  *dof = 0;
+  std::vector<int> free;
+  for (size_t k = 0; k < a.camera.params.size(); ++k) {
+    const bool fixed_a = k < a.param_fixed.size() && a.param_fixed[k];
+    const bool fixed_b = k < b.param_fixed.size() && b.param_fixed[k];
+    if (!fixed_a && !fixed_b) free.push_back(static_cast<int>(k));
+  }
+  const int n = static_cast<int>(free.size());
+  const Eigen::Index num_params =
+      static_cast<Eigen::Index>(a.camera.params.size());
+  if (n == 0 || a.covariance.rows() < num_params ||
+      b.covariance.rows() < num_params) {
+    return;
+  }
+  Eigen::VectorXd d(n);
+  Eigen::MatrixXd sum(n, n);
+  for (int i = 0; i < n; ++i) {
+    d(i) = a.camera.params[free[i]] - b.camera.params[free[i]];
+    for (int j = 0; j < n; ++j) {
+      sum(i, j) =
+          a.covariance(free[i], free[j]) + b.covariance(free[i], free[j]);
+    }
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(sum);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return;
+  const double value = d.dot(ldlt.solve(d));
+  if (!std::isfinite(value)) return;
+  *chi2 = value;
+  *dof = n;
+}
+
+}  // namespace
+
+double ChiSquareZ(double chi2, int dof) {
+  if (dof < 1 || !(chi2 >= 0)) return 0;
+  const double v = 2.0 / (9.0 * dof);
+  return (std::cbrt(chi2 / dof) - (1.0 - v)) / std::sqrt(v);
+}
+
+namespace {
+
+// The halves' two calibrations, started from the full solution, each with
+// its covariance. False (with out->error) when a half cannot be calibrated
+// or does not determine the model.
+bool CalibrateHalves(const std::vector<CalibrationView>& views,
+                     const CalibrationResult& result,
+                     const CalibrationOptions& calibration,
+                     CrossValidation* out, CalibrationResult halves[2]) {
+  const Camera& camera = result.camera;
+  CalibrationOptions half_options = calibration;
+  half_options.initial_params = camera.params;
+  half_options.compute_covariance = true;
+  if (result.trust_region_radius > 0) {
+    half_options.initial_trust_region_radius = result.trust_region_radius;
+  }
+  // The two halves side by side, each on its share of the threads (a
+  // calibration's result does not depend on its thread count).
+  const int workers = std::min(2, std::max(1, calibration.num_threads));
+  half_options.num_threads = std::max(1, calibration.num_threads / workers);
+  // Each half starts from the full solution's intrinsics and its views'
+  // poses: a few iterations from its own minimum.
+  CalibrationOptions options_of[2] = {half_options, half_options};
+  std::vector<CalibrationView> half[2] = {
+      Half(views, result, 0, &options_of[0].initial_cam_from_board),
+      Half(views, result, 1, &options_of[1].initial_cam_from_board)};
+  out->views_a = static_cast<int>(half[0].size());
+  out->views_b = static_cast<int>(half[1].size());
+  std::string error[2];
+  char ok[2] = {0, 0};
+  ParallelFor(2, workers, [&](int h) {
+    ok[h] = Calibrate(half[h], camera.model, camera.width, camera.height,
+                      options_of[h], &halves[h], &error[h]);
+  });
+  for (int h = 0; h < 2; ++h) {
+    const std::string name = h == 0 ? "A" : "B";
+    if (!ok[h]) {
+      out->error = "half " + name + " (" + std::to_string(half[h].size()) +
+                   " views): " + error[h];
+      return false;
+    }
+    if (!halves[h].covariance_ok) {
+      out->error = "half " + name +
+                   ": no covariance (the half does not determine the model)";
+      return false;
+    }
+  }
+  return true;
+}
+
+// The rays of both halves at the grid pixels of `map` within the observed
+// field; valid[k] where both unproject and B's pixel Jacobian exists
+// (g[k]: the derivative of B's projection with respect to a small rotation
+// of the ray).
+struct HalvesRays {
+  std::vector<Eigen::Vector3d> a, b;
+  std::vector<Eigen::Matrix<double, 2, 3>> g;
+  std::vector<bool> unprojected;  // both halves unproject the pixel
+  std::vector<bool> valid;        // and B's pixel Jacobian exists
+};
+
+HalvesRays RaysOfHalves(const CrossValidation& out, const PixelMap& map,
+                        const Camera& camera, double max_angle_deg) {
+  HalvesRays rays;
+  rays.a.resize(map.values.size());
+  rays.b.resize(map.values.size());
+  rays.g.resize(map.values.size());
+  rays.unprojected.assign(map.values.size(), false);
+  rays.valid.assign(map.values.size(), false);
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) {
+      const int k = j * map.cols + i;
+      const double angle = map.angle_deg[k];
+      if (!std::isfinite(angle) || angle > max_angle_deg) continue;
+      const Eigen::Vector2d pixel = MapPixel(map, camera, i, j);
+      if (!out.camera_a.Unproject(pixel, &rays.a[k]).converged ||
+          !out.camera_b.Unproject(pixel, &rays.b[k]).converged) {
+        continue;
+      }
+      rays.unprojected[k] = true;
+      Eigen::MatrixXd unused;
+      rays.valid[k] = PixelJacobians(out.camera_b, pixel, &unused, &rays.g[k]);
+    }
+  }
+  return rays;
+}
+
+// The two halves' camera frames are each tied to their own board poses
+// only: rotating a camera frame together with all of its poses changes no
+// projection of the boards, and a small such rotation is nearly the same as
+// a shift of the principal point. Two independent fits therefore differ by
+// a rotation that is no disagreement about the lens. As mrcal does
+// (projection_diff), the rotation that best aligns the rays of the two
+// solutions over the observed field is fitted first (Kabsch: least squares
+// over the unit rays of the grid pixels), then refined by a few
+// Gauss-Newton steps on the pixel differences themselves, the measure the
+// expected figures use (RotationGauge).
+Eigen::Matrix3d FitRotationBetweenHalves(const CrossValidation& out,
+                                         const PixelMap& map,
+                                         const Camera& camera,
+                                         const HalvesRays& rays) {
+  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < rays.valid.size(); ++k) {
+    if (rays.unprojected[k]) cross += rays.b[k] * rays.a[k].transpose();
+  }
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+      cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) =
+      (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
+  Eigen::Matrix3d b_from_a = svd.matrixU() * d * svd.matrixV().transpose();
+  for (int iteration = 0; iteration < 3; ++iteration) {
+    Eigen::Matrix3d gtg = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d gtr = Eigen::Vector3d::Zero();
+    for (int j = 0; j < map.rows; ++j) {
+      for (int i = 0; i < map.cols; ++i) {
+        const int k = j * map.cols + i;
+        Eigen::Vector2d projected;
+        if (!rays.valid[k] ||
+            !ProjectDirection(out.camera_b, b_from_a * rays.a[k], &projected)) {
+          continue;
+        }
+        gtg += rays.g[k].transpose() * rays.g[k];
+        gtr +=
+            rays.g[k].transpose() * (projected - MapPixel(map, camera, i, j));
+      }
+    }
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(gtg);
+    if (!lu.isInvertible()) break;
+    const Eigen::Vector3d omega = -lu.solve(gtr);
+    if (!omega.allFinite() || omega.norm() == 0) break;
+    b_from_a =
+        Eigen::AngleAxisd(omega.norm(), omega.normalized()).toRotationMatrix() *
+        b_from_a;
+  }
+  return b_from_a;
+}
+
+// What noise alone would give at each pixel of `difference`: the two
+// halves' projection covariances add, each with its own rotation gauge
+// removed over the same field, as the comparison removes the rotation
+// between them.
+PixelMap ExpectedDifference(const CrossValidation& out,
+                            const CalibrationResult halves[2],
+                            const PixelMap& difference, double max_angle_deg,
+                            const EvidenceOptions& options) {
+  const Eigen::MatrixXd gauge_a =
+      RotationGauge(out.camera_a, options.grid_step_px, max_angle_deg);
+  const Eigen::MatrixXd gauge_b =
+      RotationGauge(out.camera_b, options.grid_step_px, max_angle_deg);
+  const PixelMap expected_a = CovarianceTraceMap(
+      out.camera_a, halves[0].covariance, options.grid_step_px, 1.0,
+      gauge_a.size() > 0 ? &gauge_a : nullptr);
+  const PixelMap expected_b = CovarianceTraceMap(
+      out.camera_b, halves[1].covariance, options.grid_step_px, 1.0,
+      gauge_b.size() > 0 ? &gauge_b : nullptr);
+  PixelMap expected = difference;
+  for (size_t k = 0; k < difference.values.size(); ++k) {
+    expected.values[k] =
+        std::isfinite(difference.values[k])
+            ? std::hypot(expected_a.values[k], expected_b.values[k])
+            : kNaN;
+  }
+  return expected;
+}
+
+}  // namespace
+
+CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
+                              const CalibrationResult& result,
+                              const CalibrationOptions& calibration,
+                              double max_angle_deg,
+                              const EvidenceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CrossValidation out;
+  const Camera& camera = result.camera;
+  CalibrationResult halves[2];
+  if (!CalibrateHalves(views, result, calibration, &out, halves)) {
+    out.seconds = SecondsSince(start);
+    return out;
+  }
+  out.camera_a = halves[0].camera;
+  out.camera_b = halves[1].camera;
+  out.rms_a_px = halves[0].rms_px;
+  out.rms_b_px = halves[1].rms_px;
+  IntrinsicsChiSquare(halves[0], halves[1], &out.intrinsics_chi2,
+                      &out.intrinsics_dof);
+
+  // |project_B(R * unproject_A(pixel)) - pixel| after the rotation between
+  // the halves is taken out.
+  PixelMap map = EmptyMap(camera, options.grid_step_px);
+  const HalvesRays rays = RaysOfHalves(out, map, camera, max_angle_deg);
+  out.b_from_a = FitRotationBetweenHalves(out, map, camera, rays);
+  out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDeg;
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) {
+      const int k = j * map.cols + i;
+      if (!rays.valid[k]) continue;
+      Eigen::Vector2d projected;
+      if (ProjectDirection(out.camera_b, out.b_from_a * rays.a[k],
+                           &projected)) {
+        map.values[k] = (projected - MapPixel(map, camera, i, j)).norm();
+      }
+    }
+  }
+  out.difference_px = map;
+  out.expected_px =
+      ExpectedDifference(out, halves, map, max_angle_deg, options);
+  out.difference_bands = SummarizeByAngle(
+      out.difference_px, options.band_width_deg, max_angle_deg);
+  out.expected_bands =
+      SummarizeByAngle(out.expected_px, options.band_width_deg, max_angle_deg);
+  out.ok = true;
+  out.seconds = SecondsSince(start);
+  return out;
+}
+
+Evidence ComputeEvidence(const std::vector<CalibrationView>& views,
+                         const CalibrationResult& result,
+                         const CalibrationOptions& calibration,
+                         const EvidenceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Evidence evidence;
+  std::string why;
+  if (!options.Check(&why)) {
+    evidence.cross_validation.error = "evidence options: " + why;
+    return evidence;
+  }
+  evidence.residuals = ComputeSystematicResiduals(views, result, options);
+  const double max_angle = evidence.residuals.max_angle_deg;
+  evidence.uncertainty =
+      ComputeProjectionUncertainty(result, max_angle, options);
+  if (options.cross_validation) {
+    evidence.cross_validation =
+        CrossValidate(views, result, calibration, max_angle, options);
+  } else {
+    evidence.cross_validation.error = "not run";
+  }
+  evidence.seconds = SecondsSince(start);
+  return evidence;
+}
+
+std::string EvidenceText(const Evidence& evidence) {
+  std::ostringstream text;
+  const CrossValidation& cv = evidence.cross_validation;
+  if (cv.ok) {
+    text << "cross-validation (" << cv.views_a << " + " << cv.views_b
+         << " views, RMS " << Printf("%.3f / %.3f px", cv.rms_a_px, cv.rms_b_px)
+         << ", rotation between the halves "
+         << Printf("%.3f deg", cv.rotation_deg) << "):\n";
+    text << "  field angle   |A-B| median   p95   expected median   p95\n";
+    for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
+      const AngleBand& d = cv.difference_bands[b];
+      const AngleBand& e = cv.expected_bands[b];
+      if (d.count == 0) continue;
+      text << Printf("  %3.0f-%3.0f deg   %8.3f   %8.3f", d.lo_deg, d.hi_deg,
+                     d.median, d.p95)
+           << Printf("   %8.3f   %8.3f px", e.median, e.p95)
+           << "  n=" << d.count << "\n";
+    }
+    if (cv.intrinsics_dof > 0) {
+      text << Printf(
+          "  intrinsics as a whole: chi-square %.1f for %.0f free "
+          "parameters (z = %.1f)\n",
+          cv.intrinsics_chi2, cv.intrinsics_dof,
+          ChiSquareZ(cv.intrinsics_chi2, cv.intrinsics_dof));
+    }
+  } else {
+    text << "cross-validation: " << cv.error << "\n";
+  }
+  const ProjectionUncertainty& u = evidence.uncertainty;
+  if (u.ok) {
+    text << "projection uncertainty (1-sigma, px per axis; rotation gauge "
+            "removed / in the camera frame):";
+    for (const UncertaintyPoint& p : u.points) {
+      text << " " << p.label << " "
+           << (p.in_image
+                   ? Printf("%.3f / %.3f", p.sigma_px, p.camera_frame_sigma_px)
+                   : "not in image")
+           << ";";
+    }
+    text << "\n";
+  } else {
+    text << "projection uncertainty: no covariance\n";
+  }
+  auto bins = [&](const char* title, const std::vector<ResidualBin>& list,
+                  const char* unit, int decimals) {
+    text << title << "\n";
+    for (const ResidualBin& b : list) {
+      text << (decimals == 0 ? Printf("  %5.0f-%5.0f ", b.lo, b.hi)
+                             : Printf("  %5.2f-%5.2f ", b.lo, b.hi))
+           << unit
+           << Printf(
+                  "  radial %+.3f +- %.3f  tangential %+.3f +- %.3f  RMS "
+                  "%.3f px",
+                  b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
+                  b.se_tangential_px, b.rms_px)
+           << "  n=" << b.count << "\n";
+    }
+  };
+  bins("residual means by field angle:", evidence.residuals.by_angle, "deg", 0);
+  bins("residual means by distance:", evidence.residuals.by_distance, "m", 2);
+  return text.str();
+}
+
+}  // namespace puzzlecal

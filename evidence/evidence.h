@@ -1,0 +1,236 @@
+#ifndef PUZZLECAL_EVIDENCE_EVIDENCE_H_
+#define PUZZLECAL_EVIDENCE_EVIDENCE_H_
+
+// Evidence on a finished calibration: is the model right for the lens and do
+// the views determine it?
+// - cross-validation: the used views split into two disjoint halves
+//   (alternating by index), each calibrated on its own; the far-field
+//   projection difference between the two solutions over the image, after
+//   the best-fit rotation between their camera frames, compared with what
+//   the two solutions' own uncertainties predict;
+// - projection uncertainty: the parameter covariance propagated to the
+//   projection of a far point at each pixel;
+// - systematic residuals: the inlier residuals split into a radial and a
+//   tangential component about the principal point, binned by field angle
+//   and by the corner's distance from the camera, with means and standard
+//   errors. A right model leaves means near zero in every bin.
+// evidence/verdict.h turns these facts into one verdict.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "calib/calibrate.h"
+#include "camera/calibration_view.h"
+#include "camera/camera_models.h"
+
+namespace puzzlecal {
+
+struct EvidenceOptions {
+  // Spacing in pixels of the grid on which the maps are computed. Default 40
+  // (1600 x 1200 -> 41 x 31 samples). >= 1.
+  int grid_step_px = 40;
+  // Width of the field-angle bands of the summaries and of the residual
+  // bins, degrees. Default 10. > 0.
+  double band_width_deg = 10.0;
+  // Bins of the residuals against board distance; their edges are quantiles
+  // of the corner distances, so every bin holds about the same count.
+  // Default 6. >= 1.
+  int distance_bins = 6;
+  // A band or bin with fewer samples than this is listed but not judged.
+  // Default 30. >= 1.
+  int min_bin_count = 30;
+  // Run the cross-validation (two extra calibrations). Default true.
+  bool cross_validation = true;
+  // Field angles (degrees) at which the projection uncertainty is reported,
+  // besides the centre and the rim (the widest observed field angle).
+  // Default 30, 60, 90. Angles the image does not reach are reported as
+  // such.
+  std::vector<double> report_angles_deg = {30.0, 60.0, 90.0};
+  // Azimuths sampled around the axis for each report angle. Default 16. >= 1.
+  int report_azimuths = 16;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+// A quantity sampled on a pixel grid: sample (i, j) is pixel
+// (min(i * step_px, width - 1), min(j * step_px, height - 1)). NaN where it is
+// not defined (no ray, or outside the observed field for the difference
+// map).
+struct PixelMap {
+  int step_px = 0;
+  int cols = 0;
+  int rows = 0;
+  std::vector<double> values;  // row-major, cols * rows
+  std::vector<double>
+      angle_deg;  // field angle of each sample's ray (NaN: none)
+  double At(int i, int j) const { return values[j * cols + i]; }
+};
+
+// Summary of a PixelMap over the samples whose field angle lies in
+// [lo_deg, hi_deg).
+struct AngleBand {
+  double lo_deg = 0;
+  double hi_deg = 0;
+  int count = 0;
+  double median = 0;
+  double p95 = 0;
+};
+
+struct CrossValidation {
+  bool ok = false;
+  std::string error;  // why not, when !ok
+  int views_a = 0;
+  int views_b = 0;
+  double rms_a_px = 0;
+  double rms_b_px = 0;
+  Camera camera_a;
+  Camera camera_b;
+  // The rotation taking half A's camera frame to half B's that best aligns
+  // their rays (the gauge freedom removed before comparing), and its angle.
+  Eigen::Matrix3d b_from_a = Eigen::Matrix3d::Identity();
+  double rotation_deg = 0;
+  // |project_B(R * unproject_A(pixel)) - pixel| in pixels, within the
+  // observed field (field angle <= the widest inlier corner's).
+  PixelMap difference_px;
+  // What noise alone would give: the RMS length of the difference predicted
+  // from the two halves' covariances, sqrt(tr(C_A(p)) + tr(C_B(p))), where
+  // C(p) is the 2 x 2 projection covariance at the pixel.
+  PixelMap expected_px;
+  std::vector<AngleBand> difference_bands;
+  std::vector<AngleBand> expected_bands;
+  // The halves' free intrinsics as a whole: the Mahalanobis distance
+  // d' (C_A + C_B)^-1 d of their difference d under the sum of their
+  // covariances, chi-square distributed with intrinsics_dof degrees of
+  // freedom when the two differ by noise alone. A band median above
+  // (difference_bands) can come from one parameter that is poorly
+  // determined everywhere in the band (every pixel of a band shares the one
+  // draw of the parameters); this figure says whether the difference is
+  // larger than the covariances allow at all.
+  double intrinsics_chi2 = 0;
+  int intrinsics_dof = 0;
+  double seconds = 0;  // the two calibrations and the comparison
+};
+
+// The standard normal quantile of a chi-square value with `dof` degrees of
+// freedom (Wilson-Hilferty: (x/k)^(1/3) is nearly normal with mean
+// 1 - 2/(9k) and variance 2/(9k)); 0 for dof < 1.
+double ChiSquareZ(double chi2, int dof);
+
+// One field angle at which the uncertainty is reported.
+struct UncertaintyPoint {
+  std::string label;  // "centre", "30 deg", ..., "rim (74.2 deg)"
+  double angle_deg = 0;
+  bool in_image = false;  // some azimuth at that angle lands in the image
+  double sigma_px = 0;    // the largest over the azimuths that land
+  // The same with the ray held fixed in the camera frame (no rotation
+  // removed).
+  double camera_frame_sigma_px = 0;
+};
+
+struct ProjectionUncertainty {
+  bool ok = false;  // false when the result has no covariance
+  // Per pixel: the 1-sigma of the projection of a far point seen at that
+  // pixel, as the RMS over the two image axes of the 2 x 2 projection
+  // covariance, sqrt(tr(C) / 2) (comparable with the per-coordinate RMS
+  // reprojection error). C = A Sigma A^T, Sigma the intrinsics' covariance
+  // marginal over the poses and A = J - G M: J = d pixel / d intrinsics
+  // with the ray held fixed, G = d pixel / d rotation of the ray, and
+  // M = (sum G^T G)^-1 sum G^T J over the observed field (`gauge`). The
+  // G M term removes the part of a parameter change that a common rotation
+  // of the camera frame undoes: a shift of cx, cy together with a rotation
+  // of every board pose moves no observation, so the camera-frame
+  // uncertainty of cx, cy is mostly not an uncertainty of the lens (mrcal
+  // reasons the same way). The camera-frame figure is kept in `points`.
+  PixelMap sigma_px;
+  Eigen::MatrixXd gauge;  // M (3 x n), empty when it could not be formed
+  bool rotation_removed = false;
+  std::vector<AngleBand> bands;
+  std::vector<UncertaintyPoint> points;
+};
+
+// Residual means of the inlier corners in one bin.
+struct ResidualBin {
+  double lo = 0;  // bin edges: degrees (field angle) or metres (distance)
+  double hi = 0;
+  int count = 0;
+  // Means of the residual (projected minus observed) along the direction
+  // from the principal point to the observed corner (radial; > 0: the
+  // model projects the corner farther out than it was seen) and across it
+  // (tangential, counter-clockwise in the image), with their standard
+  // errors (standard deviation / sqrt(count)).
+  double mean_radial_px = 0;
+  double mean_tangential_px = 0;
+  double se_radial_px = 0;
+  double se_tangential_px = 0;
+  // RMS of the residual coordinates, sqrt(sum |r|^2 / 2n).
+  double rms_px = 0;
+};
+
+struct SystematicResiduals {
+  std::vector<ResidualBin> by_angle;     // field angle of the corner's ray
+  std::vector<ResidualBin> by_distance;  // |corner| in the camera frame, m
+  double max_angle_deg = 0;  // widest field angle of an inlier corner
+};
+
+struct Evidence {
+  CrossValidation cross_validation;
+  ProjectionUncertainty uncertainty;
+  SystematicResiduals residuals;
+  double seconds = 0;  // all of it
+};
+
+// The binned residual means of `result` (no solves).
+SystematicResiduals ComputeSystematicResiduals(
+    const std::vector<CalibrationView>& views, const CalibrationResult& result,
+    const EvidenceOptions& options);
+
+// 2 x 2 covariance of the projection of the ray through `pixel` under the
+// intrinsics' covariance: with the ray held fixed in the camera frame, or,
+// with `gauge` (RotationGauge), after the best-fit common rotation. False
+// when the pixel has no ray.
+bool ProjectionCovariance(const Camera& camera,
+                          const Eigen::MatrixXd& covariance,
+                          const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov,
+                          const Eigen::MatrixXd* gauge = nullptr);
+
+// M = (sum G^T G)^-1 sum G^T J over the grid pixels of `camera` whose ray is
+// at most max_angle_deg off the axis (see ProjectionUncertainty): the
+// rotation that best undoes a parameter change. Empty when not formed.
+Eigen::MatrixXd RotationGauge(const Camera& camera, int step_px,
+                              double max_angle_deg);
+
+// The projection uncertainty map and figures of `result` (no solves).
+ProjectionUncertainty ComputeProjectionUncertainty(
+    const CalibrationResult& result, double max_angle_deg,
+    const EvidenceOptions& options);
+
+// Calibrates the two halves of the used views of `result` (even and odd
+// positions among them) with `calibration` options, started from the full
+// solution, and compares them.
+CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
+                              const CalibrationResult& result,
+                              const CalibrationOptions& calibration,
+                              double max_angle_deg,
+                              const EvidenceOptions& options);
+
+// All of the above for a successful Calibrate(views, ...) -> result. Invalid
+// options leave everything empty, with the reason in
+// cross_validation.error.
+Evidence ComputeEvidence(const std::vector<CalibrationView>& views,
+                         const CalibrationResult& result,
+                         const CalibrationOptions& calibration,
+                         const EvidenceOptions& options);
+
+// Summaries of a map by field-angle bands of `band_width_deg` up to
+// `max_angle_deg` (samples beyond it are left out).
+std::vector<AngleBand> SummarizeByAngle(const PixelMap& map,
+                                        double band_width_deg,
+                                        double max_angle_deg);
+
+// Readable text of the evidence (tables of the bands, points and bins).
+std::string EvidenceText(const Evidence& evidence);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_EVIDENCE_EVIDENCE_H_

@@ -1,0 +1,531 @@
+#include "evidence/verdict.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "util/failure.h"
+
+namespace puzzlecal {
+namespace {
+
+std::string Printf(const char* format, double a, double b = 0, double c = 0,
+                   double d = 0, double e = 0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), format, a, b, c, d, e);
+  return buffer;
+}
+
+struct Finding {
+  VerdictKind kind;
+  std::string text;
+};
+
+// True when the bin's mean (radial or tangential) is systematic.
+bool Systematic(const ResidualBin& bin, int min_count,
+                const VerdictOptions& options, double* worst_px) {
+  if (bin.count < min_count) return false;
+  bool found = false;
+  *worst_px = 0;
+  for (const auto& [mean, se] :
+       {std::pair<double, double>(bin.mean_radial_px, bin.se_radial_px),
+        std::pair<double, double>(bin.mean_tangential_px,
+                                  bin.se_tangential_px)}) {
+    if (std::abs(mean) > options.residual_se_factor * se &&
+        std::abs(mean) > options.residual_floor_px) {
+      found = true;
+      *worst_px = std::max(*worst_px, std::abs(mean));
+    }
+  }
+  return found;
+}
+
+std::string BinText(const ResidualBin& bin, const char* unit, bool metres) {
+  const bool radial =
+      std::abs(bin.mean_radial_px) / std::max(1e-12, bin.se_radial_px) >=
+      std::abs(bin.mean_tangential_px) / std::max(1e-12, bin.se_tangential_px);
+  const double mean = radial ? bin.mean_radial_px : bin.mean_tangential_px;
+  const double se = radial ? bin.se_radial_px : bin.se_tangential_px;
+  return std::string(radial ? "radial" : "tangential") + " residual mean " +
+         Printf("%+.3f +- %.3f px", mean, se) + " at " +
+         (metres ? Printf("%.2f-%.2f ", bin.lo, bin.hi)
+                 : Printf("%.0f-%.0f ", bin.lo, bin.hi)) +
+         unit + Printf(" (n=%.0f)", bin.count);
+}
+
+// The factor by which the halves differ more than predicted in every judged
+// band (VerdictOptions::halves_min_bands): the smallest band ratio, at least
+// 1; 1 with fewer judged bands.
+double HalvesScale(const CrossValidation& cv, int min_count,
+                   const VerdictOptions& options) {
+  if (!cv.ok || options.halves_min_bands == 0) return 1.0;
+  int bands = 0;
+  double smallest = 0;
+  for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
+    const AngleBand& d = cv.difference_bands[b];
+    const AngleBand& e = cv.expected_bands[b];
+    if (d.count < min_count || !(e.median > 0)) continue;
+    const double ratio = d.median / e.median;
+    smallest = bands == 0 ? ratio : std::min(smallest, ratio);
+    ++bands;
+  }
+  if (bands < options.halves_min_bands) return 1.0;
+  return std::max(1.0, smallest);
+}
+
+// ---- the findings of MakeVerdict, one function per kind of evidence ----
+
+// Model error: a field-angle band where the halves differ far beyond their
+// (scaled) predicted difference.
+void AddHalvesFindings(const CrossValidation& cv, double halves_scale,
+                       int min_count, const VerdictOptions& options,
+                       std::vector<Finding>* findings) {
+  if (!cv.ok) return;
+  double worst_ratio = 0;
+  std::string halves_text;
+  for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
+    const AngleBand& d = cv.difference_bands[b];
+    const AngleBand& e = cv.expected_bands[b];
+    if (d.count < min_count || !(e.median > 0)) continue;
+    const double ratio = d.median / (halves_scale * e.median);
+    if (ratio > options.halves_factor && d.median > options.halves_floor_px &&
+        ratio > worst_ratio) {
+      worst_ratio = ratio;
+      halves_text = Printf(
+          "the two halves of the views differ by %.3f px (median) at "
+          "%.0f-%.0f deg, %.1f times what their uncertainty predicts "
+          "(%.3f px)",
+          d.median, d.lo_deg, d.hi_deg, ratio, halves_scale * e.median);
+      if (halves_scale > 1) {
+        halves_text += Printf(
+            ", the prediction scaled by %.2f, the best-agreeing band's "
+            "excess",
+            halves_scale);
+      }
+    }
+  }
+  if (halves_text.empty()) return;
+  if (cv.intrinsics_dof > 0) {
+    const double z = ChiSquareZ(
+        cv.intrinsics_chi2 / (halves_scale * halves_scale), cv.intrinsics_dof);
+    if (options.halves_min_z > 0 && z <= options.halves_min_z) return;
+    halves_text += Printf(
+        "; their intrinsics differ with chi-square %.1f for %.0f parameters "
+        "(z = %.1f)",
+        cv.intrinsics_chi2 / (halves_scale * halves_scale), cv.intrinsics_dof,
+        z);
+  }
+  findings->push_back({VerdictKind::kModelError, halves_text});
+}
+
+// Model error: binned residual means far from zero (by field angle, by
+// board distance) and errors that grow as the board comes closer. Returns
+// whether the errors depend on closeness (for the model to suggest).
+bool AddSystematicResidualFindings(const SystematicResiduals& residuals,
+                                   int min_count, const VerdictOptions& options,
+                                   std::vector<Finding>* findings) {
+  double worst_angle = 0, worst_distance = 0;
+  const ResidualBin* angle_bin = nullptr;
+  const ResidualBin* distance_bin = nullptr;
+  for (const ResidualBin& bin : residuals.by_angle) {
+    double worst;
+    if (Systematic(bin, min_count, options, &worst) && worst > worst_angle) {
+      worst_angle = worst;
+      angle_bin = &bin;
+    }
+  }
+  const size_t nd = residuals.by_distance.size();
+  for (size_t b = 0; b < nd; ++b) {
+    const ResidualBin& bin = residuals.by_distance[b];
+    double worst;
+    if (Systematic(bin, min_count, options, &worst) && worst > worst_distance) {
+      worst_distance = worst;
+      distance_bin = &bin;
+    }
+  }
+  // Errors that grow as the board comes closer: the nearest bin's residual
+  // RMS well above the farthest's.
+  double near_rms = 0, far_rms = 0;
+  const ResidualBin* nearest = nullptr;
+  for (const ResidualBin& bin : residuals.by_distance) {
+    if (bin.count < min_count) continue;
+    if (nearest == nullptr) {
+      nearest = &bin;
+      near_rms = bin.rms_px;
+    }
+    far_rms = bin.rms_px;
+  }
+  double nearest_worst = 0;
+  const bool nearest_systematic =
+      nd >= 2 && nearest != nullptr &&
+      Systematic(*nearest, min_count, options, &nearest_worst);
+  const bool rms_grows = nd >= 2 && far_rms > 0 &&
+                         near_rms > options.closeness_rms_ratio * far_rms;
+  if (angle_bin != nullptr) {
+    findings->push_back({VerdictKind::kModelError,
+                         "systematic " + BinText(*angle_bin, "deg", false)});
+  }
+  if (distance_bin != nullptr &&
+      !(nearest_systematic && distance_bin == nearest)) {
+    findings->push_back({VerdictKind::kModelError,
+                         "systematic " + BinText(*distance_bin, "m", true)});
+  }
+  const bool other_model_error = !findings->empty();
+  if (nearest_systematic) {
+    findings->push_back(
+        {VerdictKind::kModelError,
+         "the corners closest to the camera carry a systematic error: " +
+             BinText(*nearest, "m", true)});
+  } else if (rms_grows &&
+             (other_model_error || near_rms > options.closeness_floor_px)) {
+    findings->push_back(
+        {VerdictKind::kModelError,
+         Printf("the residuals grow as the board comes closer (RMS %.3f px "
+                "for the nearest corners, %.3f px for the farthest)",
+                near_rms, far_rms)});
+  }
+  return nearest_systematic || rms_grows;
+}
+
+// Bad detections: too many outliers, or a few views far worse than the
+// median view (RMS over all of a view's corners, outliers included; a view
+// the rejection emptied counts too). Returns the number of such views.
+int AddBadDetectionFindings(const CalibrationResult& result,
+                            const VerdictOptions& options,
+                            std::vector<Finding>* findings) {
+  const int all_corners = result.num_corners_used + result.num_outliers;
+  const double outlier_fraction =
+      all_corners > 0 ? static_cast<double>(result.num_outliers) / all_corners
+                      : 0.0;
+  if (outlier_fraction > options.max_outlier_fraction) {
+    findings->push_back(
+        {VerdictKind::kBadDetections,
+         Printf("%.1f %% of the corners were rejected as outliers (limit "
+                "%.1f %%)",
+                100 * outlier_fraction, 100 * options.max_outlier_fraction)});
+  }
+  std::vector<double> all_rms(result.view_used.size(), 0.0);
+  std::vector<double> view_rms;
+  for (size_t v = 0; v < result.view_used.size(); ++v) {
+    if (!result.view_used[v] || v >= result.residuals.size()) continue;
+    double sum2 = 0;
+    for (const Eigen::Vector2d& r : result.residuals[v])
+      sum2 += r.squaredNorm();
+    const size_t n = result.residuals[v].size();
+    all_rms[v] = n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
+    view_rms.push_back(all_rms[v]);
+  }
+  if (view_rms.empty()) return 0;
+  std::vector<double> sorted = view_rms;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
+                   sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  const double limit =
+      std::max(options.view_rms_factor * median, options.view_rms_floor_px);
+  std::string bad_views;
+  int num_bad_views = 0;
+  for (size_t v = 0; v < result.view_used.size(); ++v) {
+    // A view the outlier rejection emptied (Calibrate's reason says so)
+    // is as bad as one can be.
+    if (!result.view_used[v] && v < result.view_reason.size() &&
+        result.view_reason[v].find("outlier") != std::string::npos) {
+      ++num_bad_views;
+      if (num_bad_views <= 5) {
+        bad_views += (bad_views.empty() ? "" : ", ") + std::string("view ") +
+                     std::to_string(v) + " (dropped: " + result.view_reason[v] +
+                     ")";
+      }
+      continue;
+    }
+    if (!result.view_used[v] || v >= result.residuals.size()) continue;
+    if (all_rms[v] > limit) {
+      ++num_bad_views;
+      if (num_bad_views <= 5) {
+        bad_views += (bad_views.empty() ? "" : ", ") + std::string("view ") +
+                     std::to_string(v) + Printf(" (%.2f px)", all_rms[v]);
+      }
+    }
+  }
+  if (num_bad_views > 0 &&
+      num_bad_views <= options.max_bad_view_fraction * view_rms.size()) {
+    findings->push_back(
+        {VerdictKind::kBadDetections,
+         Printf("%.0f view(s) dropped or with an RMS over all corners "
+                "above %.2f px (%.0f x the median view's %.3f px): ",
+                num_bad_views, limit, options.view_rms_factor, median) +
+             bad_views});
+  }
+  return num_bad_views;
+}
+
+// Insufficient data: few views, little coverage, no covariance, a large
+// projection uncertainty, an undetermined parameter, halves that cannot be
+// calibrated.
+void AddInsufficientDataFindings(const CalibrationResult& result,
+                                 const Evidence& evidence,
+                                 const EvidenceOptions& evidence_options,
+                                 const VerdictOptions& options,
+                                 std::vector<Finding>* findings) {
+  const Camera& camera = result.camera;
+  if (result.num_views_used < options.min_views) {
+    findings->push_back({VerdictKind::kInsufficientData,
+                         Printf("only %.0f views used (want %.0f or more)",
+                                result.num_views_used, options.min_views)});
+  }
+  if (result.coverage < options.min_coverage) {
+    findings->push_back(
+        {VerdictKind::kInsufficientData,
+         Printf("the corners cover %.0f %% of the image (want %.0f %%)",
+                100 * result.coverage, 100 * options.min_coverage)});
+  }
+  if (!result.covariance_ok) {
+    findings->push_back({VerdictKind::kInsufficientData,
+                         "no parameter covariance: the views do not determine "
+                         "every parameter"});
+  }
+  if (evidence.uncertainty.ok) {
+    double worst = 0, at = 0;
+    for (const AngleBand& band : evidence.uncertainty.bands) {
+      if (band.count > 0 && band.median > worst) {
+        worst = band.median;
+        at = band.lo_deg;
+      }
+    }
+    if (worst > options.max_uncertainty_px) {
+      findings->push_back(
+          {VerdictKind::kInsufficientData,
+           Printf("the projection uncertainty reaches %.3f px (median at "
+                  "%.0f-%.0f deg; limit %.2f px)",
+                  worst, at, at + evidence_options.band_width_deg,
+                  options.max_uncertainty_px)});
+    }
+  }
+  if (result.covariance_ok) {
+    const std::vector<std::string> names = CameraModelParamNames(camera.model);
+    for (size_t k = 0; k < names.size() && k < result.param_stddev.size() &&
+                       k < camera.params.size();
+         ++k) {
+      if (k < result.param_fixed.size() && result.param_fixed[k]) continue;
+      const double sigma = result.param_stddev[k];
+      const bool distortion = static_cast<int>(k) >= kDistortionBegin;
+      if (distortion && !options.check_distortion_determined) continue;
+      if (sigma > std::abs(camera.params[k]) &&
+          (!distortion || sigma > options.min_undetermined_distortion_stddev)) {
+        findings->push_back(
+            {VerdictKind::kInsufficientData,
+             names[k] + Printf(" is undetermined (%.4g +- %.3g)",
+                               camera.params[k], sigma)});
+      }
+    }
+  }
+  const CrossValidation& cv = evidence.cross_validation;
+  if (!cv.ok && cv.error != "not run") {
+    findings->push_back(
+        {VerdictKind::kInsufficientData,
+         "the halves of the views cannot be calibrated alone: " + cv.error});
+  }
+}
+
+// The verdict's kind and reason: the findings of the highest-ranked kind
+// (model-error, bad-detections, insufficient-data); good when none.
+void RankFindings(const std::vector<Finding>& findings, Verdict* verdict) {
+  for (const Finding& f : findings) verdict->findings.push_back(f.text);
+  for (VerdictKind kind :
+       {VerdictKind::kModelError, VerdictKind::kBadDetections,
+        VerdictKind::kInsufficientData}) {
+    std::string reason;
+    for (const Finding& f : findings) {
+      if (f.kind != kind) continue;
+      reason += (reason.empty() ? "" : "; ") + f.text;
+    }
+    if (reason.empty()) continue;
+    verdict->kind = kind;
+    verdict->reason = reason;
+    return;
+  }
+}
+
+// Model error: the next step names the model to try.
+void SuggestModel(CameraModelId model, bool grows_with_closeness,
+                  double max_angle_deg, const VerdictOptions& options,
+                  Verdict* verdict) {
+  verdict->suggested_model =
+      NextModel(model, grows_with_closeness, max_angle_deg, options);
+  if (verdict->suggested_model.empty()) {
+    verdict->next_step =
+        "no richer model is available; check the board's flatness and "
+        "its definition (tile size)";
+    return;
+  }
+  verdict->next_step = "calibrate with --model " + verdict->suggested_model;
+  if (verdict->suggested_model == "kannala-brandt-noncentral") {
+    verdict->next_step +=
+        grows_with_closeness
+            ? " (a central model cannot follow a lens whose errors "
+              "change as the board comes closer)"
+            : " (the central model leaves structured residuals)";
+  } else if (CameraModelIsPinhole(model) &&
+             verdict->suggested_model == "kannala-brandt") {
+    verdict->next_step +=
+        Printf(" (corners reach %.0f deg off the axis: a fisheye lens)",
+               max_angle_deg);
+  }
+}
+
+// Good: the reason gives the figures that back it.
+std::string GoodReason(const CalibrationResult& result,
+                       const CrossValidation& cv, double halves_scale,
+                       int min_count) {
+  double worst_diff = 0, worst_expected = 0;
+  for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
+    if (cv.difference_bands[b].count < min_count) continue;
+    if (cv.difference_bands[b].median > worst_diff) {
+      worst_diff = cv.difference_bands[b].median;
+      worst_expected = cv.expected_bands[b].median;
+    }
+  }
+  std::string reason = Printf("RMS %.3f px", result.rms_px);
+  if (cv.ok) {
+    reason += Printf(
+        "; the halves agree (largest band median %.3f px, noise predicts "
+        "%.3f px",
+        worst_diff, worst_expected);
+    if (halves_scale > 1) {
+      reason += Printf(
+          "; they differ %.2f times more than it in every band: corner "
+          "errors shared within views, the stated uncertainty is "
+          "optimistic by about that factor",
+          halves_scale);
+    }
+    reason += ")";
+  }
+  return reason + "; no systematic residuals";
+}
+
+}  // namespace
+
+const char* VerdictKindName(VerdictKind kind) {
+  switch (kind) {
+    case VerdictKind::kGood:
+      return "good";
+    case VerdictKind::kModelError:
+      return "model-error";
+    case VerdictKind::kInsufficientData:
+      return "insufficient-data";
+    case VerdictKind::kBadDetections:
+      return "bad-detections";
+  }
+  return "good";
+}
+
+bool VerdictOptions::Check(std::string* why) const {
+  if (!(halves_factor > 0)) return Fail("halves_factor must be > 0", why);
+  if (!(halves_floor_px >= 0)) return Fail("halves_floor_px must be >= 0", why);
+  if (halves_min_bands < 0) return Fail("halves_min_bands must be >= 0", why);
+  if (!std::isfinite(halves_min_z)) {
+    return Fail("halves_min_z must be finite", why);
+  }
+  if (!(residual_se_factor > 0)) {
+    return Fail("residual_se_factor must be > 0", why);
+  }
+  if (!(residual_floor_px >= 0)) {
+    return Fail("residual_floor_px must be >= 0", why);
+  }
+  if (!(pinhole_max_field_deg > 0 && pinhole_max_field_deg < 90)) {
+    return Fail("pinhole_max_field_deg must be in (0, 90)", why);
+  }
+  if (!(max_outlier_fraction >= 0 && max_outlier_fraction <= 1)) {
+    return Fail("max_outlier_fraction must be in [0, 1]", why);
+  }
+  if (!(view_rms_factor > 1)) return Fail("view_rms_factor must be > 1", why);
+  if (!(view_rms_floor_px >= 0)) {
+    return Fail("view_rms_floor_px must be >= 0", why);
+  }
+  if (!(max_bad_view_fraction >= 0 && max_bad_view_fraction <= 1)) {
+    return Fail("max_bad_view_fraction must be in [0, 1]", why);
+  }
+  if (min_views < 1) return Fail("min_views must be >= 1", why);
+  if (!(min_coverage >= 0 && min_coverage <= 1)) {
+    return Fail("min_coverage must be in [0, 1]", why);
+  }
+  if (!(max_uncertainty_px > 0)) {
+    return Fail("max_uncertainty_px must be > 0", why);
+  }
+  if (!(min_undetermined_distortion_stddev >= 0)) {
+    return Fail("min_undetermined_distortion_stddev must be >= 0", why);
+  }
+  return true;
+}
+
+std::string Verdict::Line() const {
+  return std::string("verdict: ") + VerdictKindName(kind) + " \u2014 " +
+         reason + " \u2014 " + next_step;
+}
+
+std::string NextModel(CameraModelId model, bool grows_with_closeness,
+                      double max_field_deg, const VerdictOptions& options) {
+  (void)grows_with_closeness;
+  const std::string name = CameraModelName(model);
+  if (CameraModelIsPinhole(model)) {
+    if (max_field_deg > options.pinhole_max_field_deg) return "kannala-brandt";
+    if (model == CameraModelId::kPinholeRadtan) return "pinhole-rational";
+    return "kannala-brandt";
+  }
+  // The central fisheye model: what it cannot follow is a lens whose
+  // entrance pupil moves with the field angle, which shows most for close
+  // corners; the non-central variant models it. (It is also the only richer
+  // fisheye model there is for structured residuals at the rim.)
+  if (name == "kannala-brandt") return "kannala-brandt-noncentral";
+  return "";
+}
+
+Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
+                    const EvidenceOptions& evidence_options,
+                    const VerdictOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) {
+    Verdict invalid;
+    invalid.kind = VerdictKind::kInsufficientData;
+    invalid.reason = "verdict options: " + why;
+    invalid.next_step = "fix the options";
+    return invalid;
+  }
+  const int min_count = evidence_options.min_bin_count;
+  const CrossValidation& cv = evidence.cross_validation;
+  const double halves_scale = HalvesScale(cv, min_count, options);
+  std::vector<Finding> findings;
+  AddHalvesFindings(cv, halves_scale, min_count, options, &findings);
+  const bool grows_with_closeness = AddSystematicResidualFindings(
+      evidence.residuals, min_count, options, &findings);
+  const int num_bad_views = AddBadDetectionFindings(result, options, &findings);
+  AddInsufficientDataFindings(result, evidence, evidence_options, options,
+                              &findings);
+
+  Verdict verdict;
+  RankFindings(findings, &verdict);
+  switch (verdict.kind) {
+    case VerdictKind::kModelError:
+      SuggestModel(result.camera.model, grows_with_closeness,
+                   evidence.residuals.max_angle_deg, options, &verdict);
+      break;
+    case VerdictKind::kBadDetections:
+      verdict.next_step = num_bad_views > 0
+                              ? "look at the worst views in the report and "
+                                "remove or retake them"
+                              : "look at the outliers in the report (blur, "
+                                "glare, a bent board) and retake those views";
+      break;
+    case VerdictKind::kInsufficientData:
+      verdict.next_step =
+          "add views: the board near the image borders and corners, tilted "
+          "by 30 degrees or more, at several distances";
+      break;
+    case VerdictKind::kGood:
+      verdict.reason = GoodReason(result, cv, halves_scale, min_count);
+      verdict.next_step = "none: the camera file is ready to use";
+      break;
+  }
+  return verdict;
+}
+
+}  // namespace puzzlecal

@@ -1,0 +1,148 @@
+#ifndef PUZZLECAL_EVIDENCE_VERDICT_H_
+#define PUZZLECAL_EVIDENCE_VERDICT_H_
+
+// One verdict on a calibration, made from its result and its evidence
+// (evidence/evidence.h): good, model-error (the model cannot follow the lens:
+// the two halves of the views disagree far beyond their uncertainty, or the
+// residuals keep a systematic part), insufficient-data (the views do not
+// determine the model well enough) or bad-detections (outliers or a few
+// views far worse than the rest). Each comes with the reason and the next
+// step, e.g. the model to try.
+//
+//   verdict: model-error — <reason> — <next step>
+
+#include <string>
+#include <vector>
+
+#include "calib/calibrate.h"
+#include "evidence/evidence.h"
+
+namespace puzzlecal {
+
+enum class VerdictKind {
+  kGood,
+  kModelError,
+  kInsufficientData,
+  kBadDetections
+};
+
+// "good", "model-error", "insufficient-data", "bad-detections".
+const char* VerdictKindName(VerdictKind kind);
+
+struct VerdictOptions {
+  // --- model error ---
+  // The halves disagree when, in a field-angle band with at least
+  // EvidenceOptions::min_bin_count samples, the median difference exceeds
+  // halves_factor times the median difference the two halves' covariances
+  // predict, and halves_floor_px. Noise alone gives ratios near 1 or
+  // below (the median length of a 2-D Gaussian vector is 0.83 times its
+  // RMS, and the fitted rotation takes out a little more). Defaults 2.5 and
+  // 0.1 px.
+  double halves_factor = 2.5;
+  double halves_floor_px = 0.1;
+  // The covariance assumes independent corner errors; errors shared by the
+  // corners of a view (its pose, the print, blur, a slightly bent board) do
+  // not average out over a view's corners, so real halves differ by more
+  // than it predicts, by about the same factor in every band. A model error
+  // instead leaves bands where the model fits. So, with at least
+  // halves_min_bands judged bands, the prediction is first scaled by the
+  // smallest ratio (difference / prediction) of any judged band, when that
+  // exceeds 1, and the halves_factor test applies to the scaled
+  // prediction. 0 turns the scaling off. Default 3.
+  int halves_min_bands = 3;
+  // A band's excess is judged a model error only when the halves' free
+  // intrinsics as a whole also differ by more than their covariances allow:
+  // the chi-square of their difference (CrossValidation::intrinsics_chi2),
+  // divided by the square of the prediction's scale above, as a standard
+  // normal quantile (ChiSquareZ) above halves_min_z. One poorly determined
+  // parameter can lift the medians of the bands where it dominates (every
+  // pixel of a band shares the one draw of the parameters) without the
+  // parameters differing significantly. Default 3.1 (a false alarm about
+  // once in a thousand runs); 0 or less turns the test off.
+  double halves_min_z = 3.1;
+  // A residual bin (min_bin_count corners or more) is systematic when its
+  // mean radial or tangential component is more than residual_se_factor
+  // standard errors and more than residual_floor_px from zero. The standard
+  // error treats corners as independent; corners of one view share a pose
+  // error, hence the floor. Defaults 5 and 0.05 px.
+  double residual_se_factor = 5.0;
+  double residual_floor_px = 0.05;
+  // The errors depend on closeness when the nearest distance bin's residual
+  // mean is systematic (see residual_se_factor) or its residual RMS
+  // exceeds closeness_rms_ratio times that of the farthest bin. With
+  // another model-error finding this points to a non-central lens; the RMS
+  // ratio alone is a model error only when the nearest bin's RMS is also
+  // above closeness_floor_px. Defaults 1.5 and 0.3 px.
+  double closeness_rms_ratio = 1.5;
+  double closeness_floor_px = 0.3;
+  // A pinhole model whose corners reach beyond this field angle (degrees)
+  // is on a lens wider than it can follow: the next step is
+  // kannala-brandt. Default 65.
+  double pinhole_max_field_deg = 65.0;
+
+  // --- bad detections ---
+  // More rejected corners than this fraction of all corners of the used
+  // views. Default 0.05.
+  double max_outlier_fraction = 0.05;
+  // A view whose RMS over all of its corners (outliers included, so a view
+  // the rejection emptied still shows) exceeds view_rms_factor times the
+  // median of that figure (and view_rms_floor_px) stands out; at most
+  // max_bad_view_fraction of the views standing out is "a few views" (more is
+  // the model's or the data's doing as a whole). Defaults 3, 0.2 px and 0.2.
+  double view_rms_factor = 3.0;
+  double view_rms_floor_px = 0.2;
+  double max_bad_view_fraction = 0.2;
+
+  // --- insufficient data ---
+  // Fewer used views than this. Default 8.
+  int min_views = 8;
+  // Coverage (CalibrationResult::coverage) below this. Default 0.2.
+  double min_coverage = 0.2;
+  // The median of the projection uncertainty map in a field-angle band
+  // within the observed field above this (pixels, per axis). Default
+  // 0.25 px.
+  double max_uncertainty_px = 0.25;
+  // A free focal length or principal point coordinate whose standard
+  // deviation exceeds its magnitude is undetermined.
+  // check_distortion_determined applies the same test to the distortion
+  // coefficients (whose standard deviation must then also exceed
+  // min_undetermined_distortion_stddev, as they can be truly near zero).
+  // Default false: coupled coefficients (the rational model's numerator
+  // and denominator) are individually undetermined while the projection
+  // they make is well determined; the projection uncertainty judges them.
+  bool check_distortion_determined = false;
+  double min_undetermined_distortion_stddev = 0.05;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+struct Verdict {
+  VerdictKind kind = VerdictKind::kGood;
+  std::string reason;     // what the evidence shows, with figures
+  std::string next_step;  // what to do
+  // Every finding, in the order checked (the verdict names the first one of
+  // the highest-ranked kind: model-error, bad-detections,
+  // insufficient-data).
+  std::vector<std::string> findings;
+  // A model name the next step suggests ("" if none).
+  std::string suggested_model;
+
+  // "verdict: <kind> — <reason> — <next step>"
+  std::string Line() const;
+};
+
+// The verdict for a successful calibration (`result`) and its evidence.
+// Invalid options give insufficient-data with the options' fault as reason.
+Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
+                    const EvidenceOptions& evidence_options,
+                    const VerdictOptions& options);
+
+// The model to try after `model` shows a model error. `grows_with_closeness`:
+// the residuals depend on the board distance; `max_field_deg`: the widest
+// observed field angle.
+std::string NextModel(CameraModelId model, bool grows_with_closeness,
+                      double max_field_deg, const VerdictOptions& options);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_EVIDENCE_VERDICT_H_

@@ -1,0 +1,84 @@
+#ifndef PUZZLECAL_FORMATS_RIG_YAML_H_
+#define PUZZLECAL_FORMATS_RIG_YAML_H_
+
+// Rig files: writing a calibrated rig in four formats, and reading the
+// puzzlecal one back.
+// - puzzlecal (default): `cameras:` a list, each with name, model, image
+//   size, named parameters and their standard deviations, `cam_from_rig`
+//   {R: 3x3 rows, t: [x, y, z]} (P_cam = R * P_rig + t, metres) with its
+//   standard deviations, and the camera's residual statistics;
+// - opencv (readable by cv::FileStorage): K/D per camera and, for two
+//   cameras, R, T (second from first), E, F and the rectification R1 R2 P1
+//   P2 Q (cv::stereoRectify; cv::fisheye::stereoRectify for two
+//   kannala-brandt cameras); for more cameras R_i, T_i of each from the
+//   first;
+// - ros: one camera_info file per camera (OUT_STEM_NAME.yaml), with the
+//   pair's rectification R and projection P for two cameras;
+// - kalibr: a camchain with T_cn_cnm1, cam_overlaps and a rostopic per
+//   camera.
+// Files are written atomically (util/atomic_file.h).
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "calib/rig_calibration.h"
+#include "camera/camera_models.h"
+#include "formats/camera_yaml.h"
+
+namespace puzzlecal {
+
+// One file of a rig output.
+struct RigFileText {
+  std::string path;
+  std::string text;
+};
+
+// The files of `result` in `format` for the output path `out_path` (one
+// file, except ros: one per camera next to it, named after the camera).
+// False with a reason when the format cannot hold the rig without loss.
+bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
+                    const std::string& out_path,
+                    std::vector<RigFileText>* files, std::string* error);
+
+// Formats, then writes every file atomically; `written` (optional) returns
+// the paths.
+bool WriteRigFiles(const std::string& out_path, CameraFileFormat format,
+                   const RigCalibrationResult& result,
+                   std::vector<std::string>* written, std::string* error);
+
+// A camera of a rig file.
+struct RigFileCamera {
+  std::string name;
+  Camera camera;
+  Eigen::Isometry3d cam_from_rig = Eigen::Isometry3d::Identity();
+};
+
+// Parses the text of a puzzlecal rig file; messages name `source` and the
+// field.
+bool ParseRigFile(const std::string& text, const std::string& source,
+                  std::vector<RigFileCamera>* cameras, std::string* error);
+bool ReadRigFile(const std::string& path, std::vector<RigFileCamera>* cameras,
+                 std::string* error);
+
+// The stereo rectification of the first two cameras of a rig, as OpenCV
+// defines it (R1, R2 rotate each camera into the common rectified frame;
+// P1, P2 project rectified points; Q maps disparity to depth). For two
+// pinhole models cv::stereoRectify, for two kannala-brandt
+// cv::fisheye::stereoRectify; for a pinhole with a fisheye the rotations
+// of cv::stereoRectify with the distortion left out (they do not depend on
+// it) and the intrinsics of the first camera's focal length.
+struct StereoRectification {
+  Eigen::Matrix3d r1, r2;
+  Eigen::Matrix<double, 3, 4> p1, p2;
+  Eigen::Matrix4d q;
+  Eigen::Matrix3d essential, fundamental;  // of the unrectified pair
+  int width = 0, height = 0;               // rectified image size
+};
+bool StereoRectify(const Camera& first, const Camera& second,
+                   const Eigen::Isometry3d& second_from_first,
+                   StereoRectification* rectification, std::string* error);
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_FORMATS_RIG_YAML_H_

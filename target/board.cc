@@ -1,0 +1,83 @@
+#include "target/board.h"
+
+#include <cmath>
+
+#include "target/puzzleboard_codes.h"
+#include "util/enum_names.h"
+
+namespace puzzlecal {
+
+constexpr EnumName<BoardType> kBoardTypeNames[] = {
+    {BoardType::kPuzzleBoard, "puzzleboard"},
+    {BoardType::kCheckerboard, "checkerboard"},
+};
+
+const char* BoardTypeName(BoardType type) {
+  return NameOf(kBoardTypeNames, type, "unknown");
+}
+
+bool BoardTypeFromName(const std::string& name, BoardType* type) {
+  return ValueOf(kBoardTypeNames, name, type);
+}
+
+bool Board::Check(std::string* why) const {
+  auto fail = [why](const std::string& message) {
+    if (why != nullptr) *why = message;
+    return false;
+  };
+  if (cols < 2 || rows < 2) {
+    return fail("cols and rows must both be >= 2 (inner corners)");
+  }
+  if (cols > kMaxBoardSide || rows > kMaxBoardSide) {
+    return fail("cols and rows must be <= " + std::to_string(kMaxBoardSide) +
+                " (inner corners; a typo?)");
+  }
+  if (!(std::isfinite(tile_size_m) && tile_size_m > 0.0)) {
+    return fail("tile_size_m must be a positive number of metres");
+  }
+  if (type == BoardType::kPuzzleBoard) {
+    if (cols > kPuzzleBoardPeriod || rows > kPuzzleBoardPeriod) {
+      return fail("cols and rows must be <= 501 for a PuzzleBoard");
+    }
+    if (origin.x() < 0 || origin.y() < 0 || origin.x() >= kPuzzleBoardPeriod ||
+        origin.y() >= kPuzzleBoardPeriod) {
+      return fail("origin must lie in [0, 501) x [0, 501)");
+    }
+  } else if (origin != Eigen::Vector2i::Zero()) {
+    return fail("origin must be [0, 0] for a checkerboard");
+  }
+  return true;
+}
+
+bool Board::Contains(const Eigen::Vector2i& id) const {
+  return id.x() >= origin.x() && id.x() < origin.x() + cols &&
+         id.y() >= origin.y() && id.y() < origin.y() + rows;
+}
+
+Eigen::Vector3d Board::Point(const Eigen::Vector2i& id) const {
+  return Eigen::Vector3d(id.x() * tile_size_m, id.y() * tile_size_m, 0.0);
+}
+
+std::vector<Eigen::Vector2i> Board::AllIds() const {
+  std::vector<Eigen::Vector2i> ids;
+  ids.reserve(NumCorners());
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < cols; ++col) {
+      ids.emplace_back(origin.x() + col, origin.y() + row);
+    }
+  }
+  return ids;
+}
+
+Board MakeBoard(BoardType type, int cols, int rows,
+                const Eigen::Vector2i& origin, double tile_size_m) {
+  Board board;
+  board.type = type;
+  board.cols = cols;
+  board.rows = rows;
+  board.origin = origin;
+  board.tile_size_m = tile_size_m;
+  return board;
+}
+
+}  // namespace puzzlecal
