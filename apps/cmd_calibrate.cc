@@ -196,14 +196,14 @@ std::string BoardMismatchMessage(const std::vector<ImageResult>& images,
     ++readable;
     const bool many = static_cast<int>(image.corners.size()) >= kManyCorners;
     mismatched += many && (image.outcome == ImageOutcome::kNotDecoded ||
-                           (board.type == BoardType::kCheckerboard &&
+                           (!board.Traits().absolute_ids &&
                             image.outcome == ImageOutcome::kTooFewCorners));
   }
   if (mismatched == 0 || 2 * mismatched < readable) return "";
   std::ostringstream out;
   out << mismatched << " of " << readable
       << " images show many corners but none matches ";
-  if (board.type == BoardType::kPuzzleBoard) {
+  if (board.Traits().absolute_ids) {
     out << "the code of " << board_file
         << " at any position: check cols, rows and origin (" << board.cols
         << " x " << board.rows << " from [" << board.origin.x() << ", "

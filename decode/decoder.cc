@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "decode/position_search.h"
+#include "util/failure.h"
 #include "util/string_format.h"
 
 namespace puzzlecal {
@@ -271,24 +272,20 @@ bool DecodeComponentBits(const LabelLattice& lattice,
 }
 
 bool DecodeOptions::Check(std::string* why) const {
-  auto fail = [why](const char* message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
   if (!bits.Check(why)) return false;
-  if (min_corners < 1) return fail("min_corners must be >= 1");
-  if (max_label_extent < 2) return fail("max_label_extent must be >= 2");
+  if (min_corners < 1) return Fail("min_corners must be >= 1", why);
+  if (max_label_extent < 2) return Fail("max_label_extent must be >= 2", why);
   if (!(max_lattice_deviation > 0.0))
-    return fail("max_lattice_deviation must be > 0");
-  if (min_bits_read < 1) return fail("min_bits_read must be >= 1");
+    return Fail("max_lattice_deviation must be > 0", why);
+  if (min_bits_read < 1) return Fail("min_bits_read must be >= 1", why);
   if (!(min_agreement >= 0.5 && min_agreement <= 1.0)) {
-    return fail("min_agreement must be in [0.5, 1]");
+    return Fail("min_agreement must be in [0.5, 1]", why);
   }
-  if (min_margin < 1) return fail("min_margin must be >= 1");
-  if (!(min_log10_odds >= 0.0)) return fail("min_log10_odds must be >= 0");
-  if (!(max_log10_nfa <= 0.0)) return fail("max_log10_nfa must be <= 0");
+  if (min_margin < 1) return Fail("min_margin must be >= 1", why);
+  if (!(min_log10_odds >= 0.0)) return Fail("min_log10_odds must be >= 0", why);
+  if (!(max_log10_nfa <= 0.0)) return Fail("max_log10_nfa must be <= 0", why);
   if (drop_corner_min_disagreeing_edges < 1) {
-    return fail("drop_corner_min_disagreeing_edges must be >= 1");
+    return Fail("drop_corner_min_disagreeing_edges must be >= 1", why);
   }
   return true;
 }
@@ -508,7 +505,7 @@ DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
     result.components[c].component = static_cast<int>(c);
   }
   if (!CheckDecodeInputs(board, options, components, &result)) return result;
-  const bool puzzle = board.type == BoardType::kPuzzleBoard;
+  const bool puzzle = board.Traits().absolute_ids;
   const cv::Mat grey =
       puzzle ? GreyForEdgeBits(image, &result.reason) : cv::Mat();
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "util/failure.h"
+
 namespace puzzlecal {
 namespace {
 
@@ -205,21 +207,17 @@ int LabelHandedness(const LabelLattice& lattice) {
 }
 
 bool EdgeBitOptions::Check(std::string* why) const {
-  auto fail = [why](const char* message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
   if (!(min_confidence > 0.0 && min_confidence <= 1.0)) {
-    return fail("bits.min_confidence must be in (0, 1]");
+    return Fail("bits.min_confidence must be in (0, 1]", why);
   }
   if (!(min_tile_contrast >= 0.0 && min_tile_contrast < 1.0)) {
-    return fail("bits.min_tile_contrast must be in [0, 1)");
+    return Fail("bits.min_tile_contrast must be in [0, 1)", why);
   }
   if (!(disc_sample_offset >= 0.0 && disc_sample_offset <= 1.0 / 6.0)) {
-    return fail("bits.disc_sample_offset must be in [0, 1/6]");
+    return Fail("bits.disc_sample_offset must be in [0, 1/6]", why);
   }
   if (!(tile_sample_offset >= 0.0 && tile_sample_offset <= 0.3)) {
-    return fail("bits.tile_sample_offset must be in [0, 0.3]");
+    return Fail("bits.tile_sample_offset must be in [0, 0.3]", why);
   }
   return true;
 }

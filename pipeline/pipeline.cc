@@ -136,7 +136,7 @@ void ProcessGreyImage(const cv::Mat& grey, const Board& board,
   result->decode = DecodeBoard(board, result->corners, result->components, grey,
                                options.decode);
   result->seconds_grid_decode = timer.Seconds();
-  if (board.type == BoardType::kPuzzleBoard && !result->decode.decoded) {
+  if (board.Traits().absolute_ids && !result->decode.decoded) {
     result->outcome = ImageOutcome::kNotDecoded;
     result->reason = result->decode.reason;
     return;

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <vector>
 
+#include "util/failure.h"
+
 namespace puzzlecal {
 namespace {
 
@@ -124,19 +126,15 @@ void FitAxis(double lo, double hi, int size, double* f, double* c) {
 }  // namespace
 
 bool UndistortOptions::Check(std::string* why) const {
-  auto fail = [&](const char* message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
-  if (!(alpha >= 0 && alpha <= 1)) return fail("alpha must be in [0, 1]");
+  if (!(alpha >= 0 && alpha <= 1)) return Fail("alpha must be in [0, 1]", why);
   if (!(max_angle_deg > 0 && max_angle_deg <= 89)) {
-    return fail("max_angle_deg must be in (0, 89]");
+    return Fail("max_angle_deg must be in (0, 89]", why);
   }
   if (!(min_area_ratio > 0 && min_area_ratio < 1)) {
-    return fail("min_area_ratio must be in (0, 1)");
+    return Fail("min_area_ratio must be in (0, 1)", why);
   }
-  if (border_samples < 4) return fail("border_samples must be >= 4");
-  if (!(tolerance_px > 0)) return fail("tolerance_px must be positive");
+  if (border_samples < 4) return Fail("border_samples must be >= 4", why);
+  if (!(tolerance_px > 0)) return Fail("tolerance_px must be positive", why);
   return true;
 }
 

@@ -52,7 +52,7 @@ double RectCoverage(double u, double v, const PatternExtent& rect,
 }  // namespace
 
 PatternExtent PrintedPatternExtent(const Board& board) {
-  const double border = board.type == BoardType::kPuzzleBoard ? 0.5 : 1.0;
+  const double border = board.Traits().border_tiles;
   PatternExtent extent;
   extent.min_x = board.origin.x() - border;
   extent.min_y = board.origin.y() - border;
@@ -94,7 +94,7 @@ int BoardPattern::HorizontalEdgeBit(int x, int y) const {
 
 bool BoardPattern::TileIsBlack(int x, int y) const {
   // Checkerboard tiles beyond the printed border tiles are paper.
-  if (board_.type == BoardType::kCheckerboard &&
+  if (board_.Traits().pattern_ends_at_border &&
       (x < extent_.min_x || x + 1 > extent_.max_x || y < extent_.min_y ||
        y + 1 > extent_.max_y)) {
     return false;
@@ -147,7 +147,7 @@ double BoardPattern::PatternBlack(double u, double v,
                  a * (1 - b) * TileIsBlack(iu, iv - 1) +
                  (1 - a) * b * TileIsBlack(iu - 1, iv) +
                  a * b * TileIsBlack(iu, iv);
-  if (board_.type != BoardType::kPuzzleBoard) return black;
+  if (!board_.Traits().absolute_ids) return black;  // no edge bits
   const int x0 = board_.origin.x(), y0 = board_.origin.y();
   const int x1 = x0 + board_.cols, y1 = y0 + board_.rows;
   auto add_disc = [&](double cu, double cv, int bit) {
@@ -203,7 +203,7 @@ BoardPattern::BoxContent BoardPattern::Classify(double min_u, double min_v,
   const double lines_u = std::floor(max_u) - std::floor(min_u);
   const double lines_v = std::floor(max_v) - std::floor(min_v);
   if (lines_u + lines_v > 1) return BoxContent::kComplex;
-  if (board_.type == BoardType::kPuzzleBoard) {
+  if (board_.Traits().absolute_ids) {
     // Disc centres near the box, printed or not (to stay simple).
     const int u0 = static_cast<int>(std::floor(min_u)) - 1;
     const int u1 = static_cast<int>(std::floor(max_u)) + 1;
@@ -249,7 +249,7 @@ BoardInk BoardPattern::SampleUnmirrored(double u, double v) const {
   }
   const int tile_x = static_cast<int>(std::floor(u));
   const int tile_y = static_cast<int>(std::floor(v));
-  if (board_.type == BoardType::kPuzzleBoard) {
+  if (board_.Traits().absolute_ids) {
     const int x0 = board_.origin.x(), y0 = board_.origin.y();
     const int x1 = x0 + board_.cols, y1 = y0 + board_.rows;
     constexpr double kR2 = kDiscRadius * kDiscRadius;

@@ -4,31 +4,31 @@
 #include <limits>
 #include <opencv2/core.hpp>
 
+#include "util/failure.h"
+
 namespace puzzlecal {
 
 bool CheckRenderCamera(const Camera& camera, std::string* why) {
-  auto fail = [why](const std::string& message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
   const int expected = CameraModelNumParams(camera.model);
   if (static_cast<int>(camera.params.size()) != expected) {
-    return fail(std::string("camera model ") + CameraModelName(camera.model) +
-                " needs " + std::to_string(expected) + " parameters, got " +
-                std::to_string(camera.params.size()));
+    return Fail(std::string("camera model ") + CameraModelName(camera.model) +
+                    " needs " + std::to_string(expected) + " parameters, got " +
+                    std::to_string(camera.params.size()),
+                why);
   }
   for (double p : camera.params) {
-    if (!std::isfinite(p)) return fail("camera parameters must be finite");
+    if (!std::isfinite(p)) return Fail("camera parameters must be finite", why);
   }
   if (!(camera.params[0] > 0 && camera.params[1] > 0)) {
-    return fail("camera focal lengths fx, fy must be positive");
+    return Fail("camera focal lengths fx, fy must be positive", why);
   }
   constexpr int kMaxSize = 20000;
   if (camera.width < 1 || camera.height < 1 || camera.width > kMaxSize ||
       camera.height > kMaxSize) {
-    return fail("camera image size must be in [1, 20000] x [1, 20000], got " +
-                std::to_string(camera.width) + " x " +
-                std::to_string(camera.height));
+    return Fail("camera image size must be in [1, 20000] x [1, 20000], got " +
+                    std::to_string(camera.width) + " x " +
+                    std::to_string(camera.height),
+                why);
   }
   return true;
 }

@@ -13,6 +13,7 @@
 
 #include "target/puzzleboard.h"
 #include "util/enum_names.h"
+#include "util/failure.h"
 
 namespace puzzlecal {
 namespace {
@@ -28,7 +29,7 @@ struct Disc {
 
 // Offset (in tiles) of corner (x0, y0) from the page's top-left corner.
 double CornerInsetTiles(const Board& board) {
-  return board.type == BoardType::kPuzzleBoard ? 0.5 : 1.0;
+  return board.Traits().border_tiles;
 }
 
 // Black tiles clipped to the page, and the discs.
@@ -53,7 +54,7 @@ void Layout(const Board& board, std::vector<Rect>* black_tiles,
       }
     }
   }
-  if (board.type != BoardType::kPuzzleBoard) return;
+  if (!board.Traits().absolute_ids) return;  // no edge bits to print
   const double r = s / 6.0;
   for (int y = y0; y < y0 + board.rows; ++y) {
     for (int x = x0; x < x0 + board.cols; ++x) {
@@ -282,7 +283,7 @@ std::string Label(const Board& board, const PrintOptions& options) {
   out << BoardTypeName(board.type) << ", " << board.cols << " x " << board.rows
       << " corners (cols x rows), tile " << Number(board.tile_size_m * 1000)
       << " mm";
-  if (board.type == BoardType::kPuzzleBoard) {
+  if (board.Traits().has_origin) {
     out << ", origin [" << board.origin.x() << ", " << board.origin.y() << "]";
   }
   out << "; print at 100 %";
@@ -396,9 +397,10 @@ bool PrintOptions::Check(std::string* why) const {
 void PrintedPageSizeMm(const Board& board, double* width_mm,
                        double* height_mm) {
   const double s = board.tile_size_m * 1000.0;
-  const int extra = board.type == BoardType::kPuzzleBoard ? 0 : 1;
-  *width_mm = (board.cols + extra) * s;
-  *height_mm = (board.rows + extra) * s;
+  // The outer inner corners are cols - 1 tiles apart, plus a border each side.
+  const double borders = 2 * board.Traits().border_tiles;
+  *width_mm = (board.cols - 1 + borders) * s;
+  *height_mm = (board.rows - 1 + borders) * s;
 }
 
 void PrintedCornerMm(const Board& board, int col, int row, double* x_mm,
@@ -412,15 +414,11 @@ void PrintedCornerMm(const Board& board, int col, int row, double* x_mm,
 bool RenderPrintableBoard(const Board& board, PrintFormat format,
                           const PrintOptions& options, std::string* bytes,
                           std::string* why) {
-  auto fail = [why](const std::string& message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
   std::string reason;
-  if (!board.Check(&reason)) return fail("board: " + reason);
-  if (!options.Check(&reason)) return fail("print options: " + reason);
+  if (!board.Check(&reason)) return Fail("board: " + reason, why);
+  if (!options.Check(&reason)) return Fail("print options: " + reason, why);
   PageLayout layout;
-  if (!LayOutPage(board, options, &layout, &reason)) return fail(reason);
+  if (!LayOutPage(board, options, &layout, &reason)) return Fail(reason, why);
   bytes->clear();
   if (format == PrintFormat::kSvg) {
     *bytes = Svg(board, layout);
@@ -437,8 +435,9 @@ bool RenderPrintableBoard(const Board& board, PrintFormat format,
     scale = options.dpi / 25.4;  // pixels per millimetre
     const double w = std::round(page_w * scale), h = std::round(page_h * scale);
     if (w > options.max_png_side_px || h > options.max_png_side_px) {
-      return fail("the PNG would be " + Number(w) + " x " + Number(h) +
-                  " pixels; lower the dpi");
+      return Fail("the PNG would be " + Number(w) + " x " + Number(h) +
+                      " pixels; lower the dpi",
+                  why);
     }
     surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24,
                                          static_cast<int>(std::max(w, 1.0)),
@@ -448,7 +447,7 @@ bool RenderPrintableBoard(const Board& board, PrintFormat format,
     const std::string message =
         cairo_status_to_string(cairo_surface_status(surface));
     cairo_surface_destroy(surface);
-    return fail("cairo: " + message);
+    return Fail("cairo: " + message, why);
   }
   cairo_t* cr = cairo_create(surface);
   Draw(cr, board, layout, scale);
@@ -469,7 +468,7 @@ bool RenderPrintableBoard(const Board& board, PrintFormat format,
   cairo_surface_destroy(surface);
   if (status != CAIRO_STATUS_SUCCESS) {
     bytes->clear();
-    return fail(std::string("cairo: ") + cairo_status_to_string(status));
+    return Fail(std::string("cairo: ") + cairo_status_to_string(status), why);
   }
   return true;
 }

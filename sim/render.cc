@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sim/board_pattern.h"
+#include "util/failure.h"
 
 namespace puzzlecal {
 namespace {
@@ -69,51 +70,49 @@ struct SubGrid {
 }  // namespace
 
 bool RenderOptions::Check(std::string* why) const {
-  auto fail = [why](const std::string& message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
   if (supersampling < 1 || supersampling > 16) {
-    return fail("supersampling must be in [1, 16]");
+    return Fail("supersampling must be in [1, 16]", why);
   }
   if (!IsFiniteRange(blur_sigma_px, 0.0, 50.0)) {
-    return fail("blur_sigma_px must be in [0, 50]");
+    return Fail("blur_sigma_px must be in [0, 50]", why);
   }
   if (!IsFiniteRange(black_level, 0.0, 1.0) ||
       !IsFiniteRange(white_level, 0.0, 1.0) || !(black_level < white_level)) {
-    return fail(
+    return Fail(
         "black_level and white_level must be in [0, 1] with "
-        "black_level < white_level");
+        "black_level < white_level",
+        why);
   }
   if (!IsFiniteRange(background_level, 0.0, 1.0)) {
-    return fail("background_level must be in [0, 1]");
+    return Fail("background_level must be in [0, 1]", why);
   }
   if (!IsFiniteRange(paper_margin_tiles, 0.0, 1000.0)) {
-    return fail("paper_margin_tiles must be in [0, 1000]");
+    return Fail("paper_margin_tiles must be in [0, 1000]", why);
   }
   if (!(std::isfinite(lighting_gradient) &&
         std::abs(lighting_gradient) < 2.0)) {
-    return fail("lighting_gradient must be in (-2, 2)");
+    return Fail("lighting_gradient must be in (-2, 2)", why);
   }
   if (!(std::isfinite(vignetting) && vignetting >= 0.0 && vignetting < 1.0)) {
-    return fail("vignetting must be in [0, 1)");
+    return Fail("vignetting must be in [0, 1)", why);
   }
   if (!(std::isfinite(gamma) && gamma > 0.05 && gamma < 20.0)) {
-    return fail("gamma must be in (0.05, 20)");
+    return Fail("gamma must be in (0.05, 20)", why);
   }
   if (!IsFiniteRange(noise_sigma, 0.0, 10.0)) {
-    return fail("noise_sigma must be in [0, 10]");
+    return Fail("noise_sigma must be in [0, 10]", why);
   }
   if (!IsFiniteRange(field_of_view_deg, 0.0, 360.0)) {
-    return fail("field_of_view_deg must be in [0, 360]");
+    return Fail("field_of_view_deg must be in [0, 360]", why);
   }
   for (size_t i = 0; i < occluders.size(); ++i) {
     const Occluder& o = occluders[i];
     if (!o.center_px.allFinite() || !IsFiniteRange(o.radius_px, 0.0, 1e6) ||
         !IsFiniteRange(o.grey, 0.0, 1.0)) {
-      return fail("occluder " + std::to_string(i) +
-                  ": center_px must be finite, radius_px >= 0, grey in "
-                  "[0, 1]");
+      return Fail("occluder " + std::to_string(i) +
+                      ": center_px must be finite, radius_px >= 0, grey in "
+                      "[0, 1]",
+                  why);
     }
   }
   return true;

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <random>
 
+#include "util/failure.h"
+
 namespace puzzlecal {
 
 double UniformDraw(std::mt19937_64* rng, double lo, double hi) {
@@ -106,10 +108,6 @@ Eigen::Isometry3d PoseFromView(const Board& board, const ViewPose& view) {
 }
 
 bool SceneSpec::Check(std::string* why) const {
-  auto fail = [why](const std::string& message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
   // Names become file names (scene_view.png): plain names only.
   auto plain_name = [](const std::string& text) {
     return !text.empty() && text.front() != '.' &&
@@ -117,83 +115,93 @@ bool SceneSpec::Check(std::string* why) const {
            text.find('\0') == std::string::npos;
   };
   if (!plain_name(name)) {
-    return fail("name: '" + name +
-                "' must be non-empty, without / or \\, not starting with .");
+    return Fail("name: '" + name +
+                    "' must be non-empty, without / or \\, not starting with .",
+                why);
   }
   std::string reason;
-  if (!CheckRenderCamera(camera, &reason)) return fail("camera: " + reason);
-  if (!board.Check(&reason)) return fail("board: " + reason);
-  if (!render.Check(&reason)) return fail("render: " + reason);
+  if (!CheckRenderCamera(camera, &reason))
+    return Fail("camera: " + reason, why);
+  if (!board.Check(&reason)) return Fail("board: " + reason, why);
+  if (!render.Check(&reason)) return Fail("render: " + reason, why);
   for (size_t i = 0; i < views.size(); ++i) {
     if (!plain_name(views[i].name)) {
-      return fail("views[" + std::to_string(i) + "].name: '" + views[i].name +
-                  "' must be non-empty, without / or \\, not starting with .");
+      return Fail(
+          "views[" + std::to_string(i) + "].name: '" + views[i].name +
+              "' must be non-empty, without / or \\, not starting with .",
+          why);
     }
     const Eigen::Matrix3d r = views[i].cam_from_board.linear();
     if (!views[i].cam_from_board.matrix().allFinite() ||
         (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() > 1e-6 ||
         r.determinant() < 0) {
-      return fail("views[" + std::to_string(i) +
-                  "].cam_from_board: not a finite rigid transform");
+      return Fail("views[" + std::to_string(i) +
+                      "].cam_from_board: not a finite rigid transform",
+                  why);
     }
   }
   const RandomViews& rv = random_views;
   if (rv.count < 0 || rv.count > 10000) {
-    return fail("random_views.count must be in [0, 10000]");
+    return Fail("random_views.count must be in [0, 10000]", why);
   }
   if (rv.count > 0) {
     if (!(Finite(rv.min_distance_m) && rv.min_distance_m > 0 &&
           rv.max_distance_m >= rv.min_distance_m &&
           Finite(rv.max_distance_m))) {
-      return fail("random_views: need 0 < min_distance_m <= max_distance_m");
+      return Fail("random_views: need 0 < min_distance_m <= max_distance_m",
+                  why);
     }
     if (!(rv.min_view_angle_deg > 0 &&
           rv.max_view_angle_deg >= rv.min_view_angle_deg &&
           rv.max_view_angle_deg <= 90)) {
-      return fail(
+      return Fail(
           "random_views: need 0 < min_view_angle_deg <= "
-          "max_view_angle_deg <= 90");
+          "max_view_angle_deg <= 90",
+          why);
     }
     if (!(Finite(rv.max_roll_deg) && Finite(rv.max_off_axis_deg) &&
           rv.max_off_axis_deg >= 0 && rv.max_off_axis_deg < 180 &&
           Finite(rv.target_margin_tiles))) {
-      return fail(
+      return Fail(
           "random_views: max_roll_deg, target_margin_tiles must be "
-          "finite, max_off_axis_deg in [0, 180)");
+          "finite, max_off_axis_deg in [0, 180)",
+          why);
     }
     if (rv.occluders_per_view < 0 || rv.occluders_per_view > 100 ||
         !(rv.min_occluder_radius_px >= 0 &&
           rv.max_occluder_radius_px >= rv.min_occluder_radius_px &&
           Finite(rv.max_occluder_radius_px))) {
-      return fail(
+      return Fail(
           "random_views: occluders_per_view in [0, 100] and "
-          "0 <= min_occluder_radius_px <= max_occluder_radius_px");
+          "0 <= min_occluder_radius_px <= max_occluder_radius_px",
+          why);
     }
   }
   for (double angle : tilt_series.view_angles_deg) {
     if (!(angle > 0 && angle <= 90)) {
-      return fail("tilt_series.view_angles_deg must lie in (0, 90]");
+      return Fail("tilt_series.view_angles_deg must lie in (0, 90]", why);
     }
   }
   if (!tilt_series.view_angles_deg.empty() &&
       !(Finite(tilt_series.distance_m) && tilt_series.distance_m > 0)) {
-    return fail("tilt_series.distance_m must be positive");
+    return Fail("tilt_series.distance_m must be positive", why);
   }
   for (double px : tile_size_series.tile_px) {
     if (!(Finite(px) && px > 0.5)) {
-      return fail("tile_size_series.tile_px must be > 0.5");
+      return Fail("tile_size_series.tile_px must be > 0.5", why);
     }
   }
   if (!tile_size_series.tile_px.empty() &&
       !(tile_size_series.view_angle_deg > 0 &&
         tile_size_series.view_angle_deg <= 90)) {
-    return fail("tile_size_series.view_angle_deg must lie in (0, 90]");
+    return Fail("tile_size_series.view_angle_deg must lie in (0, 90]", why);
   }
   if (views.empty() && rv.count == 0 && tilt_series.view_angles_deg.empty() &&
       tile_size_series.tile_px.empty()) {
-    return fail(
+    return Fail(
         "the scene has no views (views, random_views, tilt_series "
-        "or tile_size_series)");
+        "or tile_size_series)",
+        why);
   }
   return true;
 }

@@ -4,6 +4,7 @@
 
 #include "target/puzzleboard_codes.h"
 #include "util/enum_names.h"
+#include "util/failure.h"
 
 namespace puzzlecal {
 
@@ -20,31 +21,40 @@ bool BoardTypeFromName(const std::string& name, BoardType* type) {
   return ValueOf(kBoardTypeNames, name, type);
 }
 
+BoardTypeTraits BoardTraits(BoardType type) {
+  switch (type) {
+    case BoardType::kPuzzleBoard:
+      return {/*absolute_ids=*/true, /*has_origin=*/true,
+              /*border_tiles=*/0.5, /*pattern_ends_at_border=*/false};
+    case BoardType::kCheckerboard:
+      return {/*absolute_ids=*/false, /*has_origin=*/false,
+              /*border_tiles=*/1.0, /*pattern_ends_at_border=*/true};
+  }
+  return {};  // not reached: every type is a case above
+}
+
 bool Board::Check(std::string* why) const {
-  auto fail = [why](const std::string& message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
   if (cols < 2 || rows < 2) {
-    return fail("cols and rows must both be >= 2 (inner corners)");
+    return Fail("cols and rows must both be >= 2 (inner corners)", why);
   }
   if (cols > kMaxBoardSide || rows > kMaxBoardSide) {
-    return fail("cols and rows must be <= " + std::to_string(kMaxBoardSide) +
-                " (inner corners; a typo?)");
+    return Fail("cols and rows must be <= " + std::to_string(kMaxBoardSide) +
+                    " (inner corners; a typo?)",
+                why);
   }
   if (!(std::isfinite(tile_size_m) && tile_size_m > 0.0)) {
-    return fail("tile_size_m must be a positive number of metres");
+    return Fail("tile_size_m must be a positive number of metres", why);
   }
-  if (type == BoardType::kPuzzleBoard) {
+  if (Traits().has_origin) {
     if (cols > kPuzzleBoardPeriod || rows > kPuzzleBoardPeriod) {
-      return fail("cols and rows must be <= 501 for a PuzzleBoard");
+      return Fail("cols and rows must be <= 501 for a PuzzleBoard", why);
     }
     if (origin.x() < 0 || origin.y() < 0 || origin.x() >= kPuzzleBoardPeriod ||
         origin.y() >= kPuzzleBoardPeriod) {
-      return fail("origin must lie in [0, 501) x [0, 501)");
+      return Fail("origin must lie in [0, 501) x [0, 501)", why);
     }
   } else if (origin != Eigen::Vector2i::Zero()) {
-    return fail("origin must be [0, 0] for a checkerboard");
+    return Fail("origin must be [0, 0] for a checkerboard", why);
   }
   return true;
 }

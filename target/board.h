@@ -12,6 +12,29 @@ enum class BoardType {
   kCheckerboard,  // plain checkerboard; ids only up to the board's symmetry
 };
 
+// What a board type means to the code that prints, renders, decodes and
+// checks it. Every type-dependent property is read from here (BoardTraits
+// switches over the types without a default, so the compiler names the
+// place a new type must fill in).
+struct BoardTypeTraits {
+  // Every tile edge carries a bit, so corner ids are absolute and any 3 x 3
+  // tiles place a view on the board (PuzzleBoard). Without them a view is
+  // labelled only up to the board's symmetry, and only when it shows the
+  // whole board.
+  bool absolute_ids;
+  // `origin` places the board on the pattern's 501 x 501 torus; otherwise
+  // it is (0, 0).
+  bool has_origin;
+  // The printed margin from the outer inner corners to the page edge, in
+  // tiles.
+  double border_tiles;
+  // Renders draw tiles beyond the printed border as paper (a plain
+  // checkerboard ends there; a PuzzleBoard render keeps its code going, as
+  // a larger print of the same pattern would).
+  bool pattern_ends_at_border;
+};
+BoardTypeTraits BoardTraits(BoardType type);
+
 // "puzzleboard" / "checkerboard".
 const char* BoardTypeName(BoardType type);
 bool BoardTypeFromName(const std::string& name, BoardType* type);
@@ -39,6 +62,8 @@ struct Board {
   // null) names the offending field.
   bool Check(std::string* why = nullptr) const;
 
+  // The type's properties (BoardTraits(type)).
+  BoardTypeTraits Traits() const { return BoardTraits(type); }
   int NumCorners() const { return cols * rows; }
   // True when `id` is one of the printed corners
   // [origin.x, origin.x + cols) x [origin.y, origin.y + rows).

@@ -256,11 +256,6 @@ class BadInputTest : public ::testing::Test {
                Quote(out.string()));
   }
 
-  // True when the program has `calibrate` (the test skips otherwise).
-  bool HasCalibrate() const {
-    return Run("calibrate --help").exit_code == kExitOk;
-  }
-
   RunResult Calibrate(const fs::path& images, const fs::path& out,
                       const std::string& extra = "") const {
     return Run("calibrate --images " + Quote(images.string()) + " --board " +
@@ -295,11 +290,6 @@ class BadInputTest : public ::testing::Test {
 
 fs::path* BadInputTest::root_ = nullptr;
 
-#define SKIP_WITHOUT_CALIBRATE()                                           \
-  if (!HasCalibrate()) {                                                   \
-    GTEST_SKIP() << "`puzzlecal calibrate` is not part of this build yet"; \
-  }
-
 // ------------------------------------------------------------------ cases --
 
 TEST_F(BadInputTest, MissingFolder) {
@@ -311,7 +301,6 @@ TEST_F(BadInputTest, MissingFolder) {
   EXPECT_NE(detect.err.find("no such file"), std::string::npos) << detect.err;
   EXPECT_FALSE(fs::exists(out));
 
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path camera = case_dir_ / "camera.yaml";
   const RunResult calibrate = Calibrate(missing, camera);
   EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
@@ -330,7 +319,6 @@ TEST_F(BadInputTest, EmptyFolder) {
   EXPECT_NE(detect.err.find("no image"), std::string::npos) << detect.err;
   EXPECT_FALSE(fs::exists(out));
 
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path camera = case_dir_ / "camera.yaml";
   const RunResult calibrate = Calibrate(empty, camera);
   EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
@@ -358,7 +346,6 @@ TEST_F(BadInputTest, FolderOfNonImages) {
       << detect.err;
   EXPECT_FALSE(fs::exists(out)) << "nothing readable: no detections file";
 
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path camera = case_dir_ / "camera.yaml";
   const RunResult calibrate = Calibrate(folder, camera);
   EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
@@ -513,7 +500,6 @@ TEST_F(BadInputTest, BrokenFilesAmongGoodViews) {
   EXPECT_EQ(detections.at("zero.png").corners, 0);
   EXPECT_NE(detections.at("zero.png").reason.find("empty"), std::string::npos);
 
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path camera = case_dir_ / "camera.yaml";
   const RunResult calibrate = Calibrate(folder, camera);
   EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
@@ -570,7 +556,6 @@ TEST_F(BadInputTest, SixteenBitRgbaAndJpegImages) {
     EXPECT_GT(detected.corners, 60) << file;
   }
 
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path camera = case_dir_ / "camera.yaml";
   const RunResult calibrate = Calibrate(folder, camera);
   EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
@@ -597,7 +582,6 @@ TEST_F(BadInputTest, TwoBoardsInOneImage) {
   const auto detections = ReadDetections(out);
   EXPECT_GT(detections.at("two_boards.png").corners, 60);
 
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path camera = case_dir_ / "camera.yaml";
   const RunResult calibrate = Calibrate(folder, camera);
   EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
@@ -652,7 +636,6 @@ TEST_F(BadInputTest, UnreadablePermissions) {
 // Board files with a missing field, a wrong type, a bad value, unknown type
 // name, not YAML at all, and a missing file: bad input naming the board file.
 TEST_F(BadInputTest, BadBoardFiles) {
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const std::vector<std::pair<std::string, std::string>> boards = {
       {"missing_cols",
@@ -692,7 +675,6 @@ TEST_F(BadInputTest, BadBoardFiles) {
 }
 
 TEST_F(BadInputTest, UnknownModelName) {
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const fs::path camera = case_dir_ / "camera.yaml";
   const RunResult run = Calibrate(folder, camera, "--model fisheye-magic");
@@ -706,7 +688,6 @@ TEST_F(BadInputTest, UnknownModelName) {
 // requires; pinhole-rational, which the camchain cannot hold, is refused
 // before any image is read.
 TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const fs::path camchain = case_dir_ / "camchain.yaml";
   const RunResult run =
@@ -740,7 +721,6 @@ TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
 // cols and rows swapped) ends with a message about the board file, not with
 // one about image sizes or the number of views.
 TEST_F(BadInputTest, WrongBoardFileNamesTheBoard) {
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);
   struct Case {
     const char* name;
@@ -782,7 +762,6 @@ TEST_F(BadInputTest, WrongBoardFileNamesTheBoard) {
 // Images of two sizes: the size most images have is used; the others are
 // named with theirs.
 TEST_F(BadInputTest, ImagesOfAnotherSizeAreNamed) {
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("sizes", 5);
   // Sorted first, so "the first image's size" would be the wrong choice.
   cv::Mat wider;
@@ -805,7 +784,6 @@ TEST_F(BadInputTest, ImagesOfAnotherSizeAreNamed) {
 // replaced as a whole (old overlays go); a report folder holding other files
 // and an unwritable camera path are refused before any image is read.
 TEST_F(BadInputTest, OutputsCheckedFirstAndReportReplaced) {
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const fs::path camera = case_dir_ / "camera.yaml";
   const fs::path report = case_dir_ / "report";
@@ -842,7 +820,6 @@ TEST_F(BadInputTest, OutputsCheckedFirstAndReportReplaced) {
 // Ctrl-C while the images are processed: "interrupted", exit 130, nothing
 // half-written.
 TEST_F(BadInputTest, InterruptSaysSoAndLeavesNothingHalfWritten) {
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const fs::path camera = case_dir_ / "camera.yaml";
   int err_pipe[2];
@@ -917,7 +894,6 @@ TEST_F(BadInputTest, ConsoleVersionHelpAndQuiet) {
     }
   }
 
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("views", 5);
   WriteFile(folder / "zero.png", "");
   const fs::path camera = case_dir_ / "camera.yaml";
@@ -978,19 +954,16 @@ TEST_F(BadInputTest, UnwritableOutput) {
     fs::permissions(read_only, fs::perms::owner_read | fs::perms::owner_exec);
     outputs.push_back(read_only / "out.yaml");
   }
-  const bool has_calibrate = HasCalibrate();
   for (const fs::path& out : outputs) {
     const RunResult detect = Detect(folder, out);
     EXPECT_EQ(detect.exit_code, kExitOutputError) << out << "\n"
                                                   << detect.all();
     EXPECT_NE(detect.err.find(out.string()), std::string::npos) << detect.err;
-    if (has_calibrate) {
-      const RunResult calibrate = Calibrate(folder, out);
-      EXPECT_EQ(calibrate.exit_code, kExitOutputError) << out << "\n"
-                                                       << calibrate.all();
-      EXPECT_NE(calibrate.err.find(out.string()), std::string::npos)
-          << calibrate.err;
-    }
+    const RunResult calibrate = Calibrate(folder, out);
+    EXPECT_EQ(calibrate.exit_code, kExitOutputError) << out << "\n"
+                                                     << calibrate.all();
+    EXPECT_NE(calibrate.err.find(out.string()), std::string::npos)
+        << calibrate.err;
   }
   fs::permissions(read_only, fs::perms::owner_all);
   // No partial output anywhere in the case folder (no temporary files left).
@@ -998,15 +971,10 @@ TEST_F(BadInputTest, UnwritableOutput) {
     EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
     EXPECT_EQ(file.find("out.yaml"), std::string::npos) << file;
   }
-  if (!has_calibrate) {
-    GTEST_SKIP() << "detect checked; `puzzlecal calibrate` is not part of "
-                    "this build yet";
-  }
 }
 
 // Too few usable views: no result, and no camera file written.
 TEST_F(BadInputTest, TooFewViewsWritesNothing) {
-  SKIP_WITHOUT_CALIBRATE();
   const fs::path folder = ImagesWithGoodViews("one_view", 1);
   const fs::path camera = case_dir_ / "camera.yaml";
   const RunResult run = Calibrate(folder, camera);

@@ -20,6 +20,7 @@
 #include "formats/image_io.h"
 #include "pipeline/pipeline.h"
 #include "tests/support/deltille_data.h"
+#include "tests/support/shared_data.h"
 
 namespace puzzlecal {
 namespace {
@@ -58,8 +59,8 @@ class DeltilleCalibrationTest : public ::testing::Test {
   void SetUp() override {
     folder_ = testing_data::DeltilleFolder();
     if (folder_.empty()) {
-      GTEST_SKIP() << "deltille fisheye photos not found: "
-                   << testing_data::DeltilleHowToGet();
+      PUZZLECAL_SKIP_WITHOUT_DATA("deltille fisheye photos not found: "
+                                  << testing_data::DeltilleHowToGet());
     }
     ImageListing listing;
     std::string error;

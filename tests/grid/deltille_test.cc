@@ -24,6 +24,7 @@
 #include "detection/detector.h"
 #include "grid/grid.h"
 #include "tests/support/deltille_data.h"
+#include "tests/support/shared_data.h"
 
 namespace puzzlecal {
 namespace {
@@ -93,7 +94,8 @@ TEST(DeltilleTest, FisheyePhotosHaveConsistentComponents) {
   const std::vector<std::string> files =
       testing_data::DeltillePhotoFiles(testing_data::DeltilleFolder());
   if (files.empty()) {
-    GTEST_SKIP() << "no deltille photos: " << testing_data::DeltilleHowToGet();
+    PUZZLECAL_SKIP_WITHOUT_DATA(
+        "no deltille photos: " << testing_data::DeltilleHowToGet());
   }
   int photos = 0, wrong_components = 0, all_88 = 0, photos_with_88 = 0;
   std::printf("photo  corners  components  largest  span    verdict\n");

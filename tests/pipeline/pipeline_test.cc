@@ -108,6 +108,9 @@ TEST_F(PipelineTest, ResultsDoNotDependOnTheThreadCount) {
       ProcessImageFiles(files_, board, options, 3);
   ASSERT_EQ(one.size(), three.size());
   for (size_t i = 0; i < one.size(); ++i) {
+    // Every view is decoded (an unusable view would compare nothing).
+    EXPECT_EQ(one[i].outcome, ImageOutcome::kUsable) << one[i].file;
+    EXPECT_GE(one[i].decode.observation.id.size(), 44u) << one[i].file;
     EXPECT_EQ(one[i].file, three[i].file);
     EXPECT_EQ(one[i].outcome, three[i].outcome);
     ASSERT_EQ(one[i].decode.observation.id.size(),

@@ -17,6 +17,7 @@
 
 #include "target/board.h"
 #include "target/puzzleboard_codes.h"
+#include "tests/support/shared_data.h"
 
 namespace puzzlecal {
 namespace {
@@ -39,8 +40,9 @@ std::string FindCodesFile() {
 TEST(PuzzleBoardCodes, EmbeddedTablesMatchPublishedCodesFile) {
   const std::string path = FindCodesFile();
   if (path.empty()) {
-    GTEST_SKIP() << "codes.txt not found (set PUZZLECAL_DATA or place it at "
-                    "../shared/puzzleboard/codes.txt)";
+    PUZZLECAL_SKIP_WITHOUT_DATA(
+        "codes.txt not found (set PUZZLECAL_DATA or place it at "
+        "../shared/puzzleboard/codes.txt)");
   }
   std::ifstream in(path);
   std::string line;
