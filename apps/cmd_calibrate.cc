@@ -22,6 +22,7 @@
 #include "apps/subcommand.h"
 #include "calib/calibrate.h"
 #include "evidence/evidence.h"
+#include "evidence/model_advice.h"
 #include "evidence/model_selection.h"
 #include "evidence/verdict.h"
 #include "formats/board_file.h"
@@ -415,6 +416,11 @@ int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
       run->views, run->result, request.calibration_options, evidence_options);
   run->verdict = MakeVerdict(run->result, run->evidence, evidence_options,
                              request.options.verdict);
+  // A suggested model is advised only after it has won on held-out views.
+  CheckModelAdvice(run->views, run->result, request.calibration_options,
+                   request.options.model_selection,
+                   request.auto_model ? &run->selection : nullptr,
+                   &run->verdict);
   return kExitOk;
 }
 

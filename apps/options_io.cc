@@ -319,6 +319,9 @@ struct Fields<ModelSelectionOptions> {
     v.Field("min_relative_gain", o.min_relative_gain);
     v.Field("gross_error_k", o.gross_error_k);
     v.Field("gross_error_floor_px", o.gross_error_floor_px);
+    v.Field("all_folds", o.all_folds);
+    v.Field("min_gain_z", o.min_gain_z);
+    v.Field("conventional_max_field_deg", o.conventional_max_field_deg);
   }
 };
 

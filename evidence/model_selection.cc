@@ -50,6 +50,10 @@ bool ModelSelectionOptions::Check(std::string* why) const {
   if (!(min_relative_gain >= 0)) {
     return Fail("min_relative_gain must be >= 0", why);
   }
+  if (!(min_gain_z >= 0)) return Fail("min_gain_z must be >= 0", why);
+  if (!(conventional_max_field_deg > 0 && conventional_max_field_deg <= 90)) {
+    return Fail("conventional_max_field_deg must be in (0, 90]", why);
+  }
   if (!(gross_error_k > 0)) return Fail("gross_error_k must be > 0", why);
   if (!(gross_error_floor_px >= 0)) {
     return Fail("gross_error_floor_px must be >= 0", why);
@@ -144,15 +148,19 @@ std::vector<std::vector<bool>> DetectionErrors(
 }
 
 // The RMS per coordinate of the corners that project, detection errors left
-// out; `corners` receives their number.
+// out; `corners` receives their number, `view_sse` each view's sum of
+// squares.
 double HoldoutRms(const CornerResiduals& residuals,
-                  const std::vector<std::vector<bool>>& gross, int* corners) {
+                  const std::vector<std::vector<bool>>& gross, int* corners,
+                  std::vector<double>* view_sse) {
   double sum2 = 0;
   int n = 0;
+  view_sse->assign(residuals.size(), 0.0);
   for (size_t v = 0; v < residuals.size(); ++v) {
     for (size_t i = 0; i < residuals[v].size(); ++i) {
       if (!residuals[v][i].allFinite() || gross[v][i]) continue;
       sum2 += residuals[v][i].squaredNorm();
+      (*view_sse)[v] += residuals[v][i].squaredNorm();
       ++n;
     }
   }
@@ -185,14 +193,14 @@ std::vector<CameraModelId> CandidateModels(
 // number of such views.
 int SplitViews(const std::vector<CalibrationView>& views,
                int min_corners_per_view, const ModelSelectionOptions& options,
-               std::vector<CalibrationView>* fit,
+               int offset, std::vector<CalibrationView>* fit,
                std::vector<CalibrationView>* holdout) {
   int position = 0;
   for (const CalibrationView& view : views) {
     if (static_cast<int>(view.board_points.size()) < min_corners_per_view) {
       continue;
     }
-    if (position++ % options.holdout_every == options.holdout_offset) {
+    if (position++ % options.holdout_every == offset) {
       holdout->push_back(view);
     } else {
       fit->push_back(view);
@@ -265,33 +273,124 @@ void CompareOnTheSameCorners(const std::vector<CornerResiduals>& residuals,
   for (size_t m = 0; m < residuals.size(); ++m) {
     ModelCandidate& c = selection->candidates[m];
     if (c.ok) {
-      c.holdout_rms_px = HoldoutRms(residuals[m], gross, &c.holdout_corners);
+      c.holdout_rms_px = HoldoutRms(residuals[m], gross, &c.holdout_corners,
+                                    &c.holdout_view_sse);
     }
   }
 }
 
-// The lowest held-out error; a model with more parameters must beat the
-// best one with fewer by min_relative_gain. -1 when no candidate succeeded.
+// Preference order: the conventional family for the field first, then fewer
+// parameters, then the candidates' order.
+bool Preferred(const ModelCandidate& a, const ModelCandidate& b,
+               bool pinhole_field) {
+  const bool a_family = CameraModelIsPinhole(a.model) == pinhole_field;
+  const bool b_family = CameraModelIsPinhole(b.model) == pinhole_field;
+  if (a_family != b_family) return a_family;
+  return a.num_params < b.num_params;
+}
+
+// The most preferred candidate that fitted, replaced by any that beats it
+// on held-out views (the lowest such), until none does. Sets `reason`.
 int ChooseCandidate(const std::vector<ModelCandidate>& candidates,
-                    double min_relative_gain) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const ModelCandidate& c : candidates) {
-    if (c.ok) best = std::min(best, c.holdout_rms_px);
-  }
-  int chosen = -1;
+                    bool pinhole_field, const ModelSelectionOptions& options,
+                    std::string* reason) {
+  int chosen = -1, lowest = -1;
   for (size_t k = 0; k < candidates.size(); ++k) {
     const ModelCandidate& c = candidates[k];
-    if (!c.ok || c.holdout_rms_px > best * (1 + min_relative_gain)) continue;
-    if (chosen < 0 || c.num_params < candidates[chosen].num_params ||
-        (c.num_params == candidates[chosen].num_params &&
-         c.holdout_rms_px < candidates[chosen].holdout_rms_px)) {
+    if (!c.ok) continue;
+    if (chosen < 0 || Preferred(c, candidates[chosen], pinhole_field)) {
       chosen = static_cast<int>(k);
     }
+    if (lowest < 0 || c.holdout_rms_px < candidates[lowest].holdout_rms_px) {
+      lowest = static_cast<int>(k);
+    }
+  }
+  if (chosen < 0) return -1;
+  for (size_t round = 0; round < candidates.size(); ++round) {
+    int winner = -1;
+    for (size_t k = 0; k < candidates.size(); ++k) {
+      if (!candidates[k].ok || static_cast<int>(k) == chosen) continue;
+      if (!BeatsOnHeldOutViews(candidates[k], candidates[chosen], options)) {
+        continue;
+      }
+      if (winner < 0 ||
+          candidates[k].holdout_rms_px < candidates[winner].holdout_rms_px) {
+        winner = static_cast<int>(k);
+      }
+    }
+    if (winner < 0) break;
+    chosen = winner;
+  }
+  const ModelCandidate& c = candidates[chosen];
+  if (chosen == lowest) {
+    *reason = "lowest held-out RMS";
+  } else {
+    double z = 0;
+    BeatsOnHeldOutViews(candidates[lowest], c, options, &z);
+    const ModelCandidate& l = candidates[lowest];
+    *reason = StringPrintf(
+        "%s has the lowest held-out RMS (%.4f px against %.4f px, %.1f %% "
+        "lower, %.1f standard errors), not by more than both %.0f %% and "
+        "%.1f standard errors: a tie, which goes to %s",
+        CameraModelName(l.model), l.holdout_rms_px, c.holdout_rms_px,
+        100 * (1 - l.holdout_rms_px / c.holdout_rms_px), z,
+        100 * options.min_relative_gain, options.min_gain_z,
+        CameraModelIsPinhole(c.model) == pinhole_field &&
+                CameraModelIsPinhole(l.model) != pinhole_field
+            ? (pinhole_field ? "the pinhole family (every corner within "
+                               "the conventional field of a pinhole lens)"
+                             : "the fisheye family (corners beyond the "
+                               "conventional field of a pinhole lens)")
+            : "the model with fewer parameters");
   }
   return chosen;
 }
 
 }  // namespace
+
+bool BeatsOnHeldOutViews(const ModelCandidate& challenger,
+                         const ModelCandidate& incumbent,
+                         const ModelSelectionOptions& options, double* z) {
+  if (z != nullptr) *z = 0;
+  if (!challenger.ok || !incumbent.ok ||
+      challenger.holdout_view_sse.size() != incumbent.holdout_view_sse.size() ||
+      challenger.holdout_view_sse.empty()) {
+    return false;
+  }
+  // Per view, the log of the ratio of the two RMS: views of every size
+  // and position weigh alike, and one view where a model extrapolates
+  // wildly cannot hide how the others compare.
+  size_t n = 0;
+  double sum = 0, sum2 = 0;
+  for (size_t v = 0; v < challenger.holdout_view_sse.size(); ++v) {
+    const double a = incumbent.holdout_view_sse[v];
+    const double b = challenger.holdout_view_sse[v];
+    if (!(a > 0) || !(b > 0)) continue;
+    const double d = 0.5 * std::log(a / b);
+    sum += d;
+    sum2 += d * d;
+    ++n;
+  }
+  if (n == 0) return false;
+  const double mean = sum / n;
+  const double variance =
+      n > 1 ? std::max(0.0, (sum2 - n * mean * mean) / (n - 1)) : 0.0;
+  const double se = std::sqrt(variance / n);
+  const double zz =
+      se > 0 ? mean / se
+             : (mean > 0 ? std::numeric_limits<double>::infinity() : 0.0);
+  if (z != nullptr) *z = zz;
+  return challenger.holdout_rms_px <
+             incumbent.holdout_rms_px * (1 - options.min_relative_gain) &&
+         n > 1 && zz > options.min_gain_z;
+}
+
+const ModelCandidate* ModelSelection::Find(CameraModelId model) const {
+  for (const ModelCandidate& c : candidates) {
+    if (c.model == model) return &c;
+  }
+  return nullptr;
+}
 
 bool SelectModel(const std::vector<CalibrationView>& views, int width,
                  int height, const CalibrationOptions& calibration,
@@ -303,26 +402,70 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
   if (!options.Check(&why))
     return Fail("model selection options: " + why, error);
   const std::vector<CameraModelId> models = CandidateModels(options);
-  std::vector<CalibrationView> fit, holdout;
-  const int usable = SplitViews(views, calibration.min_corners_per_view,
-                                options, &fit, &holdout);
-  selection->fit_views = static_cast<int>(fit.size());
-  selection->holdout_views = static_cast<int>(holdout.size());
-  if (holdout.empty()) {
+  const int first_fold = options.all_folds ? 0 : options.holdout_offset;
+  const int last_fold =
+      options.all_folds ? options.holdout_every - 1 : options.holdout_offset;
+  double widest_deg = 0;
+  std::vector<CornerResiduals> residuals(models.size());
+  std::vector<double> fit_sum2(models.size(), 0.0);
+  for (size_t m = 0; m < models.size(); ++m) {
+    ModelCandidate candidate;
+    candidate.model = models[m];
+    candidate.num_params = CameraModelNumParams(models[m]);
+    candidate.ok = true;
+    selection->candidates.push_back(candidate);
+  }
+  int usable = 0;
+  selection->folds = 0;
+  for (int fold = first_fold; fold <= last_fold; ++fold) {
+    std::vector<CalibrationView> fit, holdout;
+    usable = SplitViews(views, calibration.min_corners_per_view, options, fold,
+                        &fit, &holdout);
+    if (holdout.empty()) continue;
+    ++selection->folds;
+    selection->fit_views = static_cast<int>(fit.size());
+    selection->holdout_views += static_cast<int>(holdout.size());
+    for (size_t m = 0; m < models.size(); ++m) {
+      ModelCandidate& total = selection->candidates[m];
+      if (!total.ok) continue;
+      CornerResiduals fold_residuals;
+      const ModelCandidate c =
+          FitCandidate(models[m], fit, holdout, width, height, calibration,
+                       options, &widest_deg, &fold_residuals);
+      total.seconds += c.seconds;
+      total.holdout_views += c.holdout_views;
+      if (!c.ok) {
+        total.ok = false;
+        total.error = selection->folds > 1 || options.all_folds
+                          ? StringPrintf("fold %d: ", fold + 1) + c.error
+                          : c.error;
+        if (c.error.rfind("skipped", 0) == 0) total.error = c.error;
+        continue;
+      }
+      fit_sum2[m] += c.fit_rms_px * c.fit_rms_px;
+      residuals[m].insert(residuals[m].end(), fold_residuals.begin(),
+                          fold_residuals.end());
+    }
+  }
+  if (selection->holdout_views == 0) {
     return Fail("model selection: too few views to hold any out (" +
                     std::to_string(usable) + ")",
                 error);
   }
-  double widest_deg = 0;
-  std::vector<CornerResiduals> residuals(models.size());
   for (size_t m = 0; m < models.size(); ++m) {
-    selection->candidates.push_back(FitCandidate(models[m], fit, holdout, width,
-                                                 height, calibration, options,
-                                                 &widest_deg, &residuals[m]));
+    ModelCandidate& c = selection->candidates[m];
+    c.fit_rms_px = std::sqrt(fit_sum2[m] / std::max(1, selection->folds));
+    if (!c.ok) residuals[m].clear();
   }
   CompareOnTheSameCorners(residuals, options, selection);
+  selection->widest_field_deg = widest_deg;
+  // Pinhole candidates do not report their field (a fisheye candidate's
+  // poses do); without a fisheye candidate the field is taken as
+  // conventional.
+  selection->pinhole_field = widest_deg <= options.conventional_max_field_deg;
   selection->chosen =
-      ChooseCandidate(selection->candidates, options.min_relative_gain);
+      ChooseCandidate(selection->candidates, selection->pinhole_field, options,
+                      &selection->reason);
   if (selection->chosen < 0) {
     std::string reasons;
     for (const ModelCandidate& c : selection->candidates) {
@@ -337,8 +480,13 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
 
 std::string ModelSelection::Table() const {
   std::ostringstream table;
-  table << "model selection: " << fit_views << " views fitted, "
-        << holdout_views << " held out (poses fitted, intrinsics fixed)";
+  table << "model selection: " << folds << (folds == 1 ? " fold" : " folds")
+        << " of " << fit_views << " views fitted, " << holdout_views
+        << " held out in all (poses fitted, intrinsics fixed)";
+  if (widest_field_deg > 0) {
+    table << StringPrintf("; corners reach %.1f deg off the axis",
+                          widest_field_deg);
+  }
   if (holdout_detection_errors > 0) {
     table << "; " << holdout_detection_errors
           << " held-out corner(s) off for every model left out as detection "
@@ -362,10 +510,8 @@ std::string ModelSelection::Table() const {
     }
   }
   if (chosen >= 0) {
-    table << "chosen: " << CameraModelName(candidates[chosen].model)
-          << " (lowest held-out RMS; candidates within "
-          << static_cast<int>(std::lround(100 * min_relative_gain))
-          << " % of it go to the one with fewer parameters)\n";
+    table << "chosen: " << CameraModelName(candidates[chosen].model) << " ("
+          << reason << ")\n";
   }
   return table.str();
 }

@@ -7,6 +7,16 @@
 // RMS of their corners is the candidate's held-out error. A model with more
 // parameters than the lens needs fits the calibration views better but not
 // the held-out ones; a model that cannot follow the lens fits neither.
+// By default every view is held out once (one fold per holdout_every), so
+// small sets still compare the candidates on all of their corners.
+//
+// The choice: the candidates are ranked by preference (the conventional
+// family for the observed field first: pinhole models when every corner
+// stays within conventional_max_field_deg of the axis, fisheye models
+// beyond; then fewer parameters). The most preferred candidate that fits is
+// chosen unless another beats it on held-out error by more than
+// min_relative_gain and by more than min_gain_z standard errors of the
+// per-view difference (noise); then the winner must be beaten in turn.
 
 #include <string>
 #include <vector>
@@ -23,6 +33,10 @@ struct ModelSelectionOptions {
   // every 4th view. holdout_every >= 2, 0 <= holdout_offset < holdout_every.
   int holdout_every = 4;
   int holdout_offset = 3;
+  // Hold out every fold in turn (offsets 0 .. holdout_every - 1: each view
+  // is held out once, at holdout_every calibrations per candidate) instead
+  // of only the holdout_offset one. Default true.
+  bool all_folds = true;
   // Candidate model names; empty (the default) means every model.
   std::vector<std::string> candidates;
   // Pinhole candidates are skipped when a fisheye candidate's corners reach
@@ -30,9 +44,19 @@ struct ModelSelectionOptions {
   // cannot project rays at 90 degrees or more, and its fit fails slowly.
   // Default 85. In (0, 90].
   double pinhole_max_field_deg = 85.0;
-  // A candidate must beat the best held-out error by more than this
-  // fraction to be preferred over one with fewer parameters. Default 0.02.
+  // A less preferred candidate must beat the chosen one's held-out RMS by
+  // more than this fraction to be chosen instead. Default 0.02. >= 0.
   double min_relative_gain = 0.02;
+  // ... and by a mean over the held-out views of the log of the ratio of
+  // the two candidates' RMS in the view of more than this many standard
+  // errors (corner errors within a view are not independent, so the views
+  // are the samples; the log lets every view weigh alike). Default 2. >= 0.
+  double min_gain_z = 2.0;
+  // The field within which pinhole models are the conventional family: when
+  // the widest corner (under any fitted candidate's poses) stays within it,
+  // pinhole models are preferred on near-ties, beyond it fisheye models.
+  // Default 55 degrees. In (0, 90].
+  double conventional_max_field_deg = 55.0;
   // A held-out corner whose error is gross for every candidate that fits
   // is a detection error (a false corner), not a model's failure: it is left
   // out of every candidate's held-out RMS, so that one such corner cannot
@@ -55,30 +79,45 @@ struct ModelCandidate {
   bool ok = false;
   std::string error;      // why the candidate failed, when !ok
   double fit_rms_px = 0;  // calibration views, inliers, per coordinate
+                          // (over the folds)
   // Held-out views, per coordinate, every corner the candidate projects but
   // the detection errors (ModelSelectionOptions::gross_error_k).
   double holdout_rms_px = 0;
   int holdout_views = 0;
   int holdout_corners = 0;
+  // Sum of squared residual lengths per held-out view (the corners of
+  // holdout_rms_px), in held-out order: the paired comparison's samples.
+  std::vector<double> holdout_view_sse;
   double seconds = 0;
 };
 
 struct ModelSelection {
   std::vector<ModelCandidate> candidates;
   int chosen = -1;  // index into candidates, -1 when none succeeded
-  int fit_views = 0;
-  int holdout_views = 0;
+  int fit_views = 0;      // per fold
+  int holdout_views = 0;  // over all folds
+  int folds = 1;
   double min_relative_gain = 0;  // the options' tie margin, for Table()
   // Held-out corners left out as gross for every candidate.
   int holdout_detection_errors = 0;
+  // The widest field angle of a corner seen by a fitted candidate, degrees,
+  // and whether the pinhole family is the conventional one for it.
+  double widest_field_deg = 0;
+  bool pinhole_field = true;
+  // Why `chosen` was chosen, in words ("lowest held-out RMS", or the
+  // candidate with the lowest and why it was not enough).
+  std::string reason;
+
+  // The candidate of that model (nullptr when it was not a candidate).
+  const ModelCandidate* Find(CameraModelId model) const;
 
   // The comparison table (one line per candidate, the chosen one marked).
   std::string Table() const;
 };
 
-// Splits the views, calibrates each candidate and picks the lowest held-out
-// error (ties within min_relative_gain go to fewer parameters). False when
-// no candidate succeeds or the options are invalid.
+// Splits the views, calibrates each candidate and chooses one (see the top
+// of this file). False when no candidate succeeds or the options are
+// invalid.
 bool SelectModel(const std::vector<CalibrationView>& views, int width,
                  int height, const CalibrationOptions& calibration,
                  const ModelSelectionOptions& options,
@@ -88,6 +127,15 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
 // the intrinsics fixed; RMS per coordinate over all corners that project.
 // `residuals`, when given, receives every corner's residual ([view][corner],
 // NaN where the corner does not project or its view was not fitted).
+// Whether `challenger` beats `incumbent` on held-out error by more than
+// min_relative_gain and min_gain_z standard errors of the per-view log RMS
+// ratio (both must have fitted, on the same held-out corners); `z` receives
+// the mean log ratio in standard errors.
+bool BeatsOnHeldOutViews(const ModelCandidate& challenger,
+                         const ModelCandidate& incumbent,
+                         const ModelSelectionOptions& options,
+                         double* z = nullptr);
+
 bool HoldoutError(
     const std::vector<CalibrationView>& views, const Camera& camera,
     const CalibrationOptions& calibration, double* rms_px, int* corners,

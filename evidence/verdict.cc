@@ -366,9 +366,10 @@ void SuggestModel(CameraModelId model, bool grows_with_closeness,
             : " (the central model leaves structured residuals)";
   } else if (CameraModelIsPinhole(model) &&
              verdict->suggested_model == "kannala-brandt") {
-    verdict->next_step +=
-        Printf(" (corners reach %.0f deg off the axis: a fisheye lens)",
-               max_angle_deg);
+    verdict->next_step += Printf(
+        " (corners reach %.0f deg off the axis, beyond the %.0f deg a "
+        "pinhole model is meant for)",
+        max_angle_deg, options.pinhole_max_field_deg);
   }
 }
 
@@ -466,11 +467,18 @@ std::string NextModel(CameraModelId model, bool grows_with_closeness,
                       double max_field_deg, const VerdictOptions& options) {
   (void)grows_with_closeness;
   const std::string name = CameraModelName(model);
+  const bool conventional_field =
+      max_field_deg <= options.pinhole_max_field_deg;
   if (CameraModelIsPinhole(model)) {
-    if (max_field_deg > options.pinhole_max_field_deg) return "kannala-brandt";
+    // Within the conventional field a lens is never called a fisheye: the
+    // pinhole family's richest model is the last to try.
+    if (!conventional_field) return "kannala-brandt";
     if (model == CameraModelId::kPinholeRadtan) return "pinhole-rational";
-    return "kannala-brandt";
+    return "";
   }
+  // A fisheye model on a lens within the conventional field: the pinhole
+  // family's richest model.
+  if (conventional_field) return "pinhole-rational";
   // The central fisheye model: what it cannot follow is a lens whose
   // entrance pupil moves with the field angle, which shows most for close
   // corners; the non-central variant models it. (It is also the only richer

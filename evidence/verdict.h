@@ -75,10 +75,12 @@ struct VerdictOptions {
   // above closeness_floor_px. Defaults 1.5 and 0.3 px.
   double closeness_rms_ratio = 1.5;
   double closeness_floor_px = 0.3;
-  // A pinhole model whose corners reach beyond this field angle (degrees)
-  // is on a lens wider than it can follow: the next step is
-  // kannala-brandt. Default 65.
-  double pinhole_max_field_deg = 65.0;
+  // The conventional field of a pinhole lens (degrees off the axis). A
+  // pinhole model whose corners reach beyond it is on a lens wider than it
+  // is meant for: the next step is kannala-brandt. A lens whose corners
+  // stay within it is never called a fisheye: the model to try is a
+  // pinhole one (pinhole-rational), or none. Default 55.
+  double pinhole_max_field_deg = 55.0;
 
   // --- bad detections ---
   // More rejected corners than this fraction of all corners of the used
@@ -137,9 +139,10 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
                     const EvidenceOptions& evidence_options,
                     const VerdictOptions& options);
 
-// The model to try after `model` shows a model error. `grows_with_closeness`:
-// the residuals depend on the board distance; `max_field_deg`: the widest
-// observed field angle.
+// The model to try after `model` shows a model error (a candidate only:
+// evidence/model_advice.h confirms it on held-out views).
+// `grows_with_closeness`: the residuals depend on the board distance;
+// `max_field_deg`: the widest observed field angle.
 std::string NextModel(CameraModelId model, bool grows_with_closeness,
                       double max_field_deg, const VerdictOptions& options);
 

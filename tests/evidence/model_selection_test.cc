@@ -73,12 +73,14 @@ TEST(HoldoutError, ZeroForTheTrueCameraOnExactCorners) {
   EXPECT_LT(rms, 1e-6);
 }
 
-// Every 4th view is held out; the table lists every candidate.
+// Every 4th view is held out, in 4 folds: each view once; the table lists
+// every candidate.
 TEST(SelectModel, SplitsViewsAndListsCandidates) {
   const Camera truth = sim::TruthRadtan();
   const ModelSelection selection = Select(Data(truth, 2), truth);
+  EXPECT_EQ(selection.folds, 4);
   EXPECT_EQ(selection.fit_views, 18);
-  EXPECT_EQ(selection.holdout_views, 6);
+  EXPECT_EQ(selection.holdout_views, 24);
   EXPECT_EQ(selection.candidates.size(), kAllCameraModels.size());
   const std::string table = selection.Table();
   for (CameraModelId id : kAllCameraModels) {

@@ -85,6 +85,13 @@ TEST(NextModel, NamesTheModelToTry) {
             "kannala-brandt");
   EXPECT_EQ(NextModel(CameraModelId::kPinholeRadtan, false, 45, options),
             "pinhole-rational");
+  // Within 55 degrees a lens is never called a fisheye.
+  EXPECT_EQ(NextModel(CameraModelId::kPinholeRational, false, 45, options), "");
+  EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandt, false, 30, options),
+            "pinhole-rational");
+  EXPECT_EQ(
+      NextModel(CameraModelId::kKannalaBrandtNoncentral, true, 80, options),
+      "");
 }
 
 // The right model on clean data of several lenses: good.

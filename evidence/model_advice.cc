@@ -1,0 +1,80 @@
+#include "evidence/model_advice.h"
+
+#include "util/string_format.h"
+
+namespace puzzlecal {
+
+ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
+                             const CalibrationResult& result,
+                             const CalibrationOptions& calibration,
+                             const ModelSelectionOptions& selection_options,
+                             const ModelSelection* selection,
+                             Verdict* verdict) {
+  ModelAdvice advice;
+  if (verdict->suggested_model.empty()) return advice;
+  advice.suggested = verdict->suggested_model;
+  CameraModelId suggested_id;
+  if (!CameraModelIdFromName(advice.suggested, &suggested_id)) {
+    return advice;
+  }
+  const CameraModelId current_id = result.camera.model;
+  const ModelCandidate* current = nullptr;
+  const ModelCandidate* suggested = nullptr;
+  if (selection != nullptr) {
+    current = selection->Find(current_id);
+    suggested = selection->Find(suggested_id);
+  }
+  ModelSelection own;
+  if (current == nullptr || suggested == nullptr || !current->ok) {
+    ModelSelectionOptions options = selection_options;
+    options.candidates = {CameraModelName(current_id), advice.suggested};
+    std::string error;
+    if (!SelectModel(views, result.camera.width, result.camera.height,
+                     calibration, options, &own, &error)) {
+      advice.error = error;
+    }
+    current = own.Find(current_id);
+    suggested = own.Find(suggested_id);
+  }
+  advice.checked = true;
+  if (current != nullptr && suggested != nullptr && current->ok &&
+      suggested->ok) {
+    advice.current_rms_px = current->holdout_rms_px;
+    advice.suggested_rms_px = suggested->holdout_rms_px;
+    advice.confirmed =
+        BeatsOnHeldOutViews(*suggested, *current, selection_options, &advice.z);
+  } else if (advice.error.empty()) {
+    advice.error = suggested != nullptr && !suggested->ok
+                       ? advice.suggested + ": " + suggested->error
+                       : "the calibrated model could not be refitted";
+  }
+  const std::string current_name = CameraModelName(current_id);
+  if (advice.confirmed) {
+    verdict->next_step += StringPrintf(
+        "; on held-out views it fits %.4f px against %.4f px for %s",
+        advice.suggested_rms_px, advice.current_rms_px, current_name.c_str());
+    return advice;
+  }
+  verdict->suggested_model.clear();
+  std::string why;
+  if (advice.error.empty()) {
+    why = StringPrintf(
+        "%s does not fit held-out views better than %s (%.4f px against "
+        "%.4f px, %.1f standard errors)",
+        advice.suggested.c_str(), current_name.c_str(), advice.suggested_rms_px,
+        advice.current_rms_px, advice.z);
+  } else {
+    why = advice.suggested + " could not be compared on held-out views (" +
+          advice.error + ")";
+  }
+  verdict->next_step =
+      why +
+      ", so no model change is advised: no model tried explains the "
+      "finding better. Check that focus and zoom stayed fixed between the "
+      "photos, that the "
+      "board is flat and its file right, and look at the worst views in the "
+      "report; more views at several distances and tilts tell these apart";
+  return advice;
+}
+
+}  // namespace puzzlecal
