@@ -21,6 +21,7 @@
 #include "formats/image_io.h"
 #include "pipeline/pipeline.h"
 #include "tests/support/deltille_data.h"
+#include "tests/support/shared_data.h"
 
 namespace puzzlecal {
 namespace {
@@ -84,8 +85,9 @@ bool LoadViews(const RealSet& set, std::vector<CalibrationView>* views,
 TEST(RealSets, AutoPicksPinholeForPinholeCamerasAndAdviceFollowsHeldOut) {
   const std::vector<RealSet> sets = RealSets();
   if (sets.empty()) {
-    GTEST_SKIP() << "no real photo set found (../shared/real, "
-                 << testing_data::DeltilleHowToGet() << ")";
+    PUZZLECAL_SKIP_WITHOUT_DATA(
+        std::string("no real photo set found (../shared/real; ") +
+        testing_data::DeltilleHowToGet() + ")");
   }
   for (const RealSet& set : sets) {
     SCOPED_TRACE(set.name);
