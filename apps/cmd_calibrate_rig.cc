@@ -278,13 +278,25 @@ CameraJudgements JudgeCameras(const std::vector<RigCameraInput>& inputs,
 // The rig's figures, each camera's verdict line (the one in the report),
 // the time and what was written.
 void PrintRigOutcome(const RigCalibrationResult& result,
-                     const CameraJudgements& judged, int threads,
-                     double seconds_images, double seconds_total,
+                     CameraFileFormat format, const CameraJudgements& judged,
+                     int threads, double seconds_images, double seconds_total,
                      const std::vector<std::string>& written) {
   std::cout << RigCalibrationReport(result);
   for (size_t c = 0; c < result.cameras.size(); ++c) {
     std::cout << RigVerdictLine(result.cameras[c].name, judged.verdicts[c])
               << "\n";
+  }
+  const bool rectified =
+      format == CameraFileFormat::kOpenCv || format == CameraFileFormat::kRos;
+  if (rectified && result.cameras.size() == 2) {
+    StereoRectification rect;
+    std::string why;
+    if (StereoRectify(result.cameras[0].camera, result.cameras[1].camera,
+                      result.cameras[1].cam_from_rig *
+                          result.cameras[0].cam_from_rig.inverse(),
+                      &rect, &why)) {
+      std::cout << "rectification: " << rect.Summary() << "\n";
+    }
   }
   std::cout << "time: " << seconds_total << " s wall clock on " << threads
             << (threads == 1 ? " thread" : " threads") << " (images "
@@ -368,8 +380,8 @@ int RunCalibrateRig() {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
   }
-  PrintRigOutcome(result, judged, request.threads, seconds_images,
-                  run_timer.Seconds(), written);
+  PrintRigOutcome(result, request.format, judged, request.threads,
+                  seconds_images, run_timer.Seconds(), written);
   return kExitOk;
 }
 

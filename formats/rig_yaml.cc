@@ -18,12 +18,6 @@ namespace {
 
 constexpr const char* kRigFormatTag = "puzzlecal-rig";
 
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d s;
-  s << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return s;
-}
-
 // Every camera must be one a camera file can hold.
 bool CheckCameras(const RigCalibrationResult& result, std::string* error) {
   if (result.cameras.size() < 2) {
@@ -132,6 +126,8 @@ bool FormatOpenCv(const RigCalibrationResult& result, std::string* text,
     EmitOpenCvMatrix(out, "P1", 3, 4, RowMajor(rect.p1));
     EmitOpenCvMatrix(out, "P2", 3, 4, RowMajor(rect.p2));
     EmitOpenCvMatrix(out, "Q", 4, 4, RowMajor(rect.q));
+    out << YAML::Key << "rectification" << YAML::Value << YAML::DoubleQuoted
+        << rect.Summary();
   } else {
     for (size_t c = 1; c < result.cameras.size(); ++c) {
       const Eigen::Isometry3d from_first =
@@ -149,7 +145,8 @@ bool FormatOpenCv(const RigCalibrationResult& result, std::string* text,
 
 std::string FormatRosCamera(const RigCameraResult& cam,
                             const Eigen::Matrix3d& rectification,
-                            const Eigen::Matrix<double, 3, 4>& projection) {
+                            const Eigen::Matrix<double, 3, 4>& projection,
+                            const std::string& note) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   out << YAML::BeginMap;
@@ -166,7 +163,8 @@ std::string FormatRosCamera(const RigCameraResult& cam,
   EmitRosMatrix(out, "rectification_matrix", 3, 3, RowMajor(rectification));
   EmitRosMatrix(out, "projection_matrix", 3, 4, RowMajor(projection));
   out << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
+  return (note.empty() ? std::string() : "# rectification: " + note + "\n") +
+         out.c_str() + "\n";
 }
 
 bool FormatRos(const RigCalibrationResult& result, const std::string& out_path,
@@ -183,6 +181,7 @@ bool FormatRos(const RigCalibrationResult& result, const std::string& out_path,
     proj[c].setZero();
     proj[c].leftCols<3>() = CameraMatrixOf(result.cameras[c].camera);
   }
+  std::string note;
   if (result.cameras.size() == 2) {
     StereoRectification r;
     if (!StereoRectify(result.cameras[0].camera, result.cameras[1].camera,
@@ -191,6 +190,7 @@ bool FormatRos(const RigCalibrationResult& result, const std::string& out_path,
                        &r, error)) {
       return false;
     }
+    note = r.Summary();
     rect[0] = r.r1;
     rect[1] = r.r2;
     proj[0] = r.p1;
@@ -201,7 +201,7 @@ bool FormatRos(const RigCalibrationResult& result, const std::string& out_path,
     file.path =
         (out.parent_path() / (stem + "_" + result.cameras[c].name + extension))
             .string();
-    file.text = FormatRosCamera(result.cameras[c], rect[c], proj[c]);
+    file.text = FormatRosCamera(result.cameras[c], rect[c], proj[c], note);
     files->push_back(file);
   }
   return true;
@@ -257,63 +257,6 @@ bool FormatKalibr(const RigCalibrationResult& result, std::string* text,
 }
 
 }  // namespace
-
-bool StereoRectify(const Camera& first, const Camera& second,
-                   const Eigen::Isometry3d& second_from_first,
-                   StereoRectification* rect, std::string* error) {
-  const Eigen::Matrix3d k1 = CameraMatrixOf(first), k2 = CameraMatrixOf(second);
-  const Eigen::Matrix3d r = second_from_first.linear();
-  const Eigen::Vector3d t = second_from_first.translation();
-  if (!(t.norm() > 0)) {
-    return Fail("the two cameras share one centre: no stereo rectification",
-                error);
-  }
-  rect->essential = Skew(t) * r;
-  rect->fundamental = k2.inverse().transpose() * rect->essential * k1.inverse();
-  rect->width = first.width;
-  rect->height = first.height;
-  cv::Mat cv_k1, cv_k2, cv_r, cv_t;
-  cv::eigen2cv(k1, cv_k1);
-  cv::eigen2cv(k2, cv_k2);
-  cv::eigen2cv(r, cv_r);
-  cv::eigen2cv(t, cv_t);
-  const cv::Size size(first.width, first.height);
-  cv::Mat r1, r2, p1, p2, q;
-  const bool fisheye1 = first.model == CameraModelId::kKannalaBrandt;
-  const bool fisheye2 = second.model == CameraModelId::kKannalaBrandt;
-  // cv::Mat over a std::vector does not copy: the vectors must outlive the
-  // calls.
-  const std::vector<double> distortion1 = DistortionOf(first);
-  const std::vector<double> distortion2 = DistortionOf(second);
-  try {
-    if (fisheye1 && fisheye2) {
-      const cv::Mat d1(distortion1), d2(distortion2);
-      cv::fisheye::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1, r2,
-                                 p1, p2, q, cv::CALIB_ZERO_DISPARITY, size, 0.0,
-                                 1.0);
-    } else {
-      // A fisheye's coefficients mean nothing to cv::stereoRectify: leave
-      // the distortion out (the rotations do not depend on it).
-      const bool pinholes = !fisheye1 && !fisheye2;
-      const cv::Mat d1 = pinholes ? cv::Mat(distortion1) : cv::Mat();
-      const cv::Mat d2 = pinholes ? cv::Mat(distortion2) : cv::Mat();
-      cv::stereoRectify(cv_k1, d1, cv_k2, d2, size, cv_r, cv_t, r1, r2, p1, p2,
-                        q, cv::CALIB_ZERO_DISPARITY, 0.0);
-    }
-  } catch (const cv::Exception& e) {
-    return Fail(std::string("stereo rectification failed: ") + e.what(), error);
-  }
-  cv::cv2eigen(r1, rect->r1);
-  cv::cv2eigen(r2, rect->r2);
-  cv::cv2eigen(p1, rect->p1);
-  cv::cv2eigen(p2, rect->p2);
-  cv::cv2eigen(q, rect->q);
-  const bool finite = rect->r1.allFinite() && rect->r2.allFinite() &&
-                      rect->p1.allFinite() && rect->p2.allFinite() &&
-                      rect->q.allFinite();
-  if (!finite) return Fail("stereo rectification is not finite", error);
-  return true;
-}
 
 bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
                     const std::string& out_path,

@@ -9,9 +9,10 @@
 //   standard deviations, and the camera's residual statistics;
 // - opencv (readable by cv::FileStorage): K/D per camera and, for two
 //   cameras, R, T (second from first), E, F and the rectification R1 R2 P1
-//   P2 Q (cv::stereoRectify; cv::fisheye::stereoRectify for two
-//   kannala-brandt cameras); for more cameras R_i, T_i of each from the
-//   first;
+//   P2 Q, checked before it is written (formats/stereo_rectification.h:
+//   cv::stereoRectify for pinholes, a pinhole target of a stated field for
+//   a pair with a fisheye), and `rectification`, a line saying what it
+//   keeps; for more cameras R_i, T_i of each from the first;
 // - ros: one camera_info file per camera (OUT_STEM_NAME.yaml), with the
 //   pair's rectification R and projection P for two cameras;
 // - kalibr: a camchain with T_cn_cnm1, cam_overlaps and a rostopic per
@@ -25,6 +26,7 @@
 #include "calib/rig_calibration.h"
 #include "camera/camera_models.h"
 #include "formats/camera_yaml.h"
+#include "formats/stereo_rectification.h"
 
 namespace puzzlecal {
 
@@ -60,24 +62,6 @@ bool ParseRigFile(const std::string& text, const std::string& source,
                   std::vector<RigFileCamera>* cameras, std::string* error);
 bool ReadRigFile(const std::string& path, std::vector<RigFileCamera>* cameras,
                  std::string* error);
-
-// The stereo rectification of the first two cameras of a rig, as OpenCV
-// defines it (R1, R2 rotate each camera into the common rectified frame;
-// P1, P2 project rectified points; Q maps disparity to depth). For two
-// pinhole models cv::stereoRectify, for two kannala-brandt
-// cv::fisheye::stereoRectify; for a pinhole with a fisheye the rotations
-// of cv::stereoRectify with the distortion left out (they do not depend on
-// it) and the intrinsics of the first camera's focal length.
-struct StereoRectification {
-  Eigen::Matrix3d r1, r2;
-  Eigen::Matrix<double, 3, 4> p1, p2;
-  Eigen::Matrix4d q;
-  Eigen::Matrix3d essential, fundamental;  // of the unrectified pair
-  int width = 0, height = 0;               // rectified image size
-};
-bool StereoRectify(const Camera& first, const Camera& second,
-                   const Eigen::Isometry3d& second_from_first,
-                   StereoRectification* rectification, std::string* error);
 
 }  // namespace puzzlecal
 

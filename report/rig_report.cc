@@ -136,7 +136,8 @@ std::string CameraSection(const RigCameraResult& cam, const Evidence* evidence,
 }
 
 std::string RigSummary(const RigReportInput& input,
-                       const std::vector<CameraCharts>& charts, bool pair) {
+                       const std::vector<CameraCharts>& charts, bool pair,
+                       const std::string& rect_note) {
   std::ostringstream md;
   md << "# Rig calibration report\n\n";
   const bool evidence = HasEvidence(input);
@@ -163,7 +164,8 @@ std::string RigSummary(const RigReportInput& input,
     md << "## Rectified pair\n\n`rectified_pair.png`: one frame of the "
           "first two cameras, rectified side by side with horizontal lines; "
           "after a good calibration every board corner lies on the same row "
-          "in both halves.\n\n![rectified_pair.png](rectified_pair.png)\n\n";
+          "in both halves. "
+       << rect_note << "\n\n![rectified_pair.png](rectified_pair.png)\n\n";
   }
   md << "## Time\n\n"
      << StringPrintf("%.2f s on %d threads (images %.2f s).\n",
@@ -239,7 +241,10 @@ StereoRectification ViewingRectification(
   const Eigen::Matrix3d r = second_from_first.linear();
   const Eigen::Vector3d centre =
       -(r.transpose() * second_from_first.translation());
-  const Eigen::Vector3d x = centre.normalized();
+  // x along the baseline, turned to the first camera's +x so that the
+  // picture stays upright whichever side the second camera is on.
+  Eigen::Vector3d x = centre.normalized();
+  if (x.x() < 0) x = -x;
   const Eigen::Vector3d axes =
       (Eigen::Vector3d::UnitZ() + r.transpose() * Eigen::Vector3d::UnitZ())
           .normalized();
@@ -258,7 +263,7 @@ StereoRectification ViewingRectification(
   rect.p1.setZero();
   rect.p1.leftCols<3>() = k;
   rect.p2 = rect.p1;
-  rect.p2(0, 3) = -f * centre.norm();
+  rect.p2(0, 3) = -f * (rect.r1 * centre).x();
   rect.width = first.width;
   rect.height = first.height;
   rect.q.setZero();
@@ -317,16 +322,36 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
     return false;
   }
   const int pair_frame = PairFrame(input);
-  if (!WriteFileAtomically((fs::path(dir) / "summary.md").string(),
-                           RigSummary(input, charts, pair_frame >= 0), error)) {
+  StereoRectification rect;
+  std::string rect_note;
+  if (pair_frame >= 0) {
+    const RigCalibrationResult& result = *input.result;
+    // The rectification the opencv and ros files hold, so that the picture
+    // shows what a user of the files gets; the viewing one where it has
+    // none.
+    const Eigen::Isometry3d second_from_first =
+        result.cameras[1].cam_from_rig *
+        result.cameras[0].cam_from_rig.inverse();
+    std::string why;
+    if (StereoRectify(result.cameras[0].camera, result.cameras[1].camera,
+                      second_from_first, &rect, &why)) {
+      rect_note =
+          "The rectification of the opencv and ros files: " + rect.Summary() +
+          ".";
+    } else {
+      rect = ViewingRectification(result.cameras[0].camera,
+                                  result.cameras[1].camera, second_from_first);
+      rect_note = "The files hold no rectification (" + why +
+                  "); drawn with a viewing rectification.";
+    }
+  }
+  if (!WriteFileAtomically(
+          (fs::path(dir) / "summary.md").string(),
+          RigSummary(input, charts, pair_frame >= 0, rect_note), error)) {
     return false;
   }
   if (pair_frame < 0) return true;
   const RigCalibrationResult& result = *input.result;
-  const StereoRectification rect =
-      ViewingRectification(result.cameras[0].camera, result.cameras[1].camera,
-                           result.cameras[1].cam_from_rig *
-                               result.cameras[0].cam_from_rig.inverse());
   cv::Mat first, second;
   if (!LoadGreyImage(input.files[0][pair_frame], ImageLoadOptions(), &first,
                      error) ||

@@ -305,6 +305,33 @@ RigSceneSpec FisheyePinholeRig(int width, int height) {
   return scene;
 }
 
+RigSceneSpec StereoFisheyeRig(int width, int height, double fov_deg) {
+  RigSceneSpec scene;
+  scene.name = "stereo_fisheye";
+  scene.board = RigBoard();
+  RigSceneCamera left, right;
+  left.name = "cam0";
+  left.camera = FisheyeLensCamera(width, height, fov_deg);
+  left.field_of_view_deg = fov_deg;
+  right.name = "cam1";
+  right.camera = FisheyeLensCamera(width, height, fov_deg, 0.94);
+  right.field_of_view_deg = fov_deg;
+  right.cam_from_rig =
+      CamFromRig(Eigen::Vector3d(-0.11, 0.003, 0.002), 3.0, -0.5);
+  scene.cameras = {left, right};
+  scene.render = RigRender();
+  RigRandomFrames& r = scene.random_frames;
+  r.count = 24;
+  r.seed = 34;
+  r.min_distance_m = 0.4;
+  r.max_distance_m = 0.7;
+  r.min_view_angle_deg = 45;
+  r.max_view_angle_deg = 85;
+  r.max_off_axis_deg = 40;
+  r.target_margin_tiles = 1;
+  return scene;
+}
+
 RigSceneSpec FourCameraRig(int width, int height) {
   RigSceneSpec scene;
   scene.name = "four_cameras";

@@ -117,6 +117,11 @@ RigSceneSpec StereoPinholeRig(int width = 640, int height = 480);
 // degrees away (they overlap only in part); some frames only the pinhole
 // or only the fisheye sees.
 RigSceneSpec FisheyePinholeRig(int width = 640, int height = 480);
+// Two Kannala-Brandt fisheyes of `fov_deg` (beyond 180 by default) side by
+// side, 11 cm apart, the second to the left of the first (so that the
+// rectified x axis points from the second to the first), nearly parallel.
+RigSceneSpec StereoFisheyeRig(int width = 640, int height = 480,
+                              double fov_deg = 190.0);
 // Four cameras of three models: a fisheye reference, pinholes turned +50
 // (radtan) and -50 degrees (rational) and a radtan turned +100 degrees that
 // shares frames with the +50 one (and the fisheye's rim) only.

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -222,6 +223,160 @@ TEST(CalibrateRigTest, FisheyeAndPinholeRendersMeetTheFigures) {
   std::cout << run.output;
 }
 
+// One camera of a rectification file as a user reads it: K, D, R, P.
+struct RectifiedCamera {
+  bool fisheye = false;
+  cv::Mat k, d, r, p;
+  int width = 0, height = 0;
+};
+
+// Rectifies `pixels` through OpenCV's own undistortion (not puzzlecal's).
+std::vector<cv::Point2d> OpenCvRectify(const RectifiedCamera& cam,
+                                       const std::vector<cv::Point2d>& pixels) {
+  std::vector<cv::Point2d> out;
+  if (pixels.empty()) return out;
+  if (cam.fisheye) {
+    cv::fisheye::undistortPoints(pixels, out, cam.k, cam.d, cam.r, cam.p);
+  } else {
+    cv::undistortPoints(pixels, out, cam.k, cam.d, cam.r, cam.p);
+  }
+  return out;
+}
+
+// Share of the rectified image whose pixel maps into the camera's image
+// (OpenCV's own rectification maps).
+double OpenCvValidFraction(const RectifiedCamera& cam) {
+  cv::Mat map_x, map_y;
+  const cv::Size size(cam.width, cam.height);
+  if (cam.fisheye) {
+    cv::fisheye::initUndistortRectifyMap(cam.k, cam.d, cam.r, cam.p, size,
+                                         CV_32FC1, map_x, map_y);
+  } else {
+    cv::initUndistortRectifyMap(cam.k, cam.d, cam.r, cam.p, size, CV_32FC1,
+                                map_x, map_y);
+  }
+  int inside = 0;
+  for (int v = 0; v < size.height; ++v) {
+    for (int u = 0; u < size.width; ++u) {
+      const float x = map_x.at<float>(v, u), y = map_y.at<float>(v, u);
+      inside += x >= 0 && y >= 0 && x <= cam.width - 1 && y <= cam.height - 1;
+    }
+  }
+  return static_cast<double>(inside) / (size.width * size.height);
+}
+
+// The scene's own corners (exact projections), matched by board point in
+// every frame both cameras see, rectified with the file's matrices by
+// OpenCV: the median row difference is at most 0.1 px, and each camera
+// covers a non-empty part of its rectified image.
+void ExpectFileRectifiesOwnCorners(const RigSceneSpec& scene,
+                                   const RectifiedCamera& first,
+                                   const RectifiedCamera& second) {
+  const std::vector<RigCameraInput> views = RigCorrespondences(scene, 0.0);
+  std::vector<double> rows;
+  for (size_t f = 0; f < views[0].frames.size(); ++f) {
+    const CalibrationView& a = views[0].frames[f];
+    const CalibrationView& b = views[1].frames[f];
+    std::vector<cv::Point2d> pa, pb;
+    for (size_t i = 0; i < a.board_points.size(); ++i) {
+      for (size_t j = 0; j < b.board_points.size(); ++j) {
+        if ((a.board_points[i] - b.board_points[j]).norm() > 1e-9) continue;
+        pa.emplace_back(a.image_points[i].x(), a.image_points[i].y());
+        pb.emplace_back(b.image_points[j].x(), b.image_points[j].y());
+      }
+    }
+    const std::vector<cv::Point2d> ra = OpenCvRectify(first, pa);
+    const std::vector<cv::Point2d> rb = OpenCvRectify(second, pb);
+    for (size_t i = 0; i < ra.size(); ++i) {
+      rows.push_back(std::abs(ra[i].y - rb[i].y));
+    }
+  }
+  ASSERT_GT(rows.size(), 50u);
+  std::nth_element(rows.begin(), rows.begin() + rows.size() / 2, rows.end());
+  const double median = rows[rows.size() / 2];
+  const double valid1 = OpenCvValidFraction(first);
+  const double valid2 = OpenCvValidFraction(second);
+  std::cout << "rectified rows of " << rows.size()
+            << " corner pairs: median difference " << median
+            << " px; valid region " << valid1 << ", " << valid2 << "\n";
+  EXPECT_LE(median, 0.1);
+  EXPECT_GT(valid1, 0.05);
+  EXPECT_GT(valid2, 0.05);
+}
+
+RectifiedCamera ReadOpenCvCamera(const cv::FileStorage& storage, int n,
+                                 bool fisheye, int width, int height) {
+  RectifiedCamera cam;
+  const std::string i = std::to_string(n);
+  storage["K" + i] >> cam.k;
+  storage["D" + i] >> cam.d;
+  storage["R" + i] >> cam.r;
+  storage["P" + i] >> cam.p;
+  cam.fisheye = fisheye;
+  cam.width = width;
+  cam.height = height;
+  return cam;
+}
+
+cv::Mat RosMatrix(const YAML::Node& node, int rows, int cols) {
+  const std::vector<double> data = node["data"].as<std::vector<double>>();
+  cv::Mat m(rows, cols, CV_64F);
+  for (int k = 0; k < rows * cols; ++k)
+    m.at<double>(k / cols, k % cols) = data[k];
+  return m;
+}
+
+RectifiedCamera ReadRosCamera(const fs::path& path, bool fisheye) {
+  const YAML::Node root = YAML::LoadFile(path.string());
+  RectifiedCamera cam;
+  cam.k = RosMatrix(root["camera_matrix"], 3, 3);
+  const int n =
+      static_cast<int>(root["distortion_coefficients"]["data"].size());
+  cam.d = RosMatrix(root["distortion_coefficients"], 1, n);
+  cam.r = RosMatrix(root["rectification_matrix"], 3, 3);
+  cam.p = RosMatrix(root["projection_matrix"], 3, 4);
+  cam.fisheye = fisheye;
+  cam.width = root["image_width"].as<int>();
+  cam.height = root["image_height"].as<int>();
+  return cam;
+}
+
+TEST(CalibrateRigTest, FisheyePairFilesRectifyTheirOwnCorners) {
+  const RenderedRig rig = Render(StereoFisheyeRig(), "fisheye_pair");
+  for (const char* format : {"opencv", "ros"}) {
+    SCOPED_TRACE(format);
+    const fs::path out = rig.root / (std::string(format) + ".yaml");
+    const fs::path report = rig.root / (std::string(format) + "_report");
+    const RunResult run = RunProgram(
+        "calibrate-rig --images " + rig.images.string() + " --board " +
+        rig.board + " --model kannala-brandt --format " + format + " --out " +
+        out.string() + " --threads 2" +
+        (std::string(format) == "opencv" ? " --report " + report.string()
+                                         : std::string()));
+    ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+    std::cout << run.output;
+    EXPECT_NE(run.output.find("rectification: a pinhole target"),
+              std::string::npos)
+        << run.output;
+    if (std::string(format) == "opencv") {
+      cv::FileStorage storage(out.string(), cv::FileStorage::READ);
+      ASSERT_TRUE(storage.isOpened());
+      const std::string note = storage["rectification"];
+      EXPECT_NE(note.find("field 120.0"), std::string::npos) << note;
+      ExpectFileRectifiesOwnCorners(
+          rig.scene, ReadOpenCvCamera(storage, 1, true, 640, 480),
+          ReadOpenCvCamera(storage, 2, true, 640, 480));
+      // The report's rectified pair is drawn upright from the file: the
+      // board seen by the first camera is in its left half.
+      EXPECT_TRUE(fs::exists(report / "rectified_pair.png"));
+    } else {
+      ExpectFileRectifiesOwnCorners(
+          rig.scene, ReadRosCamera(rig.root / "ros_cam0.yaml", true),
+          ReadRosCamera(rig.root / "ros_cam1.yaml", true));
+    }
+  }
+}
+
 TEST(CalibrateRigTest, StereoPinholeRendersInOpenCvFormat) {
   const RenderedRig rig = Render(StereoPinholeRig(), "stereo");
   const fs::path out = rig.root / "stereo.yaml";
@@ -256,6 +411,9 @@ TEST(CalibrateRigTest, StereoPinholeRendersInOpenCvFormat) {
     storage[key] >> m;
     EXPECT_FALSE(m.empty()) << key;
   }
+  ExpectFileRectifiesOwnCorners(rig.scene,
+                                ReadOpenCvCamera(storage, 1, false, 640, 480),
+                                ReadOpenCvCamera(storage, 2, false, 640, 480));
 }
 
 // Kalibr's radtan has 4 coefficients: --format kalibr calibrates

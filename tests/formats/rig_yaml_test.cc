@@ -184,6 +184,13 @@ TEST(RigYamlTest, OpenCvFormatOfAFisheyePairRectifies) {
                             ResultFromScene(scene), nullptr, &error))
       << error;
   ExpectRectifies(scene, path);
+  // A pinhole target of the stated field (cv::fisheye::stereoRectify's
+  // defaults give a focal length of a few pixels on a 180-degree lens).
+  cv::FileStorage fs(path, cv::FileStorage::READ);
+  const Eigen::MatrixXd p1 = ReadMatrix(fs, "P1");
+  EXPECT_NEAR(p1(0, 0), 319.5 / std::tan(60 * M_PI / 180), 1.0);
+  const std::string note = fs["rectification"];
+  EXPECT_NE(note.find("field 120.0"), std::string::npos) << note;
 }
 
 TEST(RigYamlTest, RosFormatWritesOneCameraInfoPerCamera) {
