@@ -38,14 +38,17 @@ std::vector<std::string> CameraModelParamNames(CameraModelId id) {
   });
 }
 
+CameraFamily CameraModelFamily(CameraModelId id) {
+  return DispatchCameraModel(
+      id, [](auto model) { return decltype(model)::kFamily; });
+}
+
 bool CameraModelIsPinhole(CameraModelId id) {
-  return id == CameraModelId::kPinholeRadtan ||
-         id == CameraModelId::kPinholeRational;
+  return CameraModelFamily(id) == CameraFamily::kPinhole;
 }
 
 bool CameraModelIsFisheye(CameraModelId id) {
-  return id == CameraModelId::kKannalaBrandt ||
-         id == CameraModelId::kKannalaBrandtNoncentral;
+  return CameraModelFamily(id) == CameraFamily::kFisheye;
 }
 
 bool CameraModelIsCentral(CameraModelId id) {
@@ -53,11 +56,26 @@ bool CameraModelIsCentral(CameraModelId id) {
       id, [](auto model) { return decltype(model)::kCentral; });
 }
 
+double FieldRadius(const Camera& camera, const Eigen::Vector3d& ray) {
+  return DispatchCameraModel(camera.model, [&](auto model) {
+    return decltype(model)::FieldRadius(ray.data());
+  });
+}
+
+double MaxMonotonicRadius(const Camera& camera) {
+  return DispatchCameraModel(camera.model, [&](auto model) {
+    return decltype(model)::MaxMonotonicRadius(camera.params.data());
+  });
+}
+
 Camera FarFieldCamera(const Camera& camera) {
   Camera far = camera;
-  if (camera.model == CameraModelId::kKannalaBrandtNoncentral) {
-    far.model = CameraModelId::kKannalaBrandt;
-    far.params.resize(std::min<size_t>(far.params.size(), kPupilBegin));
+  far.model = DispatchCameraModel(
+      camera.model, [](auto model) { return decltype(model)::kFarFieldId; });
+  if (far.model != camera.model) {
+    // The far-field model's parameters are the first ones of the model's.
+    far.params.resize(
+        std::min<size_t>(far.params.size(), CameraModelNumParams(far.model)));
   }
   return far;
 }

@@ -2,9 +2,12 @@
 #define PUZZLECAL_CAMERA_CAMERA_MODELS_H_
 
 // Camera models: stateless structs with a fixed parameter count, named
-// parameters, a templated Project (double and ceres::Jet) and an iterative
-// Unproject. One closed list of models (CameraModelId) and one dispatch point
-// (DispatchCameraModel).
+// parameters, their facts (name, family, central or not, far-field model,
+// the field radius and where the distortion stops being monotonic), a
+// templated Project (double and ceres::Jet) and an iterative Unproject. One
+// closed list of models (CameraModelList) and one dispatch point
+// (DispatchCameraModel). A new model is its struct, its CameraModelId and
+// its entry in CameraModelList; everything else reads the struct.
 //
 // Conventions (shared with OpenCV, so results can be checked against
 // cv::projectPoints / cv::fisheye::projectPoints):
@@ -16,7 +19,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -27,6 +32,15 @@ enum class CameraModelId {
   kPinholeRational,
   kKannalaBrandt,
   kKannalaBrandtNoncentral,
+};
+
+// How a model maps the field angle to the image: pinhole models through the
+// radius in the normalised image plane (tan of the angle; points must be in
+// front of the camera), fisheye models through the angle itself (rays
+// beyond 90 degrees too).
+enum class CameraFamily {
+  kPinhole,
+  kFisheye,
 };
 
 // Parameter groups, the same index ranges for every model.
@@ -64,6 +78,41 @@ double ScalarPart(const T& x) {
 // selects the 12-parameter form (k4 k5 k6 in the denominator).
 template <bool Rational>
 struct PinholeDistorted {
+  static constexpr CameraFamily kFamily = CameraFamily::kPinhole;
+
+  // The radius the distortion is a function of, for a ray in the camera
+  // frame: |(x, y)| / z (infinity behind the camera).
+  static double FieldRadius(const double* ray) {
+    if (!(ray[2] > 0)) return std::numeric_limits<double>::infinity();
+    return std::sqrt(ray[0] * ray[0] + ray[1] * ray[1]) / ray[2];
+  }
+
+  // The field radius up to which the distorted radius r * radial(r) keeps
+  // growing (beyond it the image folds over), scanned up to a 89.9-degree
+  // ray.
+  static double MaxMonotonicRadius(const double* p) {
+    auto distorted = [&](double r) {
+      const double r2 = r * r, r4 = r2 * r2, r6 = r4 * r2;
+      double radial = 1 + p[4] * r2 + p[5] * r4 + p[8] * r6;
+      if constexpr (Rational) radial /= 1 + p[9] * r2 + p[10] * r4 + p[11] * r6;
+      return r * radial;
+    };
+    constexpr double kMaxRadius = 572.0;  // tan(89.9 degrees)
+    constexpr int kSteps = 20000;
+    double previous = 0.0;
+    for (int i = 1; i <= kSteps; ++i) {
+      // Finer steps near the centre, where lenses live.
+      const double r =
+          kMaxRadius * std::pow(static_cast<double>(i) / kSteps, 3);
+      const double value = distorted(r);
+      if (!(value > previous)) {
+        return kMaxRadius * std::pow(static_cast<double>(i - 1) / kSteps, 3);
+      }
+      previous = value;
+    }
+    return kMaxRadius;
+  }
+
   template <typename T>
   static void Distort(const T* params, const T& x, const T& y, T* xd, T* yd) {
     const T& k1 = params[4];
@@ -158,6 +207,7 @@ struct PinholeRadtanModel : internal::PinholeDistorted<false> {
   static constexpr CameraModelId kId = CameraModelId::kPinholeRadtan;
   static constexpr const char* kName = "pinhole-radtan";
   static constexpr bool kCentral = true;  // every ray starts at the origin
+  static constexpr CameraModelId kFarFieldId = kId;
   static constexpr int kNumParams = 9;
   static constexpr std::array<const char*, kNumParams> kParamNames = {
       "fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
@@ -169,6 +219,7 @@ struct PinholeRationalModel : internal::PinholeDistorted<true> {
   static constexpr CameraModelId kId = CameraModelId::kPinholeRational;
   static constexpr const char* kName = "pinhole-rational";
   static constexpr bool kCentral = true;  // every ray starts at the origin
+  static constexpr CameraModelId kFarFieldId = kId;
   static constexpr int kNumParams = 12;
   static constexpr std::array<const char*, kNumParams> kParamNames = {
       "fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
@@ -180,10 +231,34 @@ struct PinholeRationalModel : internal::PinholeDistorted<true> {
 struct KannalaBrandtModel {
   static constexpr CameraModelId kId = CameraModelId::kKannalaBrandt;
   static constexpr const char* kName = "kannala-brandt";
+  static constexpr CameraFamily kFamily = CameraFamily::kFisheye;
   static constexpr bool kCentral = true;  // every ray starts at the origin
+  static constexpr CameraModelId kFarFieldId = kId;
   static constexpr int kNumParams = 8;
   static constexpr std::array<const char*, kNumParams> kParamNames = {
       "fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4"};
+
+  // The angle theta the distortion is a function of, for a ray in the
+  // camera frame.
+  static double FieldRadius(const double* ray) {
+    return std::atan2(std::sqrt(ray[0] * ray[0] + ray[1] * ray[1]), ray[2]);
+  }
+
+  // The angle up to which theta_d(theta) keeps growing (beyond it the image
+  // folds over), at most pi: the first angle where
+  // d theta_d / d theta = 1 + 3 k1 t^2 + 5 k2 t^4 + 7 k3 t^6 + 9 k4 t^8
+  // stops being positive.
+  static double MaxMonotonicRadius(const double* p) {
+    constexpr int kSteps = 4000;
+    for (int i = 1; i <= kSteps; ++i) {
+      const double t = M_PI * i / kSteps;
+      const double t2 = t * t, t4 = t2 * t2, t6 = t4 * t2, t8 = t4 * t4;
+      const double slope =
+          1 + 3 * p[4] * t2 + 5 * p[5] * t4 + 7 * p[6] * t6 + 9 * p[7] * t8;
+      if (!(slope > 0)) return M_PI * (i - 1) / kSteps;
+    }
+    return M_PI;
+  }
 
   template <typename T>
   static T DistortTheta(const T* params, const T& theta) {
@@ -277,7 +352,10 @@ struct KannalaBrandtModel {
 struct KannalaBrandtNoncentralModel {
   static constexpr CameraModelId kId = CameraModelId::kKannalaBrandtNoncentral;
   static constexpr const char* kName = "kannala-brandt-noncentral";
+  static constexpr CameraFamily kFamily = CameraFamily::kFisheye;
   static constexpr bool kCentral = false;
+  // Far points see kannala-brandt with the first 8 parameters (no e1 e2).
+  static constexpr CameraModelId kFarFieldId = CameraModelId::kKannalaBrandt;
   static constexpr int kNumParams = 10;
   static constexpr std::array<const char*, kNumParams> kParamNames = {
       "fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4", "e1", "e2"};
@@ -294,6 +372,14 @@ struct KannalaBrandtNoncentralModel {
   // the input, wherever it is evaluated.
   static constexpr int kThetaIterations = 7;
   static constexpr double kThetaConvergedStep = 1e-9;
+
+  // The radial distortion is kannala-brandt's.
+  static double FieldRadius(const double* ray) {
+    return KannalaBrandtModel::FieldRadius(ray);
+  }
+  static double MaxMonotonicRadius(const double* params) {
+    return KannalaBrandtModel::MaxMonotonicRadius(params);
+  }
 
   template <typename T>
   static T PupilZ(const T* params, const T& theta) {
@@ -400,27 +486,52 @@ struct KannalaBrandtNoncentralModel {
   }
 };
 
+// The one list of models, in the order of CameraModelId.
+using CameraModelList =
+    std::tuple<PinholeRadtanModel, PinholeRationalModel, KannalaBrandtModel,
+               KannalaBrandtNoncentralModel>;
+inline constexpr int kNumCameraModels = std::tuple_size_v<CameraModelList>;
+
+namespace internal {
+
+template <size_t... I>
+constexpr std::array<CameraModelId, sizeof...(I)> ModelIds(
+    std::index_sequence<I...>) {
+  return {std::tuple_element_t<I, CameraModelList>::kId...};
+}
+
+template <size_t... I>
+constexpr bool IdsFollowTheList(std::index_sequence<I...>) {
+  return ((static_cast<size_t>(std::tuple_element_t<I, CameraModelList>::kId) ==
+           I) &&
+          ...);
+}
+static_assert(IdsFollowTheList(std::make_index_sequence<kNumCameraModels>()),
+              "CameraModelList must list the models in CameraModelId order");
+
+}  // namespace internal
+
 // Calls fn(Model{}) with the model struct for `id`; the one dispatch point from
-// a runtime model id to the templates above.
+// a runtime model id to the templates above. The switch has no default, so
+// the compiler names it when CameraModelId gains a value.
 template <typename Fn>
 decltype(auto) DispatchCameraModel(CameraModelId id, Fn&& fn) {
   switch (id) {
     case CameraModelId::kPinholeRadtan:
-      return fn(PinholeRadtanModel{});
+      return fn(std::tuple_element_t<0, CameraModelList>{});
     case CameraModelId::kPinholeRational:
-      return fn(PinholeRationalModel{});
+      return fn(std::tuple_element_t<1, CameraModelList>{});
     case CameraModelId::kKannalaBrandt:
-      return fn(KannalaBrandtModel{});
+      return fn(std::tuple_element_t<2, CameraModelList>{});
     case CameraModelId::kKannalaBrandtNoncentral:
-      return fn(KannalaBrandtNoncentralModel{});
+      return fn(std::tuple_element_t<3, CameraModelList>{});
   }
-  return fn(PinholeRadtanModel{});  // unreachable for valid ids
+  return fn(std::tuple_element_t<0, CameraModelList>{});  // invalid ids only
 }
 
 // All models, in the order of CameraModelId.
-inline constexpr std::array<CameraModelId, 4> kAllCameraModels = {
-    CameraModelId::kPinholeRadtan, CameraModelId::kPinholeRational,
-    CameraModelId::kKannalaBrandt, CameraModelId::kKannalaBrandtNoncentral};
+inline constexpr std::array<CameraModelId, kNumCameraModels> kAllCameraModels =
+    internal::ModelIds(std::make_index_sequence<kNumCameraModels>());
 
 // "pinhole-radtan", "pinhole-rational", "kannala-brandt",
 // "kannala-brandt-noncentral".
@@ -431,6 +542,7 @@ bool CameraModelIdFromName(const std::string& name, CameraModelId* id);
 std::string CameraModelNames();
 int CameraModelNumParams(CameraModelId id);
 std::vector<std::string> CameraModelParamNames(CameraModelId id);
+CameraFamily CameraModelFamily(CameraModelId id);
 // True for the pinhole models (points must have z > 0).
 bool CameraModelIsPinhole(CameraModelId id);
 // True for the fisheye models (kannala-brandt and its non-central form:
@@ -472,6 +584,15 @@ struct Camera {
     return UnprojectPixelToRay(model, params.data(), pixel, ray);
   }
 };
+
+// The field radius of `ray` (camera frame) that the model's distortion is a
+// function of: tan of the field angle for pinhole models, the angle for
+// fisheye models.
+double FieldRadius(const Camera& camera, const Eigen::Vector3d& ray);
+// The field radius up to which the camera's distortion is monotonic (the
+// image folds over beyond it): pi at most for fisheye models, tan(89.9 deg)
+// for pinhole models.
+double MaxMonotonicRadius(const Camera& camera);
 
 // The central model whose projection a non-central one approaches for far
 // points, and its parameters (the model itself for central ones):

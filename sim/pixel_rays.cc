@@ -33,51 +33,6 @@ bool CheckRenderCamera(const Camera& camera, std::string* why) {
   return true;
 }
 
-double MaxMonotonicRadius(const Camera& camera) {
-  const std::vector<double>& p = camera.params;
-  if (CameraModelIsFisheye(camera.model)) {
-    // d theta_d / d theta = 1 + 3 k1 t^2 + 5 k2 t^4 + 7 k3 t^6 + 9 k4 t^8.
-    constexpr int kSteps = 4000;
-    for (int i = 1; i <= kSteps; ++i) {
-      const double t = M_PI * i / kSteps;
-      const double t2 = t * t, t4 = t2 * t2, t6 = t4 * t2, t8 = t4 * t4;
-      const double slope =
-          1 + 3 * p[4] * t2 + 5 * p[5] * t4 + 7 * p[6] * t6 + 9 * p[7] * t8;
-      if (!(slope > 0)) return M_PI * (i - 1) / kSteps;
-    }
-    return M_PI;
-  }
-  // Pinhole: r_d(r) = r * radial(r); scan r up to a 89.9-degree ray.
-  const bool rational = camera.model == CameraModelId::kPinholeRational;
-  auto distorted = [&](double r) {
-    const double r2 = r * r, r4 = r2 * r2, r6 = r4 * r2;
-    double radial = 1 + p[4] * r2 + p[5] * r4 + p[8] * r6;
-    if (rational) radial /= 1 + p[9] * r2 + p[10] * r4 + p[11] * r6;
-    return r * radial;
-  };
-  constexpr double kMaxRadius = 572.0;  // tan(89.9 degrees)
-  constexpr int kSteps = 20000;
-  double previous = 0.0;
-  for (int i = 1; i <= kSteps; ++i) {
-    // Finer steps near the centre, where lenses live.
-    const double r = kMaxRadius * std::pow(static_cast<double>(i) / kSteps, 3);
-    const double value = distorted(r);
-    if (!(value > previous)) {
-      return kMaxRadius * std::pow(static_cast<double>(i - 1) / kSteps, 3);
-    }
-    previous = value;
-  }
-  return kMaxRadius;
-}
-
-double UndistortedRadius(const Camera& camera, const Eigen::Vector3d& ray) {
-  if (CameraModelIsFisheye(camera.model)) {
-    return std::atan2(ray.head<2>().norm(), ray.z());
-  }
-  if (!(ray.z() > 0)) return std::numeric_limits<double>::infinity();
-  return ray.head<2>().norm() / ray.z();
-}
-
 bool PixelRayGrid::Compute(const Camera& camera, std::string* why) {
   rays_.clear();
   origin_z_.clear();
@@ -107,8 +62,7 @@ bool PixelRayGrid::Compute(const Camera& camera, std::string* why) {
         }
         if (!status.converged || !std::isfinite(ray[0]) ||
             !std::isfinite(ray[1]) || !std::isfinite(ray[2]) ||
-            !(UndistortedRadius(camera,
-                                Eigen::Vector3d(ray[0], ray[1], ray[2])) <
+            !(FieldRadius(camera, Eigen::Vector3d(ray[0], ray[1], ray[2])) <
               max_radius)) {
           ray[0] = ray[1] = ray[2] = std::numeric_limits<double>::quiet_NaN();
           ++invalid_per_row[cy];

@@ -21,18 +21,6 @@ namespace puzzlecal {
 // outside [1, 20000].
 bool CheckRenderCamera(const Camera& camera, std::string* why = nullptr);
 
-// Where the camera model stays one-to-one: the largest undistorted radius
-// (pinhole models: |(x/z, y/z)|; the kannala-brandt models: the angle theta
-// from the axis, at most pi) up to which the radial distortion keeps
-// increasing.
-// Beyond it the polynomial folds back and the image shows nothing real.
-double MaxMonotonicRadius(const Camera& camera);
-
-// The undistorted radius of a camera-frame ray direction in the sense of
-// MaxMonotonicRadius (infinity for pinhole rays with z <= 0). For a
-// non-central camera pass the direction from the ray's origin.
-double UndistortedRadius(const Camera& camera, const Eigen::Vector3d& ray);
-
 class PixelRayGrid {
  public:
   // Unprojects the (width + 1) x (height + 1) pixel corners of `camera`.

@@ -155,7 +155,7 @@ std::vector<TruthCorner> ProjectBoardCorners(
       seen_from = point - ray.origin;
       const double cos_angle = ray.direction.dot(seen_from.normalized());
       visible = status.converged && cos_angle > std::cos(1e-6) &&
-                UndistortedRadius(camera, seen_from) < max_radius;
+                FieldRadius(camera, seen_from) < max_radius;
     }
     if (visible && options.field_of_view_deg > 0) {
       // One pixel of margin, measured by the model's local ray spread.

@@ -304,5 +304,103 @@ TEST(CameraModelsTest, NameDispatch) {
   EXPECT_NE(CameraModelNames().find("kannala-brandt"), std::string::npos);
 }
 
+// The family says how the field angle reaches the image: a fisheye model
+// projects a point 100 degrees off the axis, a pinhole model refuses it.
+TEST(CameraModelFacts, FamilyMatchesWhatProjectAccepts) {
+  const double angle = 100 * M_PI / 180;
+  const Eigen::Vector3d behind(std::sin(angle), 0.0, std::cos(angle));
+  for (CameraModelId id : kAllCameraModels) {
+    Eigen::Vector2d pixel;
+    const bool projected =
+        ProjectPoint(id, ParamsFor(id).data(), behind, &pixel);
+    EXPECT_EQ(projected, CameraModelIsFisheye(id)) << CameraModelName(id);
+    EXPECT_NE(CameraModelIsFisheye(id), CameraModelIsPinhole(id));
+  }
+}
+
+// FieldRadius is tan(angle) for pinhole models and the angle for fisheyes.
+TEST(CameraModelFacts, FieldRadiusOfARay) {
+  const double angle = 40 * M_PI / 180;
+  const Eigen::Vector3d ray(0.6 * std::sin(angle), 0.8 * std::sin(angle),
+                            std::cos(angle));
+  for (CameraModelId id : kAllCameraModels) {
+    Camera camera;
+    camera.model = id;
+    camera.params = ParamsFor(id);
+    const double expected = CameraModelIsFisheye(id) ? angle : std::tan(angle);
+    EXPECT_NEAR(FieldRadius(camera, ray), expected, 1e-12)
+        << CameraModelName(id);
+  }
+  Camera pinhole;
+  pinhole.params = kRadtan;
+  EXPECT_TRUE(std::isinf(FieldRadius(pinhole, Eigen::Vector3d(0.1, 0, -1))));
+}
+
+// MaxMonotonicRadius is where the projected radius stops growing: checked
+// through Project on both sides, against the closed form of a pure k1 lens.
+TEST(CameraModelFacts, MaxMonotonicRadiusIsWhereTheImageFoldsOver) {
+  struct Case {
+    CameraModelId id;
+    std::vector<double> params;
+    double fold;  // where d(r_d)/dr = 0
+  };
+  const std::vector<Case> cases = {
+      // r (1 - 0.5 r^2): 1 - 1.5 r^2 = 0.
+      {CameraModelId::kPinholeRadtan,
+       {500, 500, 320, 240, -0.5, 0, 0, 0, 0},
+       std::sqrt(1 / 1.5)},
+      // theta (1 - 0.1 theta^2): 1 - 0.3 theta^2 = 0.
+      {CameraModelId::kKannalaBrandt,
+       {500, 500, 320, 240, -0.1, 0, 0, 0},
+       std::sqrt(1 / 0.3)},
+  };
+  for (const Case& c : cases) {
+    Camera camera;
+    camera.model = c.id;
+    camera.params = c.params;
+    const double fold = MaxMonotonicRadius(camera);
+    EXPECT_NEAR(fold, c.fold, 2e-3) << CameraModelName(c.id);
+    // The image radius along x of a ray at field radius r.
+    auto image_radius = [&](double r) {
+      const Eigen::Vector3d ray =
+          CameraModelIsFisheye(c.id)
+              ? Eigen::Vector3d(std::sin(r), 0, std::cos(r))
+              : Eigen::Vector3d(r, 0, 1);
+      Eigen::Vector2d pixel;
+      EXPECT_TRUE(camera.Project(ray, &pixel));
+      return pixel.x() - c.params[2];
+    };
+    EXPECT_LT(image_radius(fold - 0.02), image_radius(fold - 0.01));
+    EXPECT_GT(image_radius(fold + 0.01), image_radius(fold + 0.02));
+  }
+  // A lens without distortion never folds within the scanned range.
+  Camera plain;
+  plain.params = {500, 500, 320, 240, 0, 0, 0, 0, 0};
+  EXPECT_NEAR(MaxMonotonicRadius(plain), 572.0, 1e-9);
+}
+
+// The far-field camera of the non-central model is kannala-brandt with its
+// first eight parameters; central models are their own far field.
+TEST(CameraModelFacts, FarFieldCamera) {
+  for (CameraModelId id : kAllCameraModels) {
+    Camera camera;
+    camera.model = id;
+    camera.params = ParamsFor(id);
+    const Camera far = FarFieldCamera(camera);
+    EXPECT_TRUE(CameraModelIsCentral(far.model));
+    EXPECT_EQ(static_cast<int>(far.params.size()),
+              CameraModelNumParams(far.model));
+    // Far points project the same through both.
+    const Eigen::Vector3d point(3.0, -2.0, 1000.0);
+    Eigen::Vector2d a, b;
+    ASSERT_TRUE(camera.Project(point, &a));
+    ASSERT_TRUE(far.Project(point, &b));
+    EXPECT_LT((a - b).norm(), 1e-3) << CameraModelName(id);
+    if (CameraModelIsCentral(id)) {
+      EXPECT_EQ(far.model, id);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace puzzlecal
