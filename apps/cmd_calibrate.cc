@@ -22,7 +22,7 @@
 #include "apps/subcommand.h"
 #include "calib/calibrate.h"
 #include "evidence/evidence.h"
-#include "evidence/model_advice.h"
+#include "evidence/judgement.h"
 #include "evidence/model_selection.h"
 #include "evidence/verdict.h"
 #include "formats/board_file.h"
@@ -411,16 +411,17 @@ int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
   if (!run->calibrated && !mismatch.empty()) run->calibration_error = mismatch;
   run->seconds_calibrate = calib_timer.Seconds();
   if (!run->calibrated) return kExitOk;
-  const EvidenceOptions& evidence_options = request.options.evidence;
-  run->evidence = ComputeEvidence(
-      run->views, run->result, request.calibration_options, evidence_options);
-  run->verdict = MakeVerdict(run->result, run->evidence, evidence_options,
-                             request.options.verdict);
-  // A suggested model is advised only after it has won on held-out views.
-  CheckModelAdvice(run->views, run->result, request.calibration_options,
-                   request.options.model_selection,
-                   request.auto_model ? &run->selection : nullptr,
-                   &run->verdict);
+  // The evidence, the verdict and the model advice (evidence/judgement.h:
+  // the steps every user of the library takes).
+  JudgementOptions judgement_options;
+  judgement_options.evidence = request.options.evidence;
+  judgement_options.verdict = request.options.verdict;
+  judgement_options.model_selection = request.options.model_selection;
+  Judgement judgement = JudgeCalibration(
+      run->views, run->result, request.calibration_options, judgement_options,
+      request.auto_model ? &run->selection : nullptr);
+  run->evidence = std::move(judgement.evidence);
+  run->verdict = std::move(judgement.verdict);
   return kExitOk;
 }
 
