@@ -251,6 +251,41 @@ int DetectCamera(const RigRequest& request, size_t c,
   return kExitBadInput;
 }
 
+// A plain checkerboard's corner grid is the same after half a turn about
+// its centre (which camera labels it which way is settled from the rig's
+// poses); a PuzzleBoard's ids are absolute.
+RigBoardSymmetry BoardSymmetry(const Board& board) {
+  RigBoardSymmetry symmetry;
+  symmetry.half_turn = board.type == BoardType::kCheckerboard;
+  symmetry.centre =
+      0.5 * (board.Point(board.origin) +
+             board.Point(board.origin +
+                         Eigen::Vector2i(board.cols - 1, board.rows - 1)));
+  return symmetry;
+}
+
+// A view of a plain checkerboard that the rig left out and that holds only
+// part of the board: say so (a part has no labels of its own).
+void NotePartialCheckerboards(const Board& board,
+                              const std::vector<RigCameraInput>& inputs,
+                              RigCalibrationResult* result) {
+  if (board.type != BoardType::kCheckerboard) return;
+  for (size_t c = 0; c < result->cameras.size(); ++c) {
+    RigCameraResult& cam = result->cameras[c];
+    for (size_t f = 0; f < cam.frame_note.size(); ++f) {
+      const size_t found = inputs[c].frames[f].board_points.size();
+      if (cam.frame_note[f].rfind("not used", 0) != 0 || found == 0 ||
+          static_cast<int>(found) >= board.NumCorners()) {
+        continue;
+      }
+      cam.frame_note[f] += " (" + std::to_string(found) + " of " +
+                           std::to_string(board.NumCorners()) +
+                           " corners found: a part of a plain checkerboard "
+                           "can be labelled in several ways)";
+    }
+  }
+}
+
 // Each camera's own calibration judged as `calibrate` judges one camera
 // (halves, uncertainty, binned residuals; evidence/evidence.h,
 // evidence/verdict.h), once, for the report and the output alike.
@@ -275,13 +310,40 @@ CameraJudgements JudgeCameras(const std::vector<RigCameraInput>& inputs,
   return judged;
 }
 
+// The frames' notes (relabelled views of a symmetric board, views left
+// out and why), each named by its file.
+void PrintFrameNotes(const RigCalibrationResult& result,
+                     const std::vector<std::vector<std::string>>& frame_files) {
+  bool relabelled = false;
+  for (size_t c = 0; c < result.cameras.size(); ++c) {
+    const RigCameraResult& cam = result.cameras[c];
+    for (size_t f = 0; f < cam.frame_note.size(); ++f) {
+      if (cam.frame_note[f].empty()) continue;
+      const std::string& file = frame_files[c][f];
+      std::cout << "frame " << f + 1 << " ("
+                << (file.empty() ? std::string("no image")
+                                 : fs::path(file).filename().string())
+                << "), camera '" << cam.name << "': " << cam.frame_note[f]
+                << "\n";
+      relabelled |= cam.relabelled[f];
+    }
+  }
+  if (relabelled) {
+    std::cout << "(a plain checkerboard looks the same after half a turn, so "
+                 "each camera may label it either way; the rig's poses "
+                 "settle which. A PuzzleBoard has no such ambiguity.)\n";
+  }
+}
+
 // The rig's figures, each camera's verdict line (the one in the report),
 // the time and what was written.
 void PrintRigOutcome(const RigCalibrationResult& result,
+                     const std::vector<std::vector<std::string>>& frame_files,
                      CameraFileFormat format, const CameraJudgements& judged,
                      int threads, double seconds_images, double seconds_total,
                      const std::vector<std::string>& written) {
   std::cout << RigCalibrationReport(result);
+  PrintFrameNotes(result, frame_files);
   for (size_t c = 0; c < result.cameras.size(); ++c) {
     std::cout << RigVerdictLine(result.cameras[c].name, judged.verdicts[c])
               << "\n";
@@ -358,8 +420,9 @@ int RunCalibrateRig() {
   options.camera.num_threads = request.threads;
   RigCalibrationResult result;
   std::string calibration_error, error;
-  const bool calibrated =
-      CalibrateRig(inputs, options, &result, &calibration_error);
+  const bool calibrated = CalibrateRig(inputs, BoardSymmetry(request.board),
+                                       options, &result, &calibration_error);
+  NotePartialCheckerboards(request.board, inputs, &result);
   const CameraJudgements judged =
       calibrated ? JudgeCameras(inputs, options, request.options, result)
                  : CameraJudgements();
@@ -380,7 +443,7 @@ int RunCalibrateRig() {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
   }
-  PrintRigOutcome(result, request.format, judged, request.threads,
+  PrintRigOutcome(result, frame_files, request.format, judged, request.threads,
                   seconds_images, run_timer.Seconds(), written);
   return kExitOk;
 }

@@ -526,15 +526,106 @@ bool FailUnplacedCameras(const std::vector<RigCameraInput>& cameras,
   return true;
 }
 
+// Stage 2a: the half-turn ambiguity of a symmetric board between cameras a
+// (already placed) and b. Each shared frame gives b's pose relative to a
+// as labelled and, for a symmetric board, with b's labels turned by half a
+// turn. The candidate that the most frames agree with (one way or the
+// other, within max_deviation_deg; the labels as found win ties) fixes the
+// convention: a frame that agrees only with its labels turned gets b's
+// labels turned (board points and b's own pose of the frame); a frame that
+// agrees neither way gets a note.
+void ResolveHalfTurns(int a, int b, const RigBoardSymmetry& symmetry,
+                      double max_deviation_deg,
+                      std::vector<RigCameraInput>* inputs,
+                      std::vector<CalibrationResult>* singles,
+                      std::vector<RigCameraResult>* out) {
+  std::vector<CalibrationResult>& single = *singles;
+  const size_t num_frames = (*inputs)[0].frames.size();
+  Eigen::Isometry3d half_turn = Eigen::Isometry3d::Identity();
+  half_turn.linear() = Eigen::Vector3d(-1, -1, 1).asDiagonal();
+  half_turn.translation() =
+      Eigen::Vector3d(2 * symmetry.centre.x(), 2 * symmetry.centre.y(), 0);
+  std::vector<size_t> frames;
+  std::vector<Eigen::Matrix3d> as_found, turned;
+  for (size_t f = 0; f < num_frames; ++f) {
+    if (single[a].view_used[f] && single[b].view_used[f]) {
+      frames.push_back(f);
+      const Eigen::Isometry3d a_inv = single[a].cam_from_board[f].inverse();
+      as_found.push_back((single[b].cam_from_board[f] * a_inv).linear());
+      turned.push_back(
+          (single[b].cam_from_board[f] * half_turn * a_inv).linear());
+    }
+  }
+  if (frames.size() < 2) return;
+  std::vector<const Eigen::Matrix3d*> candidates;
+  for (const Eigen::Matrix3d& r : as_found) candidates.push_back(&r);
+  if (symmetry.half_turn) {
+    for (const Eigen::Matrix3d& r : turned) candidates.push_back(&r);
+  }
+  const Eigen::Matrix3d* centre = candidates[0];
+  int best_count = -1;
+  for (const Eigen::Matrix3d* candidate : candidates) {
+    int count = 0;
+    for (size_t k = 0; k < frames.size(); ++k) {
+      const bool agrees =
+          RotationDifferenceDeg(as_found[k], *candidate) <= max_deviation_deg ||
+          (symmetry.half_turn &&
+           RotationDifferenceDeg(turned[k], *candidate) <= max_deviation_deg);
+      count += agrees ? 1 : 0;
+    }
+    if (count > best_count) {
+      best_count = count;
+      centre = candidate;
+    }
+  }
+  RigCameraResult& note_b = (*out)[b];
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const size_t f = frames[k];
+    const double before = RotationDifferenceDeg(as_found[k], *centre);
+    if (before <= max_deviation_deg) continue;
+    const double after = RotationDifferenceDeg(turned[k], *centre);
+    if (symmetry.half_turn && after <= max_deviation_deg) {
+      CalibrationView& view = (*inputs)[b].frames[f];
+      for (Eigen::Vector3d& point : view.board_points)
+        point = half_turn * point;
+      single[b].cam_from_board[f] = single[b].cam_from_board[f] * half_turn;
+      note_b.relabelled[f] = true;
+      note_b.frame_note[f] = StringPrintf(
+          "board labels turned by half a turn to agree with '%s' (the "
+          "symmetric board's poses were %.1f deg apart, %.2f deg after)",
+          (*out)[a].name.c_str(), before, after);
+      continue;
+    }
+    // Neither way: b's view of the frame is left out of the rig.
+    single[b].view_used[f] = false;
+    (*inputs)[b].frames[f] = CalibrationView();
+    if (symmetry.half_turn) {
+      note_b.frame_note[f] = StringPrintf(
+          "its board pose relative to '%s' is %.1f deg from the rig's, %.1f "
+          "deg with its labels turned by half a turn: not the board's "
+          "symmetry",
+          (*out)[a].name.c_str(), before, after);
+    } else {
+      note_b.frame_note[f] = StringPrintf(
+          "its board pose relative to '%s' is %.1f deg from the rig's",
+          (*out)[a].name.c_str(), before);
+    }
+  }
+}
+
 // Stage 2: the starting cam_from_rig of every camera, from the frames two
 // cameras share, chained along the maximum spanning tree of shared frames
 // from the reference camera. `start_parent` receives each camera's parent
 // in that tree (-1 for the reference).
-bool StartCamFromRig(const std::vector<RigCameraInput>& cameras,
-                     const std::vector<CalibrationResult>& single,
+bool StartCamFromRig(std::vector<RigCameraInput>* inputs,
+                     std::vector<CalibrationResult>* singles,
+                     const RigBoardSymmetry& symmetry,
                      const RigCalibrationOptions& options,
                      std::vector<Eigen::Isometry3d>* cam_from_rig,
-                     std::vector<int>* start_parent, std::string* error) {
+                     std::vector<int>* start_parent,
+                     std::vector<RigCameraResult>* out, std::string* error) {
+  const std::vector<RigCameraInput>& cameras = *inputs;
+  const std::vector<CalibrationResult>& single = *singles;
   const size_t num_cameras = cameras.size();
   const size_t num_frames = cameras[0].frames.size();
   Eigen::MatrixXi posed_shared =
@@ -565,6 +656,9 @@ bool StartCamFromRig(const std::vector<RigCameraInput>& cameras,
       }
     }
     if (best_b < 0) break;
+    ResolveHalfTurns(best_a, best_b, symmetry,
+                     options.max_start_rotation_deviation_deg, inputs, singles,
+                     out);
     std::vector<Eigen::Isometry3d> samples;  // cam_b_from_cam_a per frame
     for (size_t f = 0; f < num_frames; ++f) {
       if (single[best_a].view_used[f] && single[best_b].view_used[f]) {
@@ -825,6 +919,37 @@ double FillRigResult(const JointState& state, const JointSolveRun& run,
   return sum2_all;
 }
 
+// Why each camera's view of a frame that is not used was left out.
+void NoteUnusedViews(const std::vector<RigCameraInput>& cameras,
+                     const std::vector<CalibrationResult>& single,
+                     const JointState& state, RigCalibrationResult* result) {
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    RigCameraResult& out = result->cameras[c];
+    for (size_t f = 0; f < cameras[c].frames.size(); ++f) {
+      if (state.used[c][f] || cameras[c].frames[f].board_points.empty()) {
+        continue;
+      }
+      std::string why;
+      if (!out.frame_note[f].empty() && !out.relabelled[f]) {
+        why = out.frame_note[f];
+      } else if (!single[c].view_used[f]) {
+        why = "its own calibration left the view out";
+        if (f < single[c].view_reason.size() &&
+            !single[c].view_reason[f].empty()) {
+          why += " (" + single[c].view_reason[f] + ")";
+        }
+      } else if (!state.frame_posed[f]) {
+        why = "no camera posed the board in this frame";
+      } else {
+        why =
+            "too few of its corners fit the rig (outliers of the joint "
+            "solve)";
+      }
+      out.frame_note[f] = "not used: " + why;
+    }
+  }
+}
+
 // Stage 6: σ of every free intrinsic and of each cam_from_rig (rotation in
 // degrees, translation, baseline), from the joint covariance scaled by the
 // residual variance (from `sum2_all`, the sum of squared inlier residuals).
@@ -966,7 +1091,16 @@ bool RigCalibrationOptions::Check(std::string* why) const {
 bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
                   const RigCalibrationOptions& options,
                   RigCalibrationResult* result, std::string* error) {
+  return CalibrateRig(cameras, RigBoardSymmetry(), options, result, error);
+}
+
+bool CalibrateRig(const std::vector<RigCameraInput>& input_cameras,
+                  const RigBoardSymmetry& symmetry,
+                  const RigCalibrationOptions& options,
+                  RigCalibrationResult* result, std::string* error) {
   *result = RigCalibrationResult();
+  // A copy: a symmetric board's views may be relabelled.
+  std::vector<RigCameraInput> cameras = input_cameras;
   std::string why;
   if (!options.Check(&why))
     return Fail("rig calibration options: " + why, error);
@@ -983,6 +1117,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
     result->cameras[c].camera.model = cameras[c].model;
     result->cameras[c].camera.width = cameras[c].width;
     result->cameras[c].camera.height = cameras[c].height;
+    result->cameras[c].relabelled.assign(num_frames, false);
+    result->cameras[c].frame_note.assign(num_frames, "");
   }
 
   const Timer single_timer;
@@ -998,8 +1134,8 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
 
   const Timer joint_timer;
   std::vector<Eigen::Isometry3d> cam_from_rig;
-  if (!StartCamFromRig(cameras, single, options, &cam_from_rig,
-                       &result->start_parent, error)) {
+  if (!StartCamFromRig(&cameras, &single, symmetry, options, &cam_from_rig,
+                       &result->start_parent, &result->cameras, error)) {
     return false;
   }
   JointState state;
@@ -1008,6 +1144,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
   JointSolveRun run;
   SolveWithOutlierRejection(copt, &state, &run);
   const double sum2_all = FillRigResult(state, run, result);
+  NoteUnusedViews(input_cameras, single, state, result);
   if (copt.compute_covariance && run.outcome.problem &&
       run.outcome.summary.IsSolutionUsable()) {
     FillRigCovariance(state, sum2_all, copt.covariance_min_eigenvalue_ratio,

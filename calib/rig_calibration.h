@@ -44,6 +44,18 @@ struct RigCameraInput {
   std::vector<std::string> fixed_params;
 };
 
+// A plain checkerboard whose corner grid maps onto itself under a half turn
+// about its centre (in the board plane): a camera cannot tell the two
+// labellings apart, so two cameras of one frame may label the board in
+// opposite orientations. Their board poses of that frame are then half a
+// turn apart, which the rig's relative pose (from the other frames) makes
+// plain; CalibrateRig relabels such a view (id -> the id half a turn away)
+// and uses the frame. A PuzzleBoard's ids are absolute: no such ambiguity.
+struct RigBoardSymmetry {
+  bool half_turn = false;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // board frame, metres
+};
+
 struct RigCalibrationOptions {
   // Options of each camera's own calibration (initialisation, fixed
   // parameters) and of the joint solve: robust loss and scale, outlier
@@ -107,6 +119,12 @@ struct RigCameraResult {
   std::vector<bool> frame_used;
   std::vector<std::vector<Eigen::Vector2d>> residuals;
   std::vector<std::vector<bool>> inlier;
+  // Per frame: true when the camera's board labels were turned by half a
+  // turn to agree with the rig (RigBoardSymmetry), and a note on the frame
+  // ("" when there is nothing to say): what was done, or why the camera's
+  // view was not used.
+  std::vector<bool> relabelled;
+  std::vector<std::string> frame_note;
 };
 
 struct RigCalibrationResult {
@@ -141,6 +159,11 @@ std::string RigCalibrationReport(const RigCalibrationResult& result);
 // its place in the rig is undetermined), or the joint solve fails; `result`
 // then holds what is known so far.
 bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
+                  const RigCalibrationOptions& options,
+                  RigCalibrationResult* result, std::string* error);
+// The same for a board with a symmetry (see RigBoardSymmetry).
+bool CalibrateRig(const std::vector<RigCameraInput>& cameras,
+                  const RigBoardSymmetry& symmetry,
                   const RigCalibrationOptions& options,
                   RigCalibrationResult* result, std::string* error);
 

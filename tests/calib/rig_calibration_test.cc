@@ -15,6 +15,7 @@
 
 #include "sim/rig_scenes.h"
 #include "sim/scenes.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace {
@@ -381,6 +382,136 @@ TEST(RigCalibrationTest, OptionsCheckNamesTheField) {
   options.min_shared_frames = 0;
   EXPECT_FALSE(options.Check(&why));
   EXPECT_NE(why.find("min_shared_frames"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace puzzlecal
+
+namespace puzzlecal {
+namespace {
+
+// A stereo rig looking at a plain 6 x 4 checkerboard (symmetric under half a
+// turn) whose second camera labels the board the other way round in some
+// frames, as a detector may: its board points turned by half a turn about
+// the corner grid's centre.
+struct SymmetricBoardRig {
+  RigSceneSpec scene;
+  std::vector<RigCameraInput> inputs;
+  RigBoardSymmetry symmetry;
+  std::vector<bool> turned;  // per frame, camera 1's labels turned
+};
+
+SymmetricBoardRig MakeSymmetricBoardRig(const std::vector<int>& turned_frames,
+                                        bool turn_all = false) {
+  SymmetricBoardRig rig;
+  rig.scene = StereoPinholeRig();
+  rig.scene.board =
+      MakeBoard(BoardType::kCheckerboard, 6, 4, Eigen::Vector2i::Zero(), 0.05);
+  rig.scene.min_visible_corners = 24;  // the whole board, as a detector needs
+  rig.scene.random_frames.count = 20;
+  rig.inputs = RigCorrespondences(rig.scene, kNoisePx, 11);
+  rig.symmetry.half_turn = true;
+  rig.symmetry.centre = Eigen::Vector3d(2.5 * 0.05, 1.5 * 0.05, 0);
+  const size_t num_frames = rig.inputs[1].frames.size();
+  rig.turned.assign(num_frames, turn_all);
+  for (int f : turned_frames) rig.turned[f] = true;
+  for (size_t f = 0; f < num_frames; ++f) {
+    if (!rig.turned[f]) continue;
+    for (Eigen::Vector3d& p : rig.inputs[1].frames[f].board_points) {
+      p = Eigen::Vector3d(2 * rig.symmetry.centre.x() - p.x(),
+                          2 * rig.symmetry.centre.y() - p.y(), p.z());
+    }
+  }
+  return rig;
+}
+
+// The rig of the same correspondences labelled alike in both cameras: a
+// resolved ambiguity gives the same calibration.
+void ExpectSameAsLabelledAlike(const SymmetricBoardRig& rig,
+                               const RigCalibrationResult& result) {
+  const SymmetricBoardRig clean = MakeSymmetricBoardRig({});
+  RigCalibrationResult expected;
+  std::string error;
+  ASSERT_TRUE(
+      CalibrateRig(clean.inputs, RigCalibrationOptions(), &expected, &error))
+      << error;
+  EXPECT_NEAR(result.cameras[1].baseline_m, expected.cameras[1].baseline_m,
+              1e-7);
+  EXPECT_LT(RotationDifferenceDeg(result.cameras[1].cam_from_rig.linear(),
+                                  expected.cameras[1].cam_from_rig.linear()),
+            1e-5);
+  EXPECT_NEAR(result.cameras[1].camera.params[0],
+              expected.cameras[1].camera.params[0], 1e-4);
+  // And the truth lies within 5 sigma of it.
+  const CamFromRigError truth =
+      CompareCamFromRig(result.cameras[1], rig.scene.cameras[1].cam_from_rig);
+  EXPECT_LT(truth.rotation_over_sigma, 5);
+  EXPECT_LT(std::abs(result.cameras[1].baseline_m -
+                     BaselineOf(rig.scene.cameras[1].cam_from_rig)),
+            5 * result.cameras[1].baseline_stddev_m);
+}
+
+int SharedFrames(const std::vector<RigCameraInput>& inputs) {
+  int shared = 0;
+  for (size_t f = 0; f < inputs[0].frames.size(); ++f) {
+    shared += !inputs[0].frames[f].board_points.empty() &&
+              !inputs[1].frames[f].board_points.empty();
+  }
+  return shared;
+}
+
+TEST(RigCalibrationTest, SymmetricBoardLabelledTheOtherWayIsTurnedAndUsed) {
+  const SymmetricBoardRig rig = MakeSymmetricBoardRig({1, 4, 7, 12});
+  const int shared = SharedFrames(rig.inputs);
+  ASSERT_GE(shared, 10);
+  RigCalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(CalibrateRig(rig.inputs, rig.symmetry, RigCalibrationOptions(),
+                           &result, &error))
+      << error;
+  EXPECT_EQ(result.shared_frames(0, 1), shared);
+  for (size_t f = 0; f < rig.turned.size(); ++f) {
+    const bool seen = !rig.inputs[1].frames[f].board_points.empty() &&
+                      !rig.inputs[0].frames[f].board_points.empty();
+    EXPECT_EQ(result.cameras[1].relabelled[f], rig.turned[f] && seen)
+        << "frame " << f;
+    if (result.cameras[1].relabelled[f]) {
+      EXPECT_NE(result.cameras[1].frame_note[f].find("half a turn"),
+                std::string::npos);
+    }
+  }
+  ExpectSameAsLabelledAlike(rig, result);
+}
+
+TEST(RigCalibrationTest, SymmetricBoardLabelledTheOtherWayEverywhere) {
+  // A camera mounted upside down labels every frame the other way round.
+  const SymmetricBoardRig rig = MakeSymmetricBoardRig({}, /*turn_all=*/true);
+  RigCalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(CalibrateRig(rig.inputs, rig.symmetry, RigCalibrationOptions(),
+                           &result, &error))
+      << error;
+  EXPECT_EQ(result.shared_frames(0, 1), SharedFrames(rig.inputs));
+  ExpectSameAsLabelledAlike(rig, result);
+}
+
+TEST(RigCalibrationTest, WithoutTheSymmetryTheTurnedFramesAreNamed) {
+  const SymmetricBoardRig rig = MakeSymmetricBoardRig({1, 4, 7, 12});
+  RigCalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(
+      CalibrateRig(rig.inputs, RigCalibrationOptions(), &result, &error))
+      << error;
+  for (int f : {1, 4, 7, 12}) {
+    if (rig.inputs[0].frames[f].board_points.empty() ||
+        rig.inputs[1].frames[f].board_points.empty()) {
+      continue;
+    }
+    EXPECT_FALSE(result.cameras[1].frame_used[f]) << "frame " << f;
+    EXPECT_NE(result.cameras[1].frame_note[f].find("not used"),
+              std::string::npos)
+        << result.cameras[1].frame_note[f];
+  }
 }
 
 }  // namespace
