@@ -431,13 +431,9 @@ int WriteCameraOf(const CalibrateRequest& request, const CalibrationRun& run) {
   CameraFileNames names;
   names.camera_name = FLAGS_camera_name;
   names.rostopic = FLAGS_rostopic;
-  CameraFileStats stats = CameraFileStatsOfResult(
-      run.result, ViewFiles(run.images, run.views.size()),
-      request.board.Point(request.board.origin));
-  stats.verdict = run.verdict.Line();
-  const CalibrationRange range = MeasureCalibrationRange(run.views, run.result);
-  stats.closest_board_distance_m = range.closest_board_distance_m;
-  stats.max_field_angle_deg = range.max_field_angle_deg;
+  const CameraFileStats stats = CalibrationFileStats(
+      run.result, run.views, ViewFiles(run.images, run.views.size()),
+      request.board.Point(request.board.origin), run.verdict.Line());
   std::string error, format_note;
   if (!WriteCameraFile(FLAGS_out, request.format, run.result.camera, stats,
                        &error, &format_note, names)) {

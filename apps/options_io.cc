@@ -598,18 +598,21 @@ constexpr char kHeader[] =
 bool LoadOptionsFile(const std::string& path, RunOptions* options,
                      std::string* error) {
   std::string text;
+  return ReadTextFile(path, &text, error) &&
+         ParseOptionsText(text, path, options, error);
+}
+
+bool ParseOptionsText(const std::string& text, const std::string& source,
+                      RunOptions* options, std::string* error) {
   YAML::Node root;
-  if (!ReadTextFile(path, &text, error) ||
-      !ParseYaml(text, path, &root, error)) {
-    return false;
-  }
+  if (!ParseYaml(text, source, &root, error)) return false;
   RunOptions read = *options;
-  FieldReader reader(path, error);
+  FieldReader reader(source, error);
   if (!ReadGroup(&reader, root, "", &read)) return false;
   read.rig.camera = read.calibration;
   std::string why;
   if (!CheckSections(read, &why)) {
-    *error = path + ": " + why;
+    *error = source + ": " + why;
     return false;
   }
   *options = read;

@@ -54,6 +54,10 @@ struct RunOptions {
 // the section whose Check() failed ("FILE: section 'detector': ...").
 bool LoadOptionsFile(const std::string& path, RunOptions* options,
                      std::string* error);
+// The same for options text (YAML, or JSON, which YAML reads); `source`
+// names it in messages.
+bool ParseOptionsText(const std::string& text, const std::string& source,
+                      RunOptions* options, std::string* error);
 
 // Every field of `options` with its value, as an options file (what
 // LoadOptionsFile reads back to the same options).

@@ -698,6 +698,20 @@ CalibrationRange MeasureCalibrationRange(
   return range;
 }
 
+CameraFileStats CalibrationFileStats(const CalibrationResult& result,
+                                     const std::vector<CalibrationView>& views,
+                                     const std::vector<std::string>& view_files,
+                                     const Eigen::Vector3d& first_corner_m,
+                                     const std::string& verdict_line) {
+  CameraFileStats stats =
+      CameraFileStatsOfResult(result, view_files, first_corner_m);
+  stats.verdict = verdict_line;
+  const CalibrationRange range = MeasureCalibrationRange(views, result);
+  stats.closest_board_distance_m = range.closest_board_distance_m;
+  stats.max_field_angle_deg = range.max_field_angle_deg;
+  return stats;
+}
+
 CameraFileStats CameraFileStatsOfResult(
     const CalibrationResult& result, const std::vector<std::string>& view_files,
     const Eigen::Vector3d& first_corner_m) {

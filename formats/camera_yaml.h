@@ -81,6 +81,16 @@ struct CalibrationRange {
 CalibrationRange MeasureCalibrationRange(
     const std::vector<CalibrationView>& views, const CalibrationResult& result);
 
+// Everything a calibration's camera file carries besides the camera: the
+// statistics of `result` (CameraFileStatsOfResult), its verdict line, and
+// where its board corners were (MeasureCalibrationRange over `views`, the
+// views it was calibrated from). What `puzzlecal calibrate` writes.
+CameraFileStats CalibrationFileStats(const CalibrationResult& result,
+                                     const std::vector<CalibrationView>& views,
+                                     const std::vector<std::string>& view_files,
+                                     const Eigen::Vector3d& first_corner_m,
+                                     const std::string& verdict_line);
+
 // What a format leaves out of a camera. opencv, ros and kalibr have no
 // non-central model: they get the far-field part of kannala-brandt-noncentral
 // (kannala-brandt with the same k1..k4, FarFieldCamera) without the pupil

@@ -17,6 +17,7 @@
 
 #include "formats/opencv_decoder.h"
 #include "formats/png_filters.h"
+#include "util/failure.h"
 
 namespace puzzlecal {
 namespace {
@@ -428,26 +429,22 @@ bool ImageLoader::LoadUnchanged(const std::string& path, cv::Mat* image,
   return Decode(path, /*grey_jpeg=*/false, image, error);
 }
 
-bool ImageLoader::Load(const std::string& path, cv::Mat* grey,
-                       std::string* error) {
-  *grey = cv::Mat();
-  cv::Mat decoded;
-  if (!Decode(path, /*grey_jpeg=*/true, &decoded, error)) return false;
+bool GreyFromImage(const cv::Mat& image, cv::Mat* grey, std::string* why) {
   cv::Mat single;
-  switch (decoded.channels()) {
+  switch (image.channels()) {
     case 1:
-      single = decoded;
+      single = image;
       break;
     case 3:
-      cv::cvtColor(decoded, single, cv::COLOR_BGR2GRAY);
+      cv::cvtColor(image, single, cv::COLOR_BGR2GRAY);
       break;
     case 4:
-      cv::cvtColor(decoded, single, cv::COLOR_BGRA2GRAY);
+      cv::cvtColor(image, single, cv::COLOR_BGRA2GRAY);
       break;
     default:
-      *error = path + ": unsupported number of channels (" +
-               std::to_string(decoded.channels()) + ")";
-      return false;
+      return Fail("unsupported number of channels (" +
+                      std::to_string(image.channels()) + ")",
+                  why);
   }
   if (single.depth() == CV_8U) {
     *grey = single;
@@ -461,6 +458,19 @@ bool ImageLoader::Load(const std::string& path, cv::Mat* grey,
     return true;
   }
   single.convertTo(*grey, CV_8U, 255.0 / max_value);
+  return true;
+}
+
+bool ImageLoader::Load(const std::string& path, cv::Mat* grey,
+                       std::string* error) {
+  *grey = cv::Mat();
+  cv::Mat decoded;
+  if (!Decode(path, /*grey_jpeg=*/true, &decoded, error)) return false;
+  std::string why;
+  if (!GreyFromImage(decoded, grey, &why)) {
+    *error = path + ": " + why;
+    return false;
+  }
   return true;
 }
 

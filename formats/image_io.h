@@ -41,6 +41,12 @@ struct ImageLoadOptions {
 bool LoadGreyImage(const std::string& path, const ImageLoadOptions& options,
                    cv::Mat* grey, std::string* error);
 
+// The one conversion of an image to the 8-bit grey the detector reads:
+// BGR / BGRA (OpenCV's channel order) to luma, 16-bit, float or other
+// depths scaled by the image's own maximum. False (with a reason) for other
+// channel counts.
+bool GreyFromImage(const cv::Mat& image, cv::Mat* grey, std::string* why);
+
 // LoadGreyImage for many files: keeps its buffers (the file's bytes, the
 // compressed and the inflated data of 8-bit grey PNGs, the inflater) from
 // one file to the next, so a folder of same-size photos costs no allocation

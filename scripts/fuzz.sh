@@ -19,7 +19,8 @@ if [ ! -f "$build_dir/CMakeCache.txt" ]; then
   if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
   CC=clang CXX=clang++ cmake -S . -B "$build_dir" "${generator[@]}" \
     -DPUZZLECAL_BUILD_FUZZ=ON -DPUZZLECAL_BUILD_TESTS=OFF \
-    -DPUZZLECAL_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo
+    -DPUZZLECAL_BUILD_BENCH=OFF -DPUZZLECAL_BUILD_PYTHON=OFF \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo
 fi
 
 all_targets=(detect_fuzzer grid_decode_fuzzer config_yaml_fuzzer camera_yaml_fuzzer)

@@ -12,6 +12,8 @@ packages=(
   libplplot-dev plplot-driver-cairo
   libdeflate-dev zlib1g-dev
   clang libclang-rt-14-dev
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
+  python3-setuptools python3-pip python3-venv python3-yaml
 )
 
 missing=()

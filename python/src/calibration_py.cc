@@ -1,0 +1,354 @@
+// Calibration: views from detections or from (ids, corners) pairs, the
+// model by name or chosen (`auto`), the calibration and its judgement
+// (evidence/judgement.h, the program's steps), and the result with numpy
+// arrays that outlives everything it came from.
+
+#include <pybind11/stl.h>
+
+#include <filesystem>
+#include <thread>
+
+#include "apps/options_io.h"
+#include "evidence/judgement.h"
+#include "formats/camera_yaml.h"
+#include "pipeline/pipeline.h"
+#include "python/src/bindings.h"
+
+namespace puzzlecal::python {
+namespace {
+
+// A calibration with everything its camera file needs; owns its data.
+struct PyCalibration {
+  Board board;
+  std::vector<CalibrationView> views;
+  std::vector<std::string> view_files;
+  JudgedCalibration judged;
+};
+
+int Threads(int threads) {
+  if (threads < 0) Raise("threads must be >= 0 (0: all cores)");
+  return threads > 0 ? threads
+                     : static_cast<int>(
+                           std::max(1u, std::thread::hardware_concurrency()));
+}
+
+PyCalibration Run(const Board& board, std::vector<CalibrationView> views,
+                  std::vector<std::string> view_files, int width, int height,
+                  const std::string& model, const RunOptions& options,
+                  int threads) {
+  if (views.empty()) {
+    Raise("no usable view: every image lacks enough corners with board ids");
+  }
+  PyCalibration run;
+  run.board = board;
+  run.views = std::move(views);
+  run.view_files = std::move(view_files);
+  CalibrationOptions calibration = options.calibration;
+  calibration.num_threads = Threads(threads);  // the same result, faster
+  JudgementOptions judgement;
+  judgement.evidence = options.evidence;
+  judgement.verdict = options.verdict;
+  judgement.model_selection = options.model_selection;
+  std::string error;
+  bool ok = false;
+  {
+    py::gil_scoped_release release;
+    ok = CalibrateAndJudge(run.views, width, height, model, calibration,
+                           judgement, &run.judged, &error);
+  }
+  if (!ok) Raise("calibration failed: " + error);
+  return run;
+}
+
+PyCalibration FromDetections(const std::vector<ImageResult>& detections,
+                             const Board& board, const std::string& model,
+                             const RunOptions& options, int threads) {
+  std::vector<ImageResult> images = detections;
+  for (size_t i = 0; i < images.size(); ++i) {
+    if (images[i].file.empty()) images[i].file = "image_" + std::to_string(i);
+  }
+  int width = 0, height = 0;
+  std::vector<CalibrationView> views =
+      MakeCalibrationViews(board, &images, &width, &height);
+  std::vector<std::string> files = ViewFiles(images, views.size());
+  return Run(board, std::move(views), std::move(files), width, height, model,
+             options, threads);
+}
+
+PyCalibration FromObservations(const py::list& observations, const Board& board,
+                               std::pair<int, int> image_size,
+                               const std::string& model,
+                               const RunOptions& options, int threads) {
+  if (image_size.first < 1 || image_size.second < 1) {
+    Raise("image_size must be (width, height) in pixels");
+  }
+  std::vector<CalibrationView> views;
+  std::vector<std::string> files;
+  for (size_t v = 0; v < observations.size(); ++v) {
+    const std::string what = "observations[" + std::to_string(v) + "]";
+    const py::handle item = observations[v];
+    if (!py::isinstance<py::tuple>(item) && !py::isinstance<py::list>(item)) {
+      Raise(what + ": expected (ids, corners)");
+    }
+    const py::sequence pair = py::reinterpret_borrow<py::sequence>(item);
+    if (pair.size() != 2) Raise(what + ": expected (ids, corners)");
+    const py::object ids_array = pair[0], corners_array = pair[1];
+    const std::vector<Eigen::Vector2i> ids =
+        Ids2(ids_array, (what + " ids").c_str());
+    const std::vector<Eigen::Vector2d> corners =
+        Points2(corners_array, (what + " corners").c_str());
+    if (ids.size() != corners.size()) {
+      Raise(what + ": " + std::to_string(ids.size()) + " ids but " +
+            std::to_string(corners.size()) + " corners");
+    }
+    CalibrationView view;
+    view.name = "view_" + std::to_string(v);
+    for (size_t k = 0; k < ids.size(); ++k) {
+      if (!board.Contains(ids[k])) {
+        Raise(what + ": id (" + std::to_string(ids[k].x()) + ", " +
+              std::to_string(ids[k].y()) + ") is not on the board");
+      }
+      view.board_points.push_back(board.Point(ids[k]));
+      view.image_points.push_back(corners[k]);
+    }
+    files.push_back(view.name);
+    views.push_back(std::move(view));
+  }
+  return Run(board, std::move(views), std::move(files), image_size.first,
+             image_size.second, model, options, threads);
+}
+
+// A PixelMap as a rows x cols float64 array (NaN outside the field).
+py::array_t<double> MapArray(const PixelMap& map) {
+  py::array_t<double> out({map.rows, map.cols});
+  for (int j = 0; j < map.rows; ++j) {
+    for (int i = 0; i < map.cols; ++i) *out.mutable_data(j, i) = map.At(i, j);
+  }
+  return out;
+}
+
+py::list Bands(const std::vector<AngleBand>& bands) {
+  py::list out;
+  for (const AngleBand& b : bands) {
+    out.append(py::dict(py::arg("lo_deg") = b.lo_deg,
+                        py::arg("hi_deg") = b.hi_deg,
+                        py::arg("count") = b.count,
+                        py::arg("median") = b.median, py::arg("p95") = b.p95));
+  }
+  return out;
+}
+
+py::list Bins(const std::vector<ResidualBin>& bins) {
+  py::list out;
+  for (const ResidualBin& b : bins) {
+    out.append(py::dict(py::arg("lo") = b.lo, py::arg("hi") = b.hi,
+                        py::arg("count") = b.count,
+                        py::arg("mean_radial_px") = b.mean_radial_px,
+                        py::arg("mean_tangential_px") = b.mean_tangential_px,
+                        py::arg("se_radial_px") = b.se_radial_px,
+                        py::arg("se_tangential_px") = b.se_tangential_px,
+                        py::arg("rms_px") = b.rms_px));
+  }
+  return out;
+}
+
+// The evidence's tables, as the report shows them.
+py::dict EvidenceDict(const Evidence& e) {
+  const CrossValidation& cv = e.cross_validation;
+  py::dict halves(py::arg("ok") = cv.ok, py::arg("error") = cv.error,
+                  py::arg("views") = py::make_tuple(cv.views_a, cv.views_b),
+                  py::arg("rms_px") = py::make_tuple(cv.rms_a_px, cv.rms_b_px),
+                  py::arg("rotation_deg") = cv.rotation_deg,
+                  py::arg("difference_px") = MapArray(cv.difference_px),
+                  py::arg("expected_px") = MapArray(cv.expected_px),
+                  py::arg("difference_bands") = Bands(cv.difference_bands),
+                  py::arg("expected_bands") = Bands(cv.expected_bands),
+                  py::arg("intrinsics_chi2") = cv.intrinsics_chi2,
+                  py::arg("intrinsics_dof") = cv.intrinsics_dof);
+  py::list points;
+  for (const UncertaintyPoint& p : e.uncertainty.points) {
+    points.append(py::dict(
+        py::arg("label") = p.label, py::arg("angle_deg") = p.angle_deg,
+        py::arg("in_image") = p.in_image, py::arg("sigma_px") = p.sigma_px));
+  }
+  py::dict uncertainty(py::arg("ok") = e.uncertainty.ok,
+                       py::arg("sigma_px") = MapArray(e.uncertainty.sigma_px),
+                       py::arg("step_px") = e.uncertainty.sigma_px.step_px,
+                       py::arg("bands") = Bands(e.uncertainty.bands),
+                       py::arg("points") = points);
+  return py::dict(
+      py::arg("halves") = halves, py::arg("uncertainty") = uncertainty,
+      py::arg("residuals_by_angle") = Bins(e.residuals.by_angle),
+      py::arg("residuals_by_distance") = Bins(e.residuals.by_distance));
+}
+
+py::dict ByName(const Camera& camera, const std::vector<double>& values) {
+  py::dict named;
+  const std::vector<std::string> names = CameraModelParamNames(camera.model);
+  for (size_t i = 0; i < names.size() && i < values.size(); ++i) {
+    named[py::str(names[i])] = values[i];
+  }
+  return named;
+}
+
+}  // namespace
+
+void BindCalibration(py::module_& m) {
+  py::class_<Verdict>(m, "Verdict",
+                      "What the evidence says about a calibration: kind "
+                      "('good', 'model-error', 'bad-detections', "
+                      "'insufficient-data'), the reason with its figures, "
+                      "the next step.")
+      .def_property_readonly(
+          "kind",
+          [](const Verdict& v) { return std::string(VerdictKindName(v.kind)); })
+      .def_readonly("reason", &Verdict::reason)
+      .def_readonly("next_step", &Verdict::next_step)
+      .def_readonly("findings", &Verdict::findings)
+      .def_readonly("suggested_model", &Verdict::suggested_model)
+      .def("line", &Verdict::Line, "the one-line form the program prints")
+      .def("__repr__", [](const Verdict& v) {
+        return "<puzzlecal.Verdict " + std::string(VerdictKindName(v.kind)) +
+               ">";
+      });
+
+  py::class_<PyCalibration>(m, "Calibration",
+                            "A calibration, its judgement and every figure "
+                            "behind them, as numpy arrays.")
+      .def_property_readonly(
+          "camera",
+          [](const PyCalibration& c) { return c.judged.result.camera; })
+      .def_property_readonly(
+          "model",
+          [](const PyCalibration& c) {
+            return std::string(CameraModelName(c.judged.result.camera.model));
+          })
+      .def_property_readonly("params_by_name",
+                             [](const PyCalibration& c) {
+                               return ByName(c.judged.result.camera,
+                                             c.judged.result.camera.params);
+                             })
+      .def_property_readonly(
+          "stddev_by_name",
+          [](const PyCalibration& c) {
+            return ByName(c.judged.result.camera, c.judged.result.param_stddev);
+          },
+          "1-sigma of every parameter (0 for fixed ones)")
+      .def_property_readonly(
+          "covariance",
+          [](const PyCalibration& c) {
+            return MatrixArray(c.judged.result.covariance);
+          },
+          "covariance of the intrinsics (param_names order)")
+      .def_property_readonly(
+          "rms_px",
+          [](const PyCalibration& c) { return c.judged.result.rms_px; },
+          "RMS of the inlier residuals per coordinate, pixels")
+      .def_property_readonly(
+          "num_outliers",
+          [](const PyCalibration& c) { return c.judged.result.num_outliers; })
+      .def_property_readonly(
+          "view_names",
+          [](const PyCalibration& c) { return c.judged.result.view_name; })
+      .def_property_readonly("view_used",
+                             [](const PyCalibration& c) {
+                               return std::vector<bool>(
+                                   c.judged.result.view_used.begin(),
+                                   c.judged.result.view_used.end());
+                             })
+      .def_property_readonly(
+          "view_reasons",
+          [](const PyCalibration& c) { return c.judged.result.view_reason; },
+          "why a view was not used ('' when used)")
+      .def_property_readonly(
+          "poses",
+          [](const PyCalibration& c) {
+            py::list poses;
+            for (const Eigen::Isometry3d& pose :
+                 c.judged.result.cam_from_board) {
+              poses.append(
+                  py::make_tuple(MatrixArray(pose.linear()),
+                                 MatrixArray(pose.translation()).reshape({3})));
+            }
+            return poses;
+          },
+          "per view (R, t): cam_from_board, P_cam = R @ P_board + t (metres)")
+      .def_property_readonly(
+          "residuals",
+          [](const PyCalibration& c) {
+            py::list out;
+            for (const auto& r : c.judged.result.residuals) {
+              out.append(PointsArray(r));
+            }
+            return out;
+          },
+          "per view, projected minus observed pixel (N x 2)")
+      .def_property_readonly(
+          "inliers",
+          [](const PyCalibration& c) {
+            py::list out;
+            for (const std::vector<bool>& mask : c.judged.result.inlier) {
+              py::array_t<bool> a(static_cast<py::ssize_t>(mask.size()));
+              for (size_t i = 0; i < mask.size(); ++i)
+                a.mutable_at(i) = mask[i];
+              out.append(a);
+            }
+            return out;
+          },
+          "per view, whether each corner was kept")
+      .def_property_readonly(
+          "verdict",
+          [](const PyCalibration& c) { return c.judged.judgement.verdict; })
+      .def_property_readonly(
+          "evidence",
+          [](const PyCalibration& c) {
+            return EvidenceDict(c.judged.judgement.evidence);
+          },
+          "the evidence behind the verdict: halves (two calibrations from "
+          "halves of the views and their difference map against what noise "
+          "gives), uncertainty (the projection's 1-sigma map and by field "
+          "angle), residual means by field angle and by distance")
+      .def_property_readonly(
+          "model_selection",
+          [](const PyCalibration& c) -> py::object {
+            if (!c.judged.auto_model) return py::none();
+            return py::str(c.judged.selection.Table());
+          },
+          "the held-out comparison of the models (model='auto'), as the "
+          "program prints it; None otherwise")
+      .def("summary",
+           [](const PyCalibration& c) { return c.judged.result.FullReport(); })
+      .def(
+          "save",
+          [](const PyCalibration& c, const std::string& path,
+             const std::string& format) {
+            CameraFileFormat file_format;
+            if (!CameraFileFormatFromName(format, &file_format)) {
+              Raise("unknown format '" + format +
+                    "'; choose one of puzzlecal, opencv, ros, kalibr");
+            }
+            const CameraFileStats stats =
+                CalibrationFileStats(c.judged.result, c.views, c.view_files,
+                                     c.board.Point(c.board.origin),
+                                     c.judged.judgement.verdict.Line());
+            std::string error, note;
+            if (!WriteCameraFile(path, file_format, c.judged.result.camera,
+                                 stats, &error, &note)) {
+              Raise(error);
+            }
+            return note;
+          },
+          py::arg("path"), py::arg("format") = "puzzlecal",
+          "Writes the camera file as `puzzlecal calibrate` does (with its "
+          "statistics, views and verdict); returns the format's note on "
+          "what it leaves out ('' when nothing).");
+
+  m.def("_calibrate_detections", &FromDetections, py::arg("detections"),
+        py::arg("board"), py::arg("model"), py::arg("options"),
+        py::arg("threads"));
+  m.def("_calibrate_observations", &FromObservations, py::arg("observations"),
+        py::arg("board"), py::arg("image_size"), py::arg("model"),
+        py::arg("options"), py::arg("threads"));
+}
+
+}  // namespace puzzlecal::python
