@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "formats/camera_file_formats.h"
 #include "formats/yaml_emit.h"
 #include "util/atomic_file.h"
 #include "util/enum_names.h"
@@ -14,8 +15,6 @@
 
 namespace puzzlecal {
 namespace {
-
-constexpr const char* kPuzzlecalFormatTag = "puzzlecal-camera";
 
 bool CheckCamera(const Camera& camera, std::string* error) {
   if (static_cast<int>(camera.params.size()) !=
@@ -35,405 +34,6 @@ bool CheckCamera(const Camera& camera, std::string* error) {
   }
   return true;
 }
-
-// One entry of the puzzlecal format's `views`.
-void EmitView(const CameraFileView& view, YAML::Emitter& out) {
-  out << YAML::BeginMap;
-  out << YAML::Key << "file" << YAML::Value << view.file;
-  out << YAML::Key << "cam_from_board" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "R" << YAML::Value;
-  EmitRows(out, view.cam_from_board.linear());
-  out << YAML::Key << "t" << YAML::Value;
-  EmitFlow(out, RowMajor(view.cam_from_board.translation()));
-  out << YAML::EndMap;
-  out << YAML::Key << "rms_px" << YAML::Value << view.rms_px;
-  out << YAML::Key << "corners" << YAML::Value << view.corners;
-  out << YAML::EndMap;
-}
-
-std::string FormatPuzzlecal(const Camera& camera,
-                            const CameraFileStats& stats) {
-  const std::vector<std::string> names = CameraModelParamNames(camera.model);
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  out << YAML::BeginMap;
-  out << YAML::Key << "format" << YAML::Value << kPuzzlecalFormatTag;
-  out << YAML::Key << "model" << YAML::Value << CameraModelName(camera.model);
-  out << YAML::Key << "image_width" << YAML::Value << camera.width;
-  out << YAML::Key << "image_height" << YAML::Value << camera.height;
-  EmitNamedValues(out, "parameters", names, camera.params);
-  if (stats.has_stats) {
-    if (stats.param_stddev.size() == names.size()) {
-      EmitNamedValues(out, "parameter_stddev", names, stats.param_stddev);
-    }
-    out << YAML::Key << "rms_px" << YAML::Value << stats.rms_px;
-    out << YAML::Key << "views_used" << YAML::Value << stats.num_views_used;
-    out << YAML::Key << "corners_used" << YAML::Value << stats.num_corners_used;
-    out << YAML::Key << "outliers" << YAML::Value << stats.num_outliers;
-    if (!stats.verdict.empty()) {
-      out << YAML::Key << "verdict" << YAML::Value << stats.verdict;
-    }
-    if (!stats.views.empty()) {
-      out << YAML::Key << "views" << YAML::Value << YAML::BeginSeq;
-      for (const CameraFileView& view : stats.views) EmitView(view, out);
-      out << YAML::EndSeq;
-    }
-  }
-  out << YAML::EndMap;
-  return std::string("# puzzlecal camera calibration\n") + out.c_str() + "\n";
-}
-
-// Key of a kannala-brandt camera's coefficients in the opencv format.
-constexpr char kOpenCvFisheyeKey[] = "fisheye_distortion_coefficients";
-
-// OpenCV's FileStorage wants "%YAML:1.0" and its own matrix tag.
-std::string FormatOpenCv(const Camera& camera) {
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  out << YAML::BeginMap;
-  out << YAML::Key << "model" << YAML::Value << CameraModelName(camera.model);
-  out << YAML::Key << "image_width" << YAML::Value << camera.width;
-  out << YAML::Key << "image_height" << YAML::Value << camera.height;
-  EmitOpenCvMatrix(out, "camera_matrix", 3, 3,
-                   RowMajor(CameraMatrixOf(camera)));
-  const std::vector<double> distortion = DistortionOf(camera);
-  // A fisheye's k1..k4 under OpenCV's usual key would be read as pinhole
-  // k1 k2 p1 p2 by cv::undistort and friends; its own key (the D of
-  // cv::fisheye) makes pinhole readers fail loudly instead.
-  const bool fisheye = CameraModelIsFisheye(camera.model);
-  if (fisheye) {
-    out << YAML::Key << "distortion_model" << YAML::Value << "fisheye";
-  }
-  EmitOpenCvMatrix(out, fisheye ? kOpenCvFisheyeKey : "distortion_coefficients",
-                   1, static_cast<int>(distortion.size()), distortion);
-  out << YAML::EndMap;
-  return std::string("%YAML:1.0\n---\n") + out.c_str() + "\n";
-}
-
-std::string FormatRos(const Camera& camera, const std::string& camera_name) {
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  const auto& p = camera.params;
-  out << YAML::BeginMap;
-  out << YAML::Key << "image_width" << YAML::Value << camera.width;
-  out << YAML::Key << "image_height" << YAML::Value << camera.height;
-  out << YAML::Key << "camera_name" << YAML::Value << camera_name;
-  EmitRosMatrix(out, "camera_matrix", 3, 3, RowMajor(CameraMatrixOf(camera)));
-  out << YAML::Key << "distortion_model" << YAML::Value
-      << RosDistortionModel(camera.model);
-  const std::vector<double> distortion = DistortionOf(camera);
-  EmitRosMatrix(out, "distortion_coefficients", 1,
-                static_cast<int>(distortion.size()), distortion);
-  EmitRosMatrix(out, "rectification_matrix", 3, 3, {1, 0, 0, 0, 1, 0, 0, 0, 1});
-  EmitRosMatrix(out, "projection_matrix", 3, 4,
-                {p[0], 0, p[2], 0, 0, p[1], p[3], 0, 0, 0, 1, 0});
-  out << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
-}
-
-bool FormatKalibr(const Camera& camera, const std::string& rostopic,
-                  std::string* text, std::string* error) {
-  const auto& p = camera.params;
-  std::vector<double> coeffs;
-  const char* model = "radtan";
-  switch (camera.model) {
-    case CameraModelId::kPinholeRational:
-      for (int k = 8; k < 12; ++k) {
-        if (p[k] != 0) {
-          return Fail("kalibr has no rational distortion model (k" +
-                          std::to_string(k - 5) + " = " + std::to_string(p[k]) +
-                          "): write the opencv or ros format, or calibrate "
-                          "pinhole-radtan with --format kalibr (k3 held at 0)",
-                      error);
-        }
-      }
-      [[fallthrough]];
-    case CameraModelId::kPinholeRadtan:
-      if (p[8] != 0) {
-        return Fail(
-            "kalibr's radtan model has no k3 (k3 = " + std::to_string(p[8]) +
-                "): write the opencv or ros format, or calibrate "
-                "with --format kalibr (k3 held at 0)",
-            error);
-      }
-      coeffs = {p[4], p[5], p[6], p[7]};
-      break;
-    case CameraModelId::kKannalaBrandt:
-    case CameraModelId::kKannalaBrandtNoncentral:  // its far-field part
-      model = "equidistant";
-      coeffs = {p[4], p[5], p[6], p[7]};
-      break;
-  }
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  out << YAML::BeginMap << YAML::Key << "cam0" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "camera_model" << YAML::Value << "pinhole";
-  out << YAML::Key << "intrinsics" << YAML::Value;
-  EmitFlow(out, {p[0], p[1], p[2], p[3]});
-  out << YAML::Key << "distortion_model" << YAML::Value << model;
-  out << YAML::Key << "distortion_coeffs" << YAML::Value;
-  EmitFlow(out, coeffs);
-  out << YAML::Key << "resolution" << YAML::Value << YAML::Flow
-      << YAML::BeginSeq << camera.width << camera.height << YAML::EndSeq;
-  out << YAML::Key << "rostopic" << YAML::Value << rostopic;
-  out << YAML::EndMap << YAML::EndMap;
-  *text = std::string(out.c_str()) + "\n";
-  return true;
-}
-
-// ---- reading ----
-
-constexpr Presence kRequired = Presence::kRequired;
-
-void ResetCamera(CameraModelId id, Camera* camera) {
-  camera->model = id;
-  camera->params.assign(CameraModelNumParams(id), 0.0);
-}
-
-bool ReadModel(const YAML::Node& map, const std::string& path, FieldReader& r,
-               CameraModelId* id) {
-  std::string name;
-  if (!r.String(map, path, "model", kRequired, &name)) return false;
-  if (!CameraModelIdFromName(name, id)) {
-    return r.Fail(
-        FieldReader::Join(path, "model"),
-        "unknown model '" + name + "' (known: " + CameraModelNames() + ")");
-  }
-  return true;
-}
-
-bool ReadImageSize(const YAML::Node& map, const std::string& path,
-                   FieldReader& r, Camera* camera) {
-  if (!r.Int(map, path, "image_width", kRequired, &camera->width) ||
-      !r.Int(map, path, "image_height", kRequired, &camera->height)) {
-    return false;
-  }
-  if (camera->width <= 0) {
-    return r.Fail(FieldReader::Join(path, "image_width"), "must be positive");
-  }
-  if (camera->height <= 0) {
-    return r.Fail(FieldReader::Join(path, "image_height"), "must be positive");
-  }
-  return true;
-}
-
-// fx fy cx cy from a row-major 3x3 camera matrix.
-bool SetIntrinsics(const std::vector<double>& k, const std::string& field,
-                   FieldReader& r, Camera* camera) {
-  if (k[1] != 0) return r.Fail(field, "skew is not supported");
-  if (!(k[0] > 0) || !(k[4] > 0)) {
-    return r.Fail(field, "focal lengths must be positive");
-  }
-  camera->params[0] = k[0];
-  camera->params[1] = k[4];
-  camera->params[2] = k[2];
-  camera->params[3] = k[5];
-  return true;
-}
-
-// Distortion coefficients into camera->params (zero-padded where the
-// format allows shorter lists).
-bool SetDistortion(const std::vector<double>& d, const std::string& field,
-                   size_t min_count, FieldReader& r, Camera* camera) {
-  const size_t count = camera->params.size() - kDistortionBegin;
-  if (d.size() < min_count || d.size() > count) {
-    return r.Fail(field,
-                  std::string("expected ") +
-                      (min_count == count ? std::to_string(count)
-                                          : std::to_string(min_count) + " to " +
-                                                std::to_string(count)) +
-                      " coefficients for " + CameraModelName(camera->model) +
-                      ", got " + std::to_string(d.size()));
-  }
-  for (size_t i = 0; i < d.size(); ++i) {
-    camera->params[kDistortionBegin + i] = d[i];
-  }
-  return true;
-}
-
-bool ParsePuzzlecal(const YAML::Node& map, const std::string& path,
-                    FieldReader& r, Camera* camera) {
-  CameraModelId id;
-  if (!ReadModel(map, path, r, &id)) return false;
-  ResetCamera(id, camera);
-  if (!ReadImageSize(map, path, r, camera)) return false;
-  YAML::Node params;
-  if (!r.Child(map, path, "parameters", kRequired, &params)) return false;
-  const std::string params_path = FieldReader::Join(path, "parameters");
-  const std::vector<std::string> names = CameraModelParamNames(id);
-  for (size_t k = 0; k < names.size(); ++k) {
-    if (!r.Double(params, params_path, names[k], kRequired,
-                  &camera->params[k])) {
-      return false;
-    }
-  }
-  if (!(camera->params[0] > 0) || !(camera->params[1] > 0)) {
-    return r.Fail(FieldReader::Join(params_path, "fx"),
-                  "focal lengths must be positive");
-  }
-  return true;
-}
-
-bool ParseViews(const YAML::Node& root, FieldReader& r,
-                std::vector<CameraFileView>* views) {
-  views->clear();
-  YAML::Node list;
-  if (!r.List(root, "", "views", Presence::kOptional, &list)) return false;
-  for (size_t v = 0; v < list.size(); ++v) {
-    const std::string path = FieldReader::Index("views", v);
-    const std::string pose_path = FieldReader::Join(path, "cam_from_board");
-    CameraFileView view;
-    YAML::Node pose;
-    Eigen::Matrix3d rotation;
-    std::vector<double> t;
-    if (!r.String(list[v], path, "file", kRequired, &view.file) ||
-        !r.Child(list[v], path, "cam_from_board", kRequired, &pose) ||
-        !r.Rows3x3(pose, pose_path, "R", kRequired, &rotation)) {
-      return false;
-    }
-    if (!((rotation.transpose() * rotation - Eigen::Matrix3d::Identity())
-              .cwiseAbs()
-              .maxCoeff() < 1e-6) ||
-        !(rotation.determinant() > 0)) {
-      return r.Fail(FieldReader::Join(pose_path, "R"), "not a rotation matrix");
-    }
-    if (!r.Doubles(pose, pose_path, "t", kRequired, 3, &t) ||
-        !r.Double(list[v], path, "rms_px", kRequired, &view.rms_px) ||
-        !r.Int(list[v], path, "corners", kRequired, &view.corners)) {
-      return false;
-    }
-    view.cam_from_board.linear() = rotation;
-    view.cam_from_board.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
-    views->push_back(view);
-  }
-  return true;
-}
-
-bool ParseOpenCvOrRos(const YAML::Node& map, const std::string& path, bool ros,
-                      FieldReader& r, Camera* camera) {
-  CameraModelId id = CameraModelId::kPinholeRadtan;
-  std::vector<double> k, d;
-  if (!r.Matrix(map, path, "camera_matrix", kRequired, 3, 3, &k)) {
-    return false;
-  }
-  const std::string distortion_key = !ros && map[kOpenCvFisheyeKey]
-                                         ? kOpenCvFisheyeKey
-                                         : "distortion_coefficients";
-  const std::string distortion_field = FieldReader::Join(path, distortion_key);
-  if (!r.Matrix(map, path, distortion_key, kRequired, 0, 0, &d)) return false;
-  if (ros) {
-    std::string model;
-    if (!r.String(map, path, "distortion_model", kRequired, &model)) {
-      return false;
-    }
-    if (model == "plumb_bob") {
-      id = CameraModelId::kPinholeRadtan;
-    } else if (model == "rational_polynomial") {
-      id = CameraModelId::kPinholeRational;
-    } else if (model == "equidistant" || model == "fisheye") {
-      id = CameraModelId::kKannalaBrandt;
-    } else {
-      return r.Fail(FieldReader::Join(path, "distortion_model"),
-                    "unknown model '" + model +
-                        "' (known: plumb_bob, rational_polynomial, "
-                        "equidistant)");
-    }
-  } else if (map["model"]) {
-    if (!ReadModel(map, path, r, &id)) return false;
-    if (CameraModelIsFisheye(id) != (distortion_key == kOpenCvFisheyeKey)) {
-      return r.Fail(
-          distortion_field,
-          std::string("model ") + CameraModelName(id) +
-              (CameraModelIsFisheye(id) ? " keeps its coefficients under "
-                                        : " cannot use ") +
-              kOpenCvFisheyeKey);
-    }
-  } else if (distortion_key == kOpenCvFisheyeKey) {
-    id = CameraModelId::kKannalaBrandt;
-  } else {
-    // OpenCV's own files carry no model: tell it by the number of
-    // coefficients (4 or 5: plumb_bob, 8: rational).
-    if (d.size() == 8)
-      id = CameraModelId::kPinholeRational;
-    else if (d.size() == 4 || d.size() == 5)
-      id = CameraModelId::kPinholeRadtan;
-    else {
-      return r.Fail(distortion_field,
-                    std::to_string(d.size()) +
-                        " coefficients without a 'model' field (expected 4, "
-                        "5 or 8)");
-    }
-  }
-  ResetCamera(id, camera);
-  if (!ReadImageSize(map, path, r, camera)) return false;
-  if (!SetIntrinsics(k, FieldReader::Join(path, "camera_matrix.data"), r,
-                     camera)) {
-    return false;
-  }
-  const size_t count = camera->params.size() - kDistortionBegin;
-  // plumb_bob may omit k3; the other models need all coefficients.
-  const size_t min_count = id == CameraModelId::kPinholeRadtan ? 4 : count;
-  return SetDistortion(d, FieldReader::Join(distortion_field, "data"),
-                       min_count, r, camera);
-}
-
-bool ParseKalibr(const YAML::Node& map, const std::string& path, FieldReader& r,
-                 Camera* camera) {
-  YAML::Node cam;
-  if (!r.Child(map, path, "cam0", kRequired, &cam)) return false;
-  const std::string cam_path = FieldReader::Join(path, "cam0");
-  std::string camera_model, distortion_model;
-  if (!r.String(cam, cam_path, "camera_model", kRequired, &camera_model)) {
-    return false;
-  }
-  if (camera_model != "pinhole") {
-    return r.Fail(FieldReader::Join(cam_path, "camera_model"),
-                  "only 'pinhole' is supported, got '" + camera_model + "'");
-  }
-  if (!r.String(cam, cam_path, "distortion_model", kRequired,
-                &distortion_model)) {
-    return false;
-  }
-  CameraModelId id;
-  if (distortion_model == "radtan") {
-    id = CameraModelId::kPinholeRadtan;
-  } else if (distortion_model == "equidistant") {
-    id = CameraModelId::kKannalaBrandt;
-  } else {
-    return r.Fail(FieldReader::Join(cam_path, "distortion_model"),
-                  "unknown model '" + distortion_model +
-                      "' (known: radtan, equidistant)");
-  }
-  ResetCamera(id, camera);
-  std::vector<double> intrinsics, coeffs, resolution;
-  if (!r.Doubles(cam, cam_path, "intrinsics", kRequired, 4, &intrinsics)) {
-    return false;
-  }
-  if (!(intrinsics[0] > 0) || !(intrinsics[1] > 0)) {
-    return r.Fail(FieldReader::Join(cam_path, "intrinsics"),
-                  "focal lengths must be positive");
-  }
-  for (int k = 0; k < 4; ++k) camera->params[k] = intrinsics[k];
-  if (!r.Doubles(cam, cam_path, "distortion_coeffs", kRequired, 4, &coeffs)) {
-    return false;
-  }
-  for (int k = 0; k < 4; ++k) camera->params[kDistortionBegin + k] = coeffs[k];
-  if (!r.Doubles(cam, cam_path, "resolution", kRequired, 2, &resolution)) {
-    return false;
-  }
-  // Whole numbers in a sane range before the cast (a double beyond int's
-  // range would make it undefined).
-  if (!std::all_of(resolution.begin(), resolution.end(), [](double v) {
-        return v >= 1 && v <= 1e6 && v == std::floor(v);
-      })) {
-    return r.Fail(FieldReader::Join(cam_path, "resolution"),
-                  "must be [width, height], whole numbers in [1, 1000000]");
-  }
-  camera->width = static_cast<int>(resolution[0]);
-  camera->height = static_cast<int>(resolution[1]);
-  return true;
-}
-
 // The root of a camera file's text. yaml-cpp does not know OpenCV's
 // "%YAML:1.0" directive: it becomes a comment (so line numbers stay right),
 // and `opencv_header` says it was there.
@@ -457,16 +57,16 @@ bool ParseCameraNode(const YAML::Node& node, const std::string& path,
   bool ok;
   if (node["format"] || node["parameters"]) {
     found = CameraFileFormat::kPuzzlecal;
-    ok = ParsePuzzlecal(node, path, r, &parsed);
+    ok = camera_file::ParsePuzzlecal(node, path, r, &parsed);
   } else if (node["cam0"]) {
     found = CameraFileFormat::kKalibr;
-    ok = ParseKalibr(node, path, r, &parsed);
+    ok = camera_file::ParseKalibr(node, path, r, &parsed);
   } else if (node["distortion_model"] && !opencv_header) {
     found = CameraFileFormat::kRos;
-    ok = ParseOpenCvOrRos(node, path, /*ros=*/true, r, &parsed);
+    ok = camera_file::ParseOpenCvOrRos(node, path, /*ros=*/true, r, &parsed);
   } else if (opencv_header || node["camera_matrix"]) {
     found = CameraFileFormat::kOpenCv;
-    ok = ParseOpenCvOrRos(node, path, /*ros=*/false, r, &parsed);
+    ok = camera_file::ParseOpenCvOrRos(node, path, /*ros=*/false, r, &parsed);
   } else {
     return r.Fail(path,
                   "not a camera file in any known format (puzzlecal, opencv, "
@@ -640,16 +240,16 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
   }
   switch (format) {
     case CameraFileFormat::kPuzzlecal:
-      *text = FormatPuzzlecal(camera, stats);
+      *text = camera_file::FormatPuzzlecal(camera, stats);
       return true;
     case CameraFileFormat::kOpenCv:
-      *text = FormatOpenCv(camera);
+      *text = camera_file::FormatOpenCv(camera);
       return true;
     case CameraFileFormat::kRos:
-      *text = FormatRos(camera, names.camera_name);
+      *text = camera_file::FormatRos(camera, names.camera_name);
       return true;
     case CameraFileFormat::kKalibr:
-      return FormatKalibr(camera, names.rostopic, text, error);
+      return camera_file::FormatKalibr(camera, names.rostopic, text, error);
   }
   return Fail("unknown camera file format", error);
 }
@@ -796,7 +396,7 @@ bool ReadCameraFileViews(const std::string& path,
   if (!root.IsMap()) return Fail(path + ": not a camera file", error);
   FieldReader reader(path, error);
   try {
-    return ParseViews(root, reader, views);
+    return camera_file::ParseViews(root, reader, views);
   } catch (const YAML::Exception& e) {
     return Fail(path + ": " + e.what(), error);
   }
