@@ -18,6 +18,7 @@
 #include "apps/subcommand.h"
 #include "calib/rig_calibration.h"
 #include "evidence/evidence.h"
+#include "evidence/rig_evidence.h"
 #include "evidence/verdict.h"
 #include "formats/board_file.h"
 #include "formats/camera_yaml.h"
@@ -292,7 +293,65 @@ void NotePartialCheckerboards(const Board& board,
 struct CameraJudgements {
   std::vector<Evidence> evidence;  // one per camera
   std::vector<Verdict> verdicts;
+  // The rig's: per-frame consistency and its verdict.
+  RigEvidence rig;
+  RigVerdict rig_verdict;
+  RigFileJudgement file;  // what the puzzlecal rig file carries
 };
+
+// The frames' names: the first camera's file name that exists.
+std::vector<std::string> FrameNames(
+    const std::vector<std::vector<std::string>>& frame_files) {
+  std::vector<std::string> names(frame_files.empty() ? 0
+                                                     : frame_files[0].size());
+  for (size_t f = 0; f < names.size(); ++f) {
+    for (const std::vector<std::string>& files : frame_files) {
+      if (f < files.size() && !files[f].empty()) {
+        names[f] = fs::path(files[f]).filename().string();
+        break;
+      }
+    }
+  }
+  return names;
+}
+
+void JudgeRig(const std::vector<RigCameraInput>& inputs,
+              const RunOptions& run_options, const RigCalibrationResult& result,
+              const std::vector<std::vector<std::string>>& frame_files,
+              CameraJudgements* judged) {
+  judged->rig = ComputeRigEvidence(inputs, result, run_options.rig_evidence);
+  judged->rig_verdict =
+      MakeRigVerdict(result, judged->rig, judged->verdicts,
+                     FrameNames(frame_files), run_options.rig_evidence);
+  RigFileJudgement& file = judged->file;
+  file.verdict_kind = judged->rig_verdict.kind;
+  file.verdict_reason = judged->rig_verdict.reason;
+  file.verdict_next_step = judged->rig_verdict.next_step;
+  for (size_t f = 0; f < judged->rig.frames.size(); ++f) {
+    const RigFrameEvidence& frame = judged->rig.frames[f];
+    RigFileFrame out;
+    for (size_t c = 0; c < result.cameras.size(); ++c) {
+      const RigFrameCamera& view = frame.cameras[c];
+      out.files.push_back(f < frame_files[c].size() ? frame_files[c][f] : "");
+      std::string use = view.used ? "used" : "";
+      if (!view.note.empty()) {
+        use = view.used ? "used; " + view.note : view.note;
+      } else if (!view.used) {
+        use = out.files.back().empty() ? "not used: no image"
+              : view.has_view          ? "not used"
+                                       : "not used: the board was not found";
+      }
+      out.use.push_back(use);
+      out.rms_px.push_back(view.rms_px);
+    }
+    out.compared = frame.compared;
+    out.transfer_px = frame.transfer_px;
+    out.pose_difference_mm = frame.pose_difference_mm;
+    out.epipolar_px = frame.epipolar_px;
+    out.moved = frame.moved;
+    file.frames.push_back(out);
+  }
+}
 
 CameraJudgements JudgeCameras(const std::vector<RigCameraInput>& inputs,
                               const RigCalibrationOptions& options,
@@ -348,6 +407,7 @@ void PrintRigOutcome(const RigCalibrationResult& result,
     std::cout << RigVerdictLine(result.cameras[c].name, judged.verdicts[c])
               << "\n";
   }
+  std::cout << judged.rig_verdict.Line() << "\n";
   const bool rectified =
       format == CameraFileFormat::kOpenCv || format == CameraFileFormat::kRos;
   if (rectified && result.cameras.size() == 2) {
@@ -387,6 +447,10 @@ bool WriteReport(const RigCalibrationResult& result, bool calibrated,
     report.evidence.push_back(&judged.evidence[c]);
     report.verdicts.push_back(&judged.verdicts[c]);
   }
+  if (calibrated) {
+    report.rig_evidence = &judged.rig;
+    report.rig_verdict = &judged.rig_verdict;
+  }
   return WriteRigReport(FLAGS_report, report, RigReportOptions(), error);
 }
 
@@ -423,9 +487,11 @@ int RunCalibrateRig() {
   const bool calibrated = CalibrateRig(inputs, BoardSymmetry(request.board),
                                        options, &result, &calibration_error);
   NotePartialCheckerboards(request.board, inputs, &result);
-  const CameraJudgements judged =
+  CameraJudgements judged =
       calibrated ? JudgeCameras(inputs, options, request.options, result)
                  : CameraJudgements();
+  if (calibrated)
+    JudgeRig(inputs, request.options, result, frame_files, &judged);
   if (!FLAGS_report.empty() &&
       !WriteReport(result, calibrated, calibration_error, judged, frame_files,
                    seconds_images, run_timer.Seconds(), request.threads,
@@ -439,7 +505,8 @@ int RunCalibrateRig() {
     return kExitNoResult;
   }
   std::vector<std::string> written;
-  if (!WriteRigFiles(FLAGS_out, request.format, result, &written, &error)) {
+  if (!WriteRigFiles(FLAGS_out, request.format, result, &written, &error,
+                     &judged.file)) {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
   }

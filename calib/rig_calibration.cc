@@ -1138,6 +1138,15 @@ bool CalibrateRig(const std::vector<RigCameraInput>& input_cameras,
                        &result->start_parent, &result->cameras, error)) {
     return false;
   }
+  for (size_t c = 0; c < num_cameras; ++c) {
+    result->cameras[c].alone_cam_from_board = single[c].cam_from_board;
+    result->cameras[c].alone_posed = single[c].view_used;
+  }
+  if (symmetry.half_turn) {
+    result->half_turn.linear() = Eigen::Vector3d(-1, -1, 1).asDiagonal();
+    result->half_turn.translation() =
+        Eigen::Vector3d(2 * symmetry.centre.x(), 2 * symmetry.centre.y(), 0);
+  }
   JointState state;
   StartJointState(cameras, single, cam_from_rig, copt.min_corners_per_view,
                   &state);

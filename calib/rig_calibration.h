@@ -125,10 +125,17 @@ struct RigCameraResult {
   // view was not used.
   std::vector<bool> relabelled;
   std::vector<std::string> frame_note;
+  // Per frame: the camera's own pose of the board (its own calibration,
+  // in the rig's labels: turned where relabelled) and whether it has one.
+  std::vector<Eigen::Isometry3d> alone_cam_from_board;
+  std::vector<bool> alone_posed;
 };
 
 struct RigCalibrationResult {
   std::vector<RigCameraResult> cameras;  // in input order; [0] = reference
+  // The board points of a relabelled view are this transform of the
+  // input's (the board's half turn; identity without a symmetry).
+  Eigen::Isometry3d half_turn = Eigen::Isometry3d::Identity();
   // Per frame: whether any camera took part, and the board pose.
   std::vector<bool> frame_used;
   std::vector<Eigen::Isometry3d> rig_from_board;  // identity when not used

@@ -33,7 +33,43 @@ bool CheckCameras(const RigCalibrationResult& result, std::string* error) {
   return true;
 }
 
-std::string FormatPuzzlecal(const RigCalibrationResult& result) {
+void EmitJudgement(YAML::Emitter& out, const RigCalibrationResult& result,
+                   const RigFileJudgement& judgement) {
+  out << YAML::Key << "verdict" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "kind" << YAML::Value << judgement.verdict_kind;
+  out << YAML::Key << "reason" << YAML::Value << judgement.verdict_reason;
+  out << YAML::Key << "next_step" << YAML::Value << judgement.verdict_next_step;
+  out << YAML::EndMap;
+  out << YAML::Key << "frames" << YAML::Value << YAML::BeginSeq;
+  for (const RigFileFrame& frame : judgement.frames) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "cameras" << YAML::Value << YAML::BeginSeq;
+    for (size_t c = 0; c < result.cameras.size() && c < frame.files.size();
+         ++c) {
+      out << YAML::BeginMap;
+      out << YAML::Key << "name" << YAML::Value << result.cameras[c].name;
+      out << YAML::Key << "file" << YAML::Value << frame.files[c];
+      out << YAML::Key << "use" << YAML::Value << frame.use[c];
+      if (frame.rms_px[c] > 0) {
+        out << YAML::Key << "rms_px" << YAML::Value << frame.rms_px[c];
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+    if (frame.compared) {
+      out << YAML::Key << "transfer_px" << YAML::Value << frame.transfer_px;
+      out << YAML::Key << "pose_difference_mm" << YAML::Value
+          << frame.pose_difference_mm;
+      out << YAML::Key << "epipolar_px" << YAML::Value << frame.epipolar_px;
+      out << YAML::Key << "moved" << YAML::Value << frame.moved;
+    }
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+}
+
+std::string FormatPuzzlecal(const RigCalibrationResult& result,
+                            const RigFileJudgement* judgement) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   out << YAML::BeginMap;
@@ -84,6 +120,7 @@ std::string FormatPuzzlecal(const RigCalibrationResult& result) {
     out << YAML::EndMap;
   }
   out << YAML::EndSeq;
+  if (judgement != nullptr) EmitJudgement(out, result, *judgement);
   out << YAML::EndMap;
   return std::string("# puzzlecal rig calibration\n") + out.c_str() + "\n";
 }
@@ -260,7 +297,8 @@ bool FormatKalibr(const RigCalibrationResult& result, std::string* text,
 
 bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
                     const std::string& out_path,
-                    std::vector<RigFileText>* files, std::string* error) {
+                    std::vector<RigFileText>* files, std::string* error,
+                    const RigFileJudgement* judgement) {
   files->clear();
   if (!CheckCameras(result, error)) return false;
   // opencv, ros and kalibr have no non-central model: they get each
@@ -273,7 +311,7 @@ bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
   file.path = out_path;
   switch (format) {
     case CameraFileFormat::kPuzzlecal:
-      file.text = FormatPuzzlecal(result);
+      file.text = FormatPuzzlecal(result, judgement);
       break;
     case CameraFileFormat::kOpenCv:
       if (!FormatOpenCv(far_field, &file.text, error)) return false;
@@ -290,10 +328,11 @@ bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
 
 bool WriteRigFiles(const std::string& out_path, CameraFileFormat format,
                    const RigCalibrationResult& result,
-                   std::vector<std::string>* written, std::string* error) {
+                   std::vector<std::string>* written, std::string* error,
+                   const RigFileJudgement* judgement) {
   std::vector<RigFileText> files;
   std::string why;
-  if (!FormatRigFiles(result, format, out_path, &files, &why)) {
+  if (!FormatRigFiles(result, format, out_path, &files, &why, judgement)) {
     return Fail("cannot write '" + out_path + "' (" +
                     CameraFileFormatName(format) + " format): " + why,
                 error);

@@ -36,18 +36,43 @@ struct RigFileText {
   std::string text;
 };
 
+// One frame of the puzzlecal rig file's `frames:` list.
+struct RigFileFrame {
+  // Per camera (the order of the cameras): the image file ("" = none),
+  // "used" or why not, the rig's residual RMS of the view (px).
+  std::vector<std::string> files;
+  std::vector<std::string> use;
+  std::vector<double> rms_px;
+  bool compared = false;  // the figures below exist
+  double transfer_px = 0;
+  double pose_difference_mm = 0;
+  double epipolar_px = 0;
+  bool moved = false;  // looks unsynchronised or moved
+};
+
+// The judgement the puzzlecal rig file carries (`verdict:`, `frames:`).
+struct RigFileJudgement {
+  std::string verdict_kind;
+  std::string verdict_reason;
+  std::string verdict_next_step;
+  std::vector<RigFileFrame> frames;
+};
+
 // The files of `result` in `format` for the output path `out_path` (one
 // file, except ros: one per camera next to it, named after the camera).
 // False with a reason when the format cannot hold the rig without loss.
+// `judgement` (optional) goes into the puzzlecal format.
 bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
                     const std::string& out_path,
-                    std::vector<RigFileText>* files, std::string* error);
+                    std::vector<RigFileText>* files, std::string* error,
+                    const RigFileJudgement* judgement = nullptr);
 
 // Formats, then writes every file atomically; `written` (optional) returns
 // the paths.
 bool WriteRigFiles(const std::string& out_path, CameraFileFormat format,
                    const RigCalibrationResult& result,
-                   std::vector<std::string>* written, std::string* error);
+                   std::vector<std::string>* written, std::string* error,
+                   const RigFileJudgement* judgement = nullptr);
 
 // A camera of a rig file.
 struct RigFileCamera {

@@ -135,12 +135,69 @@ std::string CameraSection(const RigCameraResult& cam, const Evidence* evidence,
   return md.str();
 }
 
+// The frames: per camera whether it was used (or why not) and its rig
+// RMS, the frame's transfer error, pose difference and epipolar error;
+// frames that look moved are marked.
+std::string FramesTable(const RigReportInput& input) {
+  const RigCalibrationResult& result = *input.result;
+  const RigEvidence& evidence = *input.rig_evidence;
+  std::ostringstream md;
+  md << "## Frames\n\nPer frame: each camera's image, whether the rig used "
+        "it and its residual RMS in the rig (px); the transfer error (the "
+        "board as one camera posed it alone, moved through the rig to the "
+        "other: RMS px), how far the frame's relative pose is from the "
+        "rig's, and the epipolar error (median, px). "
+     << StringPrintf("Frames whose transfer error exceeds %.2f px ",
+                     evidence.moved_limit_px)
+     << "(typical " << StringPrintf("%.2f", evidence.median_transfer_px)
+     << " px) look unsynchronised or moved: **moved**.\n\n| frame |";
+  for (const RigCameraResult& cam : result.cameras) {
+    md << " " << cam.name << " |";
+  }
+  md << " transfer (px) | pose difference | epipolar (px) | |\n|---|";
+  for (size_t c = 0; c < result.cameras.size(); ++c) md << "---|";
+  md << "---:|---:|---:|---|\n";
+  for (size_t f = 0; f < evidence.frames.size(); ++f) {
+    const RigFrameEvidence& frame = evidence.frames[f];
+    std::string name;
+    for (size_t c = 0; c < input.files.size() && name.empty(); ++c) {
+      if (f < input.files[c].size() && !input.files[c][f].empty()) {
+        name = fs::path(input.files[c][f]).filename().string();
+      }
+    }
+    md << "| " << (name.empty() ? std::to_string(f + 1) : name) << " |";
+    for (const RigFrameCamera& view : frame.cameras) {
+      std::string cell = !view.has_view ? "-"
+                         : view.used    ? StringPrintf("%.3f", view.rms_px)
+                                        : "not used";
+      if (!view.note.empty()) {
+        cell = view.used ? cell + " (" + view.note + ")" : view.note;
+      }
+      std::replace(cell.begin(), cell.end(), '|', '/');
+      md << " " << cell << " |";
+    }
+    if (frame.compared) {
+      md << StringPrintf(" %.3f | %.2f mm, %.3f deg | %.3f | %s |\n",
+                         frame.transfer_px, frame.pose_difference_mm,
+                         frame.pose_difference_deg, frame.epipolar_px,
+                         frame.moved ? "**moved**" : "");
+    } else {
+      md << " | | | |\n";
+    }
+  }
+  md << "\n";
+  return md.str();
+}
+
 std::string RigSummary(const RigReportInput& input,
                        const std::vector<CameraCharts>& charts, bool pair,
                        const std::string& rect_note) {
   std::ostringstream md;
   md << "# Rig calibration report\n\n";
   const bool evidence = HasEvidence(input);
+  if (input.rig_verdict != nullptr) {
+    md << "**" << input.rig_verdict->Line() << "**\n\n";
+  }
   if (evidence) {
     for (size_t c = 0; c < input.verdicts.size(); ++c) {
       md << "- "
@@ -153,6 +210,7 @@ std::string RigSummary(const RigReportInput& input,
     md << "> **Calibration failed:** " << input.calibration_error << "\n\n";
   } else if (input.result != nullptr && !input.result->cameras.empty()) {
     md << "## Rig\n\n```\n" << RigCalibrationReport(*input.result) << "```\n\n";
+    if (input.rig_evidence != nullptr) md << FramesTable(input);
     for (size_t c = 0; c < input.result->cameras.size(); ++c) {
       md << CameraSection(input.result->cameras[c],
                           evidence ? input.evidence[c] : nullptr,

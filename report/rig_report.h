@@ -18,6 +18,7 @@
 #include "calib/rig_calibration.h"
 #include "camera/camera_models.h"
 #include "evidence/evidence.h"
+#include "evidence/rig_evidence.h"
 #include "evidence/verdict.h"
 #include "formats/rig_yaml.h"
 #include "report/report.h"
@@ -45,6 +46,10 @@ struct RigReportInput {
   // failed calibration); otherwise one non-null entry per camera each.
   std::vector<const Evidence*> evidence;
   std::vector<const Verdict*> verdicts;
+  // The rig's per-frame consistency and verdict (evidence/rig_evidence.h);
+  // null when not computed.
+  const RigEvidence* rig_evidence = nullptr;
+  const RigVerdict* rig_verdict = nullptr;
   double seconds_images = 0;  // detection, grid and decode, wall clock
   double seconds_total = 0;
   int threads = 1;

@@ -156,6 +156,24 @@ CamFromRigError CompareCamFromRig(const RigCameraResult& estimate,
   return error;
 }
 
+Eigen::Isometry3d RigFramePoseSeenBy(
+    const RigSceneSpec& scene, const std::vector<Eigen::Isometry3d>& frames,
+    size_t c, size_t f) {
+  Eigen::Isometry3d pose = frames[f];
+  if (c == 0 || std::find(scene.moved_frames.begin(), scene.moved_frames.end(),
+                          static_cast<int>(f)) == scene.moved_frames.end()) {
+    return pose;
+  }
+  std::mt19937_64 rng(scene.moved_seed * 1000003 + f);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::Vector3d direction;
+  do {
+    direction = Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+  } while (!(direction.norm() > 1e-6));
+  pose.translation() += scene.moved_by_m * direction.normalized();
+  return pose;
+}
+
 std::vector<RigCameraInput> RigCorrespondences(const RigSceneSpec& scene,
                                                double noise_px, uint64_t seed) {
   const std::vector<Eigen::Isometry3d> frames = RigFramePoses(scene);
@@ -173,7 +191,7 @@ std::vector<RigCameraInput> RigCorrespondences(const RigSceneSpec& scene,
       CalibrationView& view = input.frames[f];
       view.name = RigFrameFileName(static_cast<int>(f));
       const std::vector<TruthCorner> corners =
-          VisibleCorners(scene, c, frames[f]);
+          VisibleCorners(scene, c, RigFramePoseSeenBy(scene, frames, c, f));
       const int visible = static_cast<int>(
           std::count_if(corners.begin(), corners.end(),
                         [](const TruthCorner& t) { return t.visible; }));
@@ -227,7 +245,8 @@ bool RenderRigScene(const RigSceneSpec& scene, const std::string& dir,
       RenderOptions options = scene.render;
       options.field_of_view_deg = cam.field_of_view_deg;
       options.seed = scene.render.seed + 1000 * c + f;
-      const Eigen::Isometry3d cam_from_board = cam.cam_from_rig * frames[f];
+      const Eigen::Isometry3d cam_from_board =
+          cam.cam_from_rig * RigFramePoseSeenBy(scene, frames, c, f);
       const std::vector<TruthCorner> corners =
           ProjectBoardCorners(scene.board, cam.camera, cam_from_board, options);
       const int visible = static_cast<int>(

@@ -61,6 +61,13 @@ struct RigSceneSpec {
   // visible corners (fewer: the camera "did not see" the frame and no file
   // is written). Default 12.
   int min_visible_corners = 12;
+  // Cameras not synchronised: in the frames listed (indices), every camera
+  // but the first sees the board moved by `moved_by_m` metres (in the rig
+  // frame, in a direction drawn from moved_seed and the frame index), as a
+  // hand-held board moves between two exposures. Default none.
+  std::vector<int> moved_frames;
+  double moved_by_m = 0.0;
+  uint64_t moved_seed = 1;
 
   // False with a reason naming the field when the rig cannot be rendered.
   bool Check(std::string* why = nullptr) const;
@@ -68,6 +75,12 @@ struct RigSceneSpec {
 
 // Every frame's rig_from_board (explicit, then random), deterministic.
 std::vector<Eigen::Isometry3d> RigFramePoses(const RigSceneSpec& scene);
+
+// The board pose camera `c` sees in frame `f` (`frames`: RigFramePoses):
+// the frame's, moved for the cameras after the first in the moved frames.
+Eigen::Isometry3d RigFramePoseSeenBy(
+    const RigSceneSpec& scene, const std::vector<Eigen::Isometry3d>& frames,
+    size_t c, size_t f);
 
 // The exact correspondences of the rig: per camera one view per frame with
 // the visible corners (TruthCorner::visible; empty when fewer than

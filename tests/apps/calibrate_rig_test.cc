@@ -377,6 +377,44 @@ TEST(CalibrateRigTest, FisheyePairFilesRectifyTheirOwnCorners) {
   }
 }
 
+// A second camera out of sync: in three frames it saw the board 4 mm away
+// from where the first did. The frames are named by file on the output and
+// in summary.md, marked in rig.yaml's frames list, and the rig verdict is
+// not good.
+TEST(CalibrateRigTest, UnsynchronisedFramesAreNamedByFile) {
+  RigSceneSpec scene = StereoPinholeRig();
+  scene.moved_frames = {2, 6, 11};
+  scene.moved_by_m = 0.004;
+  const RenderedRig rig = Render(scene, "unsynchronised");
+  const fs::path out = rig.root / "rig.yaml";
+  const fs::path report = rig.root / "report";
+  const RunResult run =
+      RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
+                 rig.board + " --model pinhole-radtan --out " + out.string() +
+                 " --report " + report.string() + " --threads 2");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  const std::string verdict = OutputLine(run.output, "rig: verdict: ");
+  EXPECT_EQ(verdict.rfind("rig: verdict: moved-frames", 0), 0u) << run.output;
+  const YAML::Node file = YAML::LoadFile(out.string());
+  EXPECT_EQ(file["verdict"]["kind"].as<std::string>(), "moved-frames");
+  ASSERT_EQ(file["frames"].size(), static_cast<size_t>(rig.summary.num_frames));
+  const std::string summary = ReadText(report / "summary.md");
+  for (int f = 0; f < rig.summary.num_frames; ++f) {
+    const bool moved = f == 2 || f == 6 || f == 11;
+    const YAML::Node frame = file["frames"][f];
+    EXPECT_EQ(frame["cameras"][1]["file"].as<std::string>(),
+              (rig.images / "cam1" / RigFrameFileName(f)).string());
+    if (!frame["moved"]) continue;
+    EXPECT_EQ(frame["moved"].as<bool>(), moved) << "frame " << f;
+    EXPECT_EQ(verdict.find(RigFrameFileName(f)) != std::string::npos, moved)
+        << verdict;
+    EXPECT_EQ(
+        summary.find("| " + RigFrameFileName(f) + " |") != std::string::npos,
+        true);
+  }
+  EXPECT_NE(summary.find("**" + verdict + "**"), std::string::npos);
+}
+
 TEST(CalibrateRigTest, StereoPinholeRendersInOpenCvFormat) {
   const RenderedRig rig = Render(StereoPinholeRig(), "stereo");
   const fs::path out = rig.root / "stereo.yaml";
