@@ -18,6 +18,7 @@
 #include "apps/subcommand.h"
 #include "calib/rig_calibration.h"
 #include "evidence/evidence.h"
+#include "evidence/model_selection.h"
 #include "evidence/rig_evidence.h"
 #include "evidence/verdict.h"
 #include "formats/board_file.h"
@@ -27,6 +28,11 @@
 #include "pipeline/pipeline.h"
 #include "report/rig_report.h"
 #include "util/timer.h"
+
+DEFINE_bool(match_by_order, false,
+            "calibrate-rig: pair the n-th image (sorted by name) of every "
+            "camera folder as one frame, instead of matching frames by file "
+            "name. Every folder must then hold the same number of images.");
 
 namespace puzzlecal {
 namespace {
@@ -38,12 +44,16 @@ constexpr char kUsage[] =
     "--model M[,M1,...] --out rig.yaml\n"
     "                        [--format puzzlecal|opencv|ros|kalibr] "
     "[--report DIR] [--threads N]\n"
-    "                        [--options FILE]\n\n"
+    "                        [--options FILE] [--match_by_order]\n\n"
     "Calibrates a rig of cameras. DIR holds one subfolder per camera; sorted "
     "by name, the first\nis the reference camera (the rig frame). The same "
     "file name in different subfolders is the\nsame instant; a camera "
-    "without that file did not see the board then. One --model for all\n"
-    "cameras, or one per camera in folder order. Writes the rig file "
+    "without that file did not see the board then (--match_by_order\n"
+    "pairs the n-th image of every folder instead, for folders named "
+    "left01.jpg, right01.jpg, ...).\nOne --model for all "
+    "cameras, or one per camera in folder order; auto chooses a camera's\n"
+    "model by held-out error, as calibrate --model auto does. Writes the rig "
+    "file "
     "atomically (ros: one\ncamera_info file per camera, OUT_STEM_NAME.yaml); "
     "a run that cannot produce a trustworthy\nresult exits non-zero and "
     "writes nothing.";
@@ -89,6 +99,7 @@ struct RigRequest {
   CameraFileFormat format = CameraFileFormat::kPuzzlecal;
   std::vector<fs::path> folders;      // one per camera, sorted
   std::vector<CameraModelId> models;  // one per camera
+  std::vector<bool> auto_model;       // per camera: --model auto
   // Per camera, the parameters the format holds fixed (Kalibr's radtan has
   // no k3).
   std::vector<std::vector<std::string>> format_fixed;
@@ -97,23 +108,28 @@ struct RigRequest {
   RunOptions options;  // --options FILE, or the defaults
 };
 
-// The models of --model (one for all cameras or one per camera).
-int ParseModelNames(std::vector<CameraModelId>* models) {
+// The models of --model (one for all cameras or one per camera; "auto"
+// chooses after detection).
+int ParseModelNames(std::vector<CameraModelId>* models,
+                    std::vector<bool>* auto_model) {
   for (const std::string& name : SplitCommas(FLAGS_model)) {
-    CameraModelId id;
-    if (!CameraModelIdFromName(name, &id)) {
+    CameraModelId id = CameraModelId::kPinholeRadtan;
+    const bool is_auto = name == "auto";
+    if (!is_auto && !CameraModelIdFromName(name, &id)) {
       std::cerr << kName << ": unknown model '" << name << "'; choose one of "
-                << CameraModelNames() << ".\n";
+                << CameraModelNames() << " or auto.\n";
       return kExitUsage;
     }
     models->push_back(id);
+    auto_model->push_back(is_auto);
   }
   return kExitOk;
 }
 
 // One model for all cameras becomes one per camera, in folder order.
 int MatchModelsToFolders(const std::vector<fs::path>& folders,
-                         std::vector<CameraModelId>* models) {
+                         std::vector<CameraModelId>* models,
+                         std::vector<bool>* auto_model) {
   if (models->size() != 1 && models->size() != folders.size()) {
     std::cerr << kName << ": " << models->size() << " models for "
               << folders.size()
@@ -126,6 +142,7 @@ int MatchModelsToFolders(const std::vector<fs::path>& folders,
     return kExitUsage;
   }
   models->resize(folders.size(), (*models)[0]);
+  auto_model->resize(folders.size(), (*auto_model)[0]);
   return kExitOk;
 }
 
@@ -146,7 +163,8 @@ int ParseRigRequest(RigRequest* request) {
     std::cerr << kName << ": --threads must be >= 0.\n";
     return kExitUsage;
   }
-  if (const int code = ParseModelNames(&request->models); code != kExitOk) {
+  if (const int code = ParseModelNames(&request->models, &request->auto_model);
+      code != kExitOk) {
     return code;
   }
   std::string error;
@@ -167,12 +185,14 @@ int ParseRigRequest(RigRequest* request) {
     std::cerr << kName << ": " << error << "\n";
     return kExitBadInput;
   }
-  if (const int code = MatchModelsToFolders(request->folders, &request->models);
+  if (const int code = MatchModelsToFolders(request->folders, &request->models,
+                                            &request->auto_model);
       code != kExitOk) {
     return code;
   }
   request->format_fixed.resize(request->folders.size());
   for (size_t c = 0; c < request->folders.size(); ++c) {
+    if (request->auto_model[c]) continue;  // after the model is chosen
     if (!CameraFormatFixedParams(request->format, request->models[c],
                                  &request->format_fixed[c], &error)) {
       std::cerr << kName << ": --format " << FLAGS_format << ", camera '"
@@ -188,12 +208,26 @@ int ParseRigRequest(RigRequest* request) {
   return kExitOk;
 }
 
-// Every camera's images; the frames are the file names of all folders, in
-// sorted order (`frame_of_name`).
+// The first few file names of a listing, for messages.
+std::string SomeNames(const ImageListing& listing) {
+  std::string names;
+  for (size_t i = 0; i < listing.images.size() && i < 3; ++i) {
+    names +=
+        (i > 0 ? ", " : "") + fs::path(listing.images[i]).filename().string();
+  }
+  return names + (listing.images.size() > 3 ? ", ..." : "");
+}
+
+// Every camera's images and the frame of each. By name (default): the
+// frames are the file names of all folders, in sorted order, and a camera
+// whose names no other camera has is refused with the rule and the way
+// out. By order (--match_by_order): the n-th image of every folder.
 int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
-               std::map<std::string, int>* frame_of_name) {
-  listings->resize(request.folders.size());
-  for (size_t c = 0; c < request.folders.size(); ++c) {
+               std::vector<std::map<std::string, int>>* frame_of_file,
+               int* num_frames) {
+  const size_t num_cameras = request.folders.size();
+  listings->resize(num_cameras);
+  for (size_t c = 0; c < num_cameras; ++c) {
     std::string error;
     if (!ListImages(request.folders[c].string(), &(*listings)[c], &error)) {
       std::cerr << kName << ": camera '"
@@ -204,12 +238,97 @@ int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
     for (const std::string& skipped : (*listings)[c].skipped) {
       LOG(INFO) << "skipped " << skipped;
     }
-    for (const std::string& file : (*listings)[c].images) {
-      frame_of_name->emplace(fs::path(file).filename().string(), 0);
+  }
+  frame_of_file->assign(num_cameras, {});
+  if (FLAGS_match_by_order) {
+    for (size_t c = 0; c < num_cameras; ++c) {
+      if ((*listings)[c].images.size() != (*listings)[0].images.size()) {
+        std::cerr << kName << ": --match_by_order: camera '"
+                  << request.folders[c].filename().string() << "' has "
+                  << (*listings)[c].images.size() << " images, camera '"
+                  << request.folders[0].filename().string() << "' "
+                  << (*listings)[0].images.size()
+                  << "; pairing by order needs the same number in every "
+                     "folder.\n";
+        return kExitBadInput;
+      }
+      for (size_t i = 0; i < (*listings)[c].images.size(); ++i) {
+        (*frame_of_file)[c][(*listings)[c].images[i]] = static_cast<int>(i);
+      }
+    }
+    *num_frames = static_cast<int>((*listings)[0].images.size());
+    return kExitOk;
+  }
+  std::map<std::string, int> frame_of_name;
+  std::map<std::string, int> cameras_with_name;
+  for (const ImageListing& listing : *listings) {
+    for (const std::string& file : listing.images) {
+      const std::string name = fs::path(file).filename().string();
+      frame_of_name.emplace(name, 0);
+      ++cameras_with_name[name];
     }
   }
-  int num_frames = 0;
-  for (auto& [name, index] : *frame_of_name) index = num_frames++;
+  for (size_t c = 0; c < num_cameras; ++c) {
+    const ImageListing& listing = (*listings)[c];
+    const bool shares = std::any_of(
+        listing.images.begin(), listing.images.end(),
+        [&](const std::string& file) {
+          return cameras_with_name[fs::path(file).filename().string()] > 1;
+        });
+    if (shares || listing.images.empty()) continue;
+    const size_t other = c == 0 ? 1 : 0;
+    std::cerr << kName << ": camera '" << request.folders[c].filename().string()
+              << "' (" << SomeNames(listing)
+              << ") has no file name that another camera has (camera '"
+              << request.folders[other].filename().string()
+              << "': " << SomeNames((*listings)[other])
+              << "). Frames are matched by file name: the same name in "
+                 "every camera folder is the same instant. Rename the files "
+                 "so that they match, or pass --match_by_order to pair the "
+                 "n-th image (sorted by name) of every folder.\n";
+    return kExitBadInput;
+  }
+  int index = 0;
+  for (auto& [name, frame] : frame_of_name) frame = index++;
+  for (size_t c = 0; c < num_cameras; ++c) {
+    for (const std::string& file : (*listings)[c].images) {
+      (*frame_of_file)[c][file] =
+          frame_of_name.at(fs::path(file).filename().string());
+    }
+  }
+  *num_frames = index;
+  return kExitOk;
+}
+
+// --model auto for camera c: the model with the lowest held-out error on
+// its own views (evidence/model_selection.h), then the format's fixed
+// parameters for it.
+int ChooseModel(const RigRequest& request, size_t c, RigCameraInput* input) {
+  std::vector<CalibrationView> views;
+  for (const CalibrationView& view : input->frames) {
+    if (!view.board_points.empty()) views.push_back(view);
+  }
+  ModelSelection selection;
+  std::string error;
+  if (!SelectModel(views, input->width, input->height,
+                   request.options.calibration, request.options.model_selection,
+                   &selection, &error) ||
+      selection.chosen < 0) {
+    std::cerr << kName << ": camera '" << input->name << "': --model auto: "
+              << (error.empty() ? selection.reason : error) << "\n";
+    return kExitNoResult;
+  }
+  input->model = selection.candidates[selection.chosen].model;
+  std::cerr << "camera '" << input->name << "': --model auto chose "
+            << CameraModelName(input->model) << " (" << selection.reason
+            << ")\n";
+  if (!CameraFormatFixedParams(request.format, input->model,
+                               &input->fixed_params, &error)) {
+    std::cerr << kName << ": --format " << FLAGS_format << ", camera '"
+              << input->name << "' (--model auto chose "
+              << CameraModelName(input->model) << "): " << error << ".\n";
+    return kExitUsage;
+  }
   return kExitOk;
 }
 
@@ -218,9 +337,9 @@ int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
 // file of each frame ("" where the camera has none).
 int DetectCamera(const RigRequest& request, size_t c,
                  const ImageListing& listing,
-                 const std::map<std::string, int>& frame_of_name,
-                 RigCameraInput* input, std::vector<std::string>* frame_files) {
-  const int num_frames = static_cast<int>(frame_of_name.size());
+                 const std::map<std::string, int>& frame_of_file,
+                 int num_frames, RigCameraInput* input,
+                 std::vector<std::string>* frame_files) {
   input->name = request.folders[c].filename().string();
   input->model = request.models[c];
   input->fixed_params = request.format_fixed[c];
@@ -232,8 +351,7 @@ int DetectCamera(const RigRequest& request, size_t c,
       request.board, &images, &input->width, &input->height);
   int usable = 0;
   for (const ImageResult& image : images) {
-    const std::string name = fs::path(image.file).filename().string();
-    const int frame = frame_of_name.at(name);
+    const int frame = frame_of_file.at(image.file);
     (*frame_files)[frame] = image.file;
     if (image.view_index < 0) {
       LOG(WARNING) << image.file << ": " << ImageOutcomeName(image.outcome)
@@ -245,7 +363,8 @@ int DetectCamera(const RigRequest& request, size_t c,
   }
   std::cerr << "camera '" << input->name << "': " << usable << " of "
             << images.size() << " images usable\n";
-  if (usable > 0) return kExitOk;
+  if (usable > 0)
+    return request.auto_model[c] ? ChooseModel(request, c, input) : kExitOk;
   std::cerr << kName << ": camera '" << input->name << "' ("
             << request.folders[c].string()
             << "): no image shows the board; no calibration written.\n";
@@ -461,8 +580,10 @@ int RunCalibrateRig() {
     return code;
   }
   std::vector<ImageListing> listings;
-  std::map<std::string, int> frame_of_name;
-  if (const int code = ListFrames(request, &listings, &frame_of_name);
+  std::vector<std::map<std::string, int>> frame_of_file;
+  int num_frames = 0;
+  if (const int code =
+          ListFrames(request, &listings, &frame_of_file, &num_frames);
       code != kExitOk) {
     return code;
   }
@@ -472,8 +593,8 @@ int RunCalibrateRig() {
   std::vector<RigCameraInput> inputs(num_cameras);
   std::vector<std::vector<std::string>> frame_files(num_cameras);
   for (size_t c = 0; c < num_cameras; ++c) {
-    if (const int code = DetectCamera(request, c, listings[c], frame_of_name,
-                                      &inputs[c], &frame_files[c]);
+    if (const int code = DetectCamera(request, c, listings[c], frame_of_file[c],
+                                      num_frames, &inputs[c], &frame_files[c]);
         code != kExitOk) {
       return code;
     }
@@ -519,7 +640,7 @@ PUZZLECAL_REGISTER_SUBCOMMAND(
     calibrate_rig, "calibrate-rig",
     "calibrate a multi-camera rig from one photo folder per camera", kUsage,
     {"images", "board", "model", "out", "format", "report", "threads",
-     "options"},
+     "options", "match_by_order"},
     &RunCalibrateRig);
 
 }  // namespace

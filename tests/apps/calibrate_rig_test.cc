@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -500,6 +501,84 @@ TEST(CalibrateRigTest, CameraThatNeverSharesAFrameIsNamedAndNothingWritten) {
   EXPECT_NE(run.output.find("'cam1' shares no frame"), std::string::npos)
       << run.output;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// Folders whose file names differ per camera (left01.png, right01.png):
+// frames are matched by name, so the program says so and how to pair them
+// by order; --match_by_order then pairs the n-th images; --model auto
+// chooses each camera's model.
+TEST(CalibrateRigTest, DifferentNamesAreRefusedWithTheRuleAndPairedByOrder) {
+  const RenderedRig rig = Render(StereoPinholeRig(), "names");
+  int renamed = 0;
+  for (const char* cam : {"cam0", "cam1"}) {
+    for (const auto& entry : fs::directory_iterator(rig.images / cam)) {
+      const std::string name = entry.path().filename().string();
+      fs::rename(
+          entry.path(),
+          entry.path().parent_path() /
+              ((std::string(cam) == "cam0" ? "left_" : "right_") + name));
+      ++renamed;
+    }
+  }
+  ASSERT_GT(renamed, 10);
+  const fs::path out = rig.root / "rig.yaml";
+  const std::string arguments = "calibrate-rig --images " +
+                                rig.images.string() + " --board " + rig.board +
+                                " --out " + out.string() + " --threads 2";
+  const RunResult refused = RunProgram(arguments + " --model pinhole-radtan");
+  EXPECT_EQ(refused.exit_code, kExitBadInput) << refused.output;
+  EXPECT_NE(refused.output.find("matched by file name"), std::string::npos)
+      << refused.output;
+  EXPECT_NE(refused.output.find("--match_by_order"), std::string::npos)
+      << refused.output;
+  EXPECT_NE(refused.output.find("left_frame_000.png"), std::string::npos)
+      << refused.output;
+  EXPECT_FALSE(fs::exists(out));
+  // Every camera sees every frame of this rig only where the board is in
+  // both views: drop the images one camera lacks so that the order pairs.
+  std::vector<std::string> left, right;
+  for (const auto& e : fs::directory_iterator(rig.images / "cam0")) {
+    left.push_back(e.path().filename().string().substr(5));
+  }
+  for (const auto& e : fs::directory_iterator(rig.images / "cam1")) {
+    right.push_back(e.path().filename().string().substr(6));
+  }
+  for (const std::string& name : left) {
+    if (std::find(right.begin(), right.end(), name) == right.end()) {
+      fs::remove(rig.images / "cam0" / ("left_" + name));
+    }
+  }
+  for (const std::string& name : right) {
+    if (std::find(left.begin(), left.end(), name) == left.end()) {
+      fs::remove(rig.images / "cam1" / ("right_" + name));
+    }
+  }
+  const RunResult paired =
+      RunProgram(arguments + " --model pinhole-radtan --match_by_order");
+  ASSERT_EQ(paired.exit_code, kExitOk) << paired.output;
+  EXPECT_NE(
+      paired.output.find("shared frames: 0-1: " +
+                         std::to_string(std::min(left.size(), right.size()))),
+      std::string::npos)
+      << paired.output;
+  std::vector<RigFileCamera> cameras;
+  std::string error;
+  ASSERT_TRUE(ReadRigFile(out.string(), &cameras, &error)) << error;
+  for (const RigFileCamera& camera : cameras) {
+    EXPECT_EQ(camera.camera.model, CameraModelId::kPinholeRadtan);
+  }
+  EXPECT_NEAR((cameras[1].cam_from_rig.linear().transpose() *
+               cameras[1].cam_from_rig.translation())
+                  .norm(),
+              0.12008, 0.001);
+  // --model auto for one camera, a model for the other.
+  const RunResult chosen =
+      RunProgram(arguments + " --model auto,pinhole-radtan --match_by_order");
+  ASSERT_EQ(chosen.exit_code, kExitOk) << chosen.output;
+  EXPECT_NE(chosen.output.find("camera 'cam0': --model auto chose "),
+            std::string::npos)
+      << chosen.output;
+  std::cout << OutputLine(chosen.output, "camera 'cam0': --model auto") << "\n";
 }
 
 TEST(CalibrateRigTest, WrongNumberOfModelsIsAUsageError) {
