@@ -278,14 +278,18 @@ int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
     if (shares || listing.images.empty()) continue;
     const size_t other = c == 0 ? 1 : 0;
     std::cerr << kName << ": camera '" << request.folders[c].filename().string()
-              << "' (" << SomeNames(listing)
-              << ") has no file name that another camera has (camera '"
+              << "' shares no frame with another camera: none of its file "
+                 "names ("
+              << SomeNames(listing) << ") is in another camera's folder ('"
               << request.folders[other].filename().string()
               << "': " << SomeNames((*listings)[other])
               << "). Frames are matched by file name: the same name in "
-                 "every camera folder is the same instant. Rename the files "
-                 "so that they match, or pass --match_by_order to pair the "
-                 "n-th image (sorted by name) of every folder.\n";
+                 "every camera folder is the same instant. If these are the "
+                 "same instants under other names, rename the files so that "
+                 "they match, or pass --match_by_order to pair the n-th image "
+                 "(sorted by name) of every folder; otherwise take photos in "
+                 "which it and a neighbouring camera see the board "
+                 "together.\n";
     return kExitBadInput;
   }
   int index = 0;
@@ -303,7 +307,7 @@ int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
 // --model auto for camera c: the model with the lowest held-out error on
 // its own views (evidence/model_selection.h), then the format's fixed
 // parameters for it.
-int ChooseModel(const RigRequest& request, size_t c, RigCameraInput* input) {
+int ChooseModel(const RigRequest& request, RigCameraInput* input) {
   std::vector<CalibrationView> views;
   for (const CalibrationView& view : input->frames) {
     if (!view.board_points.empty()) views.push_back(view);
@@ -364,7 +368,7 @@ int DetectCamera(const RigRequest& request, size_t c,
   std::cerr << "camera '" << input->name << "': " << usable << " of "
             << images.size() << " images usable\n";
   if (usable > 0)
-    return request.auto_model[c] ? ChooseModel(request, c, input) : kExitOk;
+    return request.auto_model[c] ? ChooseModel(request, input) : kExitOk;
   std::cerr << kName << ": camera '" << input->name << "' ("
             << request.folders[c].string()
             << "): no image shows the board; no calibration written.\n";

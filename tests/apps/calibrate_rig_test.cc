@@ -497,8 +497,13 @@ TEST(CalibrateRigTest, CameraThatNeverSharesAFrameIsNamedAndNothingWritten) {
   const RunResult run =
       RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
                  rig.board + " --model pinhole-radtan --out " + out.string());
-  EXPECT_EQ(run.exit_code, kExitNoResult) << run.output;
-  EXPECT_NE(run.output.find("'cam1' shares no frame"), std::string::npos)
+  // No file name is in both folders: refused before any image is read,
+  // with the rule and both ways out.
+  EXPECT_EQ(run.exit_code, kExitBadInput) << run.output;
+  EXPECT_NE(run.output.find("'cam0' shares no frame with another camera"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("see the board together"), std::string::npos)
       << run.output;
   EXPECT_FALSE(fs::exists(out));
 }
