@@ -439,13 +439,16 @@ std::vector<std::string> FrameNames(
 }
 
 void JudgeRig(const std::vector<RigCameraInput>& inputs,
-              const RunOptions& run_options, const RigCalibrationResult& result,
+              const RigCalibrationResult& result,
               const std::vector<std::vector<std::string>>& frame_files,
               CameraJudgements* judged) {
-  judged->rig = ComputeRigEvidence(inputs, result, run_options.rig_evidence);
+  // The rig evidence's options are at their defaults (evidence/rig_evidence.h):
+  // the options file has no section for them yet.
+  const RigEvidenceOptions rig_options;
+  judged->rig = ComputeRigEvidence(inputs, result, rig_options);
   judged->rig_verdict =
       MakeRigVerdict(result, judged->rig, judged->verdicts,
-                     FrameNames(frame_files), run_options.rig_evidence);
+                     FrameNames(frame_files), rig_options);
   RigFileJudgement& file = judged->file;
   file.verdict_kind = judged->rig_verdict.kind;
   file.verdict_reason = judged->rig_verdict.reason;
@@ -616,7 +619,7 @@ int RunCalibrateRig() {
       calibrated ? JudgeCameras(inputs, options, request.options, result)
                  : CameraJudgements();
   if (calibrated)
-    JudgeRig(inputs, request.options, result, frame_files, &judged);
+    JudgeRig(inputs, result, frame_files, &judged);
   if (!FLAGS_report.empty() &&
       !WriteReport(result, calibrated, calibration_error, judged, frame_files,
                    seconds_images, run_timer.Seconds(), request.threads,
