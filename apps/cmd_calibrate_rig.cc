@@ -3,7 +3,11 @@
 
 #include <glog/logging.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -94,6 +98,70 @@ bool ListCameraFolders(const std::string& root, std::vector<fs::path>* folders,
 
 constexpr const char* kName = "puzzlecal calibrate-rig";
 
+// ---- interruption and outputs ----
+
+// Set once the rig file is in place; read by the SIGINT handler.
+volatile std::sig_atomic_t g_rig_written = 0;
+
+// Ctrl-C: says so and what is left, then ends the process (exit 130). The
+// rig file is written by rename and the report built aside, so none is
+// half-written; a rig file written before the interruption stays.
+void OnInterrupt(int) {
+  const char* message =
+      g_rig_written ? "\npuzzlecal calibrate-rig: interrupted; the rig file "
+                      "was written, the report was not\n"
+                    : "\npuzzlecal calibrate-rig: interrupted; nothing "
+                      "written\n";
+  const ssize_t ignored = ::write(STDERR_FILENO, message, std::strlen(message));
+  (void)ignored;
+  std::_Exit(130);
+}
+
+// Files a rig report folder holds (WriteRigReport's names).
+bool IsReportFile(const fs::path& file) {
+  const std::string name = file.filename().string();
+  return name == "summary.md" || file.extension() == ".png";
+}
+
+// The report goes to `dir` by renaming a finished temporary folder into its
+// place. Checked before the work: `dir` is new, or a folder holding only a
+// report (it is replaced as a whole); its parent can be created and
+// written.
+bool CheckReportFolder(const fs::path& dir, std::string* error) {
+  std::error_code ec;
+  if (fs::exists(dir, ec)) {
+    if (!fs::is_directory(dir, ec)) {
+      *error = "--report " + dir.string() + " is a file, not a folder";
+      return false;
+    }
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      if (!entry.is_regular_file() || !IsReportFile(entry.path())) {
+        *error = "--report " + dir.string() + " holds " +
+                 entry.path().filename().string() +
+                 ", which is not part of a report; choose a new or empty "
+                 "folder (a report folder is replaced as a whole)";
+        return false;
+      }
+    }
+  }
+  const fs::path parent =
+      dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
+  fs::create_directories(parent, ec);
+  if (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK) != 0) {
+    *error = "cannot write the report folder " + dir.string() + ": " +
+             parent.string() + " is not a writable folder";
+    return false;
+  }
+  return true;
+}
+
+// Hidden names next to the report folder.
+fs::path SiblingPath(const fs::path& dir, const std::string& suffix) {
+  const fs::path parent =
+      dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
+  return parent / ("." + dir.filename().string() + suffix);
+}
+
 // What the command line asks for, checked before any image is read.
 struct RigRequest {
   CameraFileFormat format = CameraFileFormat::kPuzzlecal;
@@ -177,7 +245,9 @@ int ParseRigRequest(RigRequest* request) {
     std::cerr << kName << ": " << error << "\n";
     return kExitBadInput;
   }
-  if (!CheckOutputPath(FLAGS_out, &error)) {
+  // Every output is checked before the work starts.
+  if (!CheckOutputPath(FLAGS_out, &error) ||
+      (!FLAGS_report.empty() && !CheckReportFolder(FLAGS_report, &error))) {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
   }
@@ -323,7 +393,7 @@ int ChooseModel(const RigRequest& request, RigCameraInput* input) {
     return kExitNoResult;
   }
   input->model = selection.candidates[selection.chosen].model;
-  std::cerr << "camera '" << input->name << "': --model auto chose "
+  if (!FLAGS_quiet) std::cerr << "camera '" << input->name << "': --model auto chose "
             << CameraModelName(input->model) << " (" << selection.reason
             << ")\n";
   if (!CameraFormatFixedParams(request.format, input->model,
@@ -365,8 +435,10 @@ int DetectCamera(const RigRequest& request, size_t c,
     input->frames[frame] = std::move(views[image.view_index]);
     ++usable;
   }
-  std::cerr << "camera '" << input->name << "': " << usable << " of "
-            << images.size() << " images usable\n";
+  if (!FLAGS_quiet) {
+    std::cerr << "camera '" << input->name << "': " << usable << " of "
+              << images.size() << " images usable\n";
+  }
   if (usable > 0)
     return request.auto_model[c] ? ChooseModel(request, input) : kExitOk;
   std::cerr << kName << ": camera '" << input->name << "' ("
@@ -439,12 +511,10 @@ std::vector<std::string> FrameNames(
 }
 
 void JudgeRig(const std::vector<RigCameraInput>& inputs,
+              const RigEvidenceOptions& rig_options,
               const RigCalibrationResult& result,
               const std::vector<std::vector<std::string>>& frame_files,
               CameraJudgements* judged) {
-  // The rig evidence's options are at their defaults (evidence/rig_evidence.h):
-  // the options file has no section for them yet.
-  const RigEvidenceOptions rig_options;
   judged->rig = ComputeRigEvidence(inputs, result, rig_options);
   judged->rig_verdict =
       MakeRigVerdict(result, judged->rig, judged->verdicts,
@@ -527,6 +597,12 @@ void PrintRigOutcome(const RigCalibrationResult& result,
                      CameraFileFormat format, const CameraJudgements& judged,
                      int threads, double seconds_images, double seconds_total,
                      const std::vector<std::string>& written) {
+  if (FLAGS_quiet) {
+    for (const std::string& path : written) {
+      std::cout << "wrote " << path << "\n";
+    }
+    return;
+  }
   std::cout << RigCalibrationReport(result);
   PrintFrameNotes(result, frame_files);
   for (size_t c = 0; c < result.cameras.size(); ++c) {
@@ -577,10 +653,31 @@ bool WriteReport(const RigCalibrationResult& result, bool calibrated,
     report.rig_evidence = &judged.rig;
     report.rig_verdict = &judged.rig_verdict;
   }
-  return WriteRigReport(FLAGS_report, report, RigReportOptions(), error);
+  // Built aside, then put in place of the folder (the old report goes).
+  const fs::path dir(FLAGS_report);
+  std::error_code ec;
+  const fs::path partial = SiblingPath(dir, ".partial");
+  const fs::path old = SiblingPath(dir, ".old");
+  fs::remove_all(partial, ec);
+  fs::remove_all(old, ec);
+  if (!WriteRigReport(partial.string(), report, RigReportOptions(), error)) {
+    fs::remove_all(partial, ec);
+    return false;
+  }
+  if (fs::exists(dir, ec)) fs::rename(dir, old, ec);
+  if (!ec) fs::rename(partial, dir, ec);
+  if (ec) {
+    *error = "cannot put the report in place at " + dir.string() + ": " +
+             ec.message();
+    fs::remove_all(partial, ec);
+    return false;
+  }
+  fs::remove_all(old, ec);
+  return true;
 }
 
 int RunCalibrateRig() {
+  std::signal(SIGINT, OnInterrupt);
   const Timer run_timer;
   RigRequest request;
   if (const int code = ParseRigRequest(&request); code != kExitOk) {
@@ -619,24 +716,37 @@ int RunCalibrateRig() {
       calibrated ? JudgeCameras(inputs, options, request.options, result)
                  : CameraJudgements();
   if (calibrated)
-    JudgeRig(inputs, result, frame_files, &judged);
-  if (!FLAGS_report.empty() &&
-      !WriteReport(result, calibrated, calibration_error, judged, frame_files,
-                   seconds_images, run_timer.Seconds(), request.threads,
-                   &error)) {
-    std::cerr << kName << ": report not written: " << error << "\n";
-    if (calibrated) return kExitOutputError;
-  }
+    JudgeRig(inputs, request.options.rig_evidence, result, frame_files, &judged);
   if (!calibrated) {
+    if (!FLAGS_report.empty() &&
+        !WriteReport(result, calibrated, calibration_error, judged, frame_files,
+                     seconds_images, run_timer.Seconds(), request.threads,
+                     &error)) {
+      std::cerr << kName << ": report not written: " << error << "\n";
+    }
     std::cerr << kName << ": no calibration written. " << calibration_error
               << "\n";
     return kExitNoResult;
   }
+  // The rig file first (atomically), then the report.
   std::vector<std::string> written;
   if (!WriteRigFiles(FLAGS_out, request.format, result, &written, &error,
                      &judged.file)) {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
+  }
+  g_rig_written = 1;
+  if (!FLAGS_report.empty()) {
+    if (!WriteReport(result, calibrated, calibration_error, judged,
+                     frame_files, seconds_images, run_timer.Seconds(),
+                     request.threads, &error)) {
+      for (const std::string& path : written) {
+        std::cout << "wrote " << path << "\n";
+      }
+      std::cerr << kName << ": report not written: " << error << "\n";
+      return kExitOutputError;
+    }
+    written.push_back(FLAGS_report + " (the report)");
   }
   PrintRigOutcome(result, frame_files, request.format, judged, request.threads,
                   seconds_images, run_timer.Seconds(), written);
@@ -647,7 +757,7 @@ PUZZLECAL_REGISTER_SUBCOMMAND(
     calibrate_rig, "calibrate-rig",
     "calibrate a multi-camera rig from one photo folder per camera", kUsage,
     {"images", "board", "model", "out", "format", "report", "threads",
-     "options", "match_by_order"},
+     "options", "match_by_order", "quiet"},
     &RunCalibrateRig);
 
 }  // namespace

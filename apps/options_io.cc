@@ -337,6 +337,16 @@ struct Fields<RigCalibrationOptions> {
 };
 
 template <>
+struct Fields<RigEvidenceOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("moved_factor", o.moved_factor);
+    v.Field("min_moved_px", o.min_moved_px);
+    v.Field("max_joint_over_alone", o.max_joint_over_alone);
+  }
+};
+
+template <>
 struct Fields<PipelineOptions> {
   // Section pipeline: what is left of PipelineOptions besides its groups
   // (those are sections of their own, see Fields<RunOptions>). Not here:
@@ -383,6 +393,7 @@ struct Fields<RunOptions> {
     v.Group("verdict", o.verdict);
     v.Group("model_selection", o.model_selection);
     v.Group("rig", o.rig);
+    v.Group("rig_evidence", o.rig_evidence);
   }
 };
 
@@ -533,6 +544,7 @@ bool CheckSections(const RunOptions& o, std::string* why) {
   if (!o.verdict.Check(&inner)) return failed("verdict");
   if (!o.model_selection.Check(&inner)) return failed("model_selection");
   if (!o.rig.Check(&inner)) return failed("rig");
+  if (!o.rig_evidence.Check(&inner)) return failed("rig_evidence");
   return true;
 }
 
@@ -591,7 +603,8 @@ constexpr char kHeader[] =
     "# calib/initialization.h, evidence evidence/evidence.h, verdict\n"
     "# evidence/verdict.h, model_selection evidence/model_selection.h, rig\n"
     "# calib/rig_calibration.h (its camera options are the calibration\n"
-    "# section). --threads and --format's fixed parameters are flags only.\n";
+    "# section), rig_evidence evidence/rig_evidence.h. --threads and\n"
+    "# --format's fixed parameters are flags only.\n";
 
 }  // namespace
 

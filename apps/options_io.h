@@ -24,6 +24,7 @@
 #include "calib/rig_calibration.h"
 #include "evidence/evidence.h"
 #include "evidence/model_selection.h"
+#include "evidence/rig_evidence.h"
 #include "evidence/verdict.h"
 #include "pipeline/pipeline.h"
 
@@ -45,6 +46,7 @@ struct RunOptions {
   // `camera` options are the calibration section (LoadOptionsFile copies
   // them).
   RigCalibrationOptions rig;
+  RigEvidenceOptions rig_evidence;  // section rig_evidence
 };
 
 // Reads the options file at `path` over `options` (fields it leaves out

@@ -586,6 +586,74 @@ TEST(CalibrateRigTest, DifferentNamesAreRefusedWithTheRuleAndPairedByOrder) {
   std::cout << OutputLine(chosen.output, "camera 'cam0': --model auto") << "\n";
 }
 
+// Outputs are checked before the work; the rig file is written first and
+// the report built aside and renamed into place; --quiet prints only what
+// was written; Ctrl-C says what was written.
+TEST(CalibrateRigTest, OutputsAreCheckedFirstAndWrittenWhole) {
+  const RenderedRig rig = Render(StereoPinholeRig(), "outputs");
+  const fs::path out = rig.root / "rig.yaml";
+  const std::string arguments = "calibrate-rig --images " +
+                                rig.images.string() + " --board " + rig.board +
+                                " --model pinhole-radtan --out " +
+                                out.string() + " --threads 2";
+  const fs::path a_file = rig.root / "afile";
+  std::ofstream(a_file) << "x";
+  RunResult run = RunProgram(arguments + " --report " + a_file.string());
+  EXPECT_EQ(run.exit_code, kExitOutputError) << run.output;
+  EXPECT_NE(run.output.find("is a file, not a folder"), std::string::npos)
+      << run.output;
+  EXPECT_EQ(run.output.find("images usable"), std::string::npos)
+      << "the work started:\n"
+      << run.output;
+  EXPECT_FALSE(fs::exists(out));
+  const fs::path other = rig.root / "other";
+  fs::create_directories(other);
+  std::ofstream(other / "notes.txt") << "mine";
+  run = RunProgram(arguments + " --report " + other.string());
+  EXPECT_EQ(run.exit_code, kExitOutputError) << run.output;
+  EXPECT_NE(run.output.find("holds notes.txt"), std::string::npos)
+      << run.output;
+  EXPECT_TRUE(fs::exists(other / "notes.txt"));
+  EXPECT_FALSE(fs::exists(out));
+
+  const fs::path report = rig.root / "report";
+  fs::create_directories(report);
+  std::ofstream(report / "old_chart.png") << "old";
+  run = RunProgram(arguments + " --report " + report.string() + " --quiet");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  std::istringstream lines(run.output);
+  for (std::string line; std::getline(lines, line);) {
+    EXPECT_EQ(line.rfind("wrote ", 0), 0u) << "--quiet printed: " << line;
+  }
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_TRUE(fs::exists(report / "summary.md"));
+  EXPECT_FALSE(fs::exists(report / "old_chart.png"));  // replaced whole
+  for (const auto& entry : fs::directory_iterator(rig.root)) {
+    EXPECT_EQ(entry.path().filename().string().find(".partial"),
+              std::string::npos)
+        << entry.path();
+  }
+
+  // Ctrl-C while the images are read.
+  fs::remove(out);
+  const fs::path log = ScratchRoot() / "interrupt.log";
+  const std::string command = ProgramPath().string() + " " + arguments +
+                              " --report " + report.string() + " > " +
+                              log.string() + " 2>&1 & p=$!; sleep 0.2; " +
+                              "kill -INT $p; wait $p; echo exit=$? >> " +
+                              log.string();
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  const std::string interrupted = ReadText(log);
+  if (interrupted.find("exit=130") != std::string::npos) {
+    EXPECT_NE(interrupted.find("interrupted; nothing written"),
+              std::string::npos)
+        << interrupted;
+    EXPECT_FALSE(fs::exists(out));
+  } else {
+    std::cout << "the run ended before the interruption:\n" << interrupted;
+  }
+}
+
 TEST(CalibrateRigTest, WrongNumberOfModelsIsAUsageError) {
   const fs::path root = ScratchRoot() / "models";
   fs::create_directories(root / "a");
