@@ -279,6 +279,8 @@ struct Fields<EvidenceOptions> {
     v.Field("cross_validation", o.cross_validation);
     v.Field("report_angles_deg", o.report_angles_deg);
     v.Field("report_azimuths", o.report_azimuths);
+    v.Field("view_focal_min_corners", o.view_consistency.min_corners);
+    v.Field("view_focal_max_iterations", o.view_consistency.max_iterations);
   }
 };
 
@@ -305,6 +307,9 @@ struct Fields<VerdictOptions> {
     v.Field("check_distortion_determined", o.check_distortion_determined);
     v.Field("min_undetermined_distortion_stddev",
             o.min_undetermined_distortion_stddev);
+    v.Field("view_focal_spread_factor", o.view_focal_spread_factor);
+    v.Field("view_focal_floor_px", o.view_focal_floor_px);
+    v.Field("max_named_views", o.max_named_views);
   }
 };
 

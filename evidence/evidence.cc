@@ -202,7 +202,7 @@ bool EvidenceOptions::Check(std::string* why) const {
       return Fail("report_angles_deg must lie in (0, 180)", why);
     }
   }
-  return true;
+  return view_consistency.Check(why);
 }
 
 bool ProjectionCovariance(const Camera& camera,
@@ -720,6 +720,8 @@ Evidence ComputeEvidence(const std::vector<CalibrationView>& views,
     return evidence;
   }
   evidence.residuals = ComputeSystematicResiduals(views, result, options);
+  evidence.view_consistency =
+      ComputeViewConsistency(views, result, options.view_consistency);
   const double max_angle = evidence.residuals.max_angle_deg;
   evidence.uncertainty =
       ComputeProjectionUncertainty(result, max_angle, options);
@@ -791,6 +793,22 @@ std::string EvidenceText(const Evidence& evidence) {
            << "  n=" << b.count << "\n";
     }
   };
+  const ViewConsistency& vc = evidence.view_consistency;
+  if (vc.ok) {
+    text << Printf(
+        "focal length per view (the rest held): %.0f views, spread %.2f "
+        "times their sigma (chi-square %.1f for %.0f), moving the corners "
+        "by %.3f px RMS\n",
+        vc.views.size(), vc.spread_ratio, vc.chi2, vc.dof, vc.effect_px);
+    for (const ViewFocal& f : MostInconsistentViews(vc, 5)) {
+      text << "  " << f.name
+           << Printf(": f = %.1f +- %.1f px (z = %+.1f)", vc.focal_px * f.scale,
+                     vc.focal_px * f.scale_sigma, f.z)
+           << "\n";
+    }
+  } else {
+    text << "focal length per view: " << vc.error << "\n";
+  }
   bins("residual means by field angle:", evidence.residuals.by_angle, "deg", 0);
   bins("residual means by distance:", evidence.residuals.by_distance, "m", 2);
   return text.str();

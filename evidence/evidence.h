@@ -23,6 +23,7 @@
 #include "calib/calibrate.h"
 #include "camera/calibration_view.h"
 #include "camera/camera_models.h"
+#include "evidence/view_consistency.h"
 
 namespace puzzlecal {
 
@@ -49,6 +50,8 @@ struct EvidenceOptions {
   std::vector<double> report_angles_deg = {30.0, 60.0, 90.0};
   // Azimuths sampled around the axis for each report angle. Default 16. >= 1.
   int report_azimuths = 16;
+  // The per-view focal lengths (evidence/view_consistency.h).
+  ViewConsistencyOptions view_consistency;
 
   bool Check(std::string* why = nullptr) const;
 };
@@ -177,6 +180,7 @@ struct Evidence {
   CrossValidation cross_validation;
   ProjectionUncertainty uncertainty;
   SystematicResiduals residuals;
+  ViewConsistency view_consistency;
   double seconds = 0;  // all of it
 };
 

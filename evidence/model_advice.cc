@@ -67,6 +67,16 @@ ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
     why = advice.suggested + " could not be compared on held-out views (" +
           advice.error + ")";
   }
+  if (verdict->kind == VerdictKind::kModelError &&
+      !verdict->inconsistent_views.empty()) {
+    // No richer model explains it; the views that disagree on the focal
+    // length do.
+    verdict->kind = VerdictKind::kInconsistentViews;
+    verdict->reason = verdict->inconsistent_views + "; " + verdict->reason;
+    verdict->next_step = verdict->inconsistent_views_next_step + " (" + why +
+                         ", so the model is not what to change)";
+    return advice;
+  }
   verdict->next_step =
       why +
       ", so no model change is advised: no model tried explains the "

@@ -33,7 +33,9 @@ struct ModelAdvice {
 // views (from `selection` when it holds both as fitted candidates, else by
 // SelectModel on the two) and rewrites the verdict's next step: the figures
 // when confirmed; the suggestion withdrawn (suggested_model cleared) and
-// the other explanations when not. Nothing happens without a suggestion.
+// the other explanations when not: a model-error verdict with an
+// inconsistent-views finding becomes inconsistent-views (the views, not
+// the model, explain it). Nothing happens without a suggestion.
 ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
                              const CalibrationResult& result,
                              const CalibrationOptions& calibration,

@@ -21,6 +21,12 @@ struct Finding {
   std::string text;
 };
 
+constexpr char kInconsistentViewsNextStep[] =
+    "the photos do not share one camera: the focal length changed between "
+    "them (autofocus, zoom) or the board was swapped. Fix focus and zoom "
+    "(autofocus off), use one board, and retake; or calibrate the photos "
+    "taken alike on their own";
+
 // True when the bin's mean (radial or tangential) is systematic.
 bool Systematic(const ResidualBin& bin, int min_count,
                 const VerdictOptions& options, double* worst_px) {
@@ -326,13 +332,44 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
   }
 }
 
+// Inconsistent views: the views' own focal lengths spread far beyond their
+// standard deviations, by more than noise in pixels.
+void AddInconsistentViewFindings(const ViewConsistency& vc,
+                                 const VerdictOptions& options,
+                                 std::vector<Finding>* findings) {
+  if (!vc.ok) return;
+  if (!(vc.spread_ratio > options.view_focal_spread_factor) ||
+      !(vc.effect_px > vc.expected_effect_px + options.view_focal_floor_px)) {
+    return;
+  }
+  std::string named;
+  for (const ViewFocal& f :
+       MostInconsistentViews(vc, options.max_named_views)) {
+    named += (named.empty() ? "" : ", ") + f.name +
+             Printf(" (f = %.1f +- %.1f px)", vc.focal_px * f.scale,
+                    vc.focal_px * f.scale_sigma);
+  }
+  findings->push_back(
+      {VerdictKind::kInconsistentViews,
+       Printf("the views disagree on the focal length: fitted per view (the "
+              "rest held) it spreads %.1f times its standard deviation "
+              "(chi-square %.0f for %.0f views), and a focal length of "
+              "their own moves the views' corners by %.3f px RMS (noise "
+              "alone: %.3f px); ",
+              vc.spread_ratio, vc.chi2, vc.dof + 1, vc.effect_px,
+              vc.expected_effect_px) +
+           Printf("the calibration's is %.1f px, most different: ",
+                  vc.focal_px) +
+           named});
+}
+
 // The verdict's kind and reason: the findings of the highest-ranked kind
 // (model-error, bad-detections, insufficient-data); good when none.
 void RankFindings(const std::vector<Finding>& findings, Verdict* verdict) {
   for (const Finding& f : findings) verdict->findings.push_back(f.text);
   for (VerdictKind kind :
-       {VerdictKind::kModelError, VerdictKind::kBadDetections,
-        VerdictKind::kInsufficientData}) {
+       {VerdictKind::kModelError, VerdictKind::kInconsistentViews,
+        VerdictKind::kBadDetections, VerdictKind::kInsufficientData}) {
     std::string reason;
     for (const Finding& f : findings) {
       if (f.kind != kind) continue;
@@ -415,6 +452,8 @@ const char* VerdictKindName(VerdictKind kind) {
       return "insufficient-data";
     case VerdictKind::kBadDetections:
       return "bad-detections";
+    case VerdictKind::kInconsistentViews:
+      return "inconsistent-views";
   }
   return "good";
 }
@@ -446,6 +485,13 @@ bool VerdictOptions::Check(std::string* why) const {
     return Fail("max_bad_view_fraction must be in [0, 1]", why);
   }
   if (min_views < 1) return Fail("min_views must be >= 1", why);
+  if (!(view_focal_spread_factor > 0)) {
+    return Fail("view_focal_spread_factor must be > 0", why);
+  }
+  if (!(view_focal_floor_px >= 0)) {
+    return Fail("view_focal_floor_px must be >= 0", why);
+  }
+  if (max_named_views < 1) return Fail("max_named_views must be >= 1", why);
   if (!(min_coverage >= 0 && min_coverage <= 1)) {
     return Fail("min_coverage must be in [0, 1]", why);
   }
@@ -503,6 +549,7 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   const double halves_scale = HalvesScale(cv, min_count, options);
   std::vector<Finding> findings;
   AddHalvesFindings(cv, halves_scale, min_count, options, &findings);
+  AddInconsistentViewFindings(evidence.view_consistency, options, &findings);
   const bool grows_with_closeness = AddSystematicResidualFindings(
       evidence.residuals, min_count, options, &findings);
   const int num_bad_views = AddBadDetectionFindings(result, options, &findings);
@@ -511,10 +558,18 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
 
   Verdict verdict;
   RankFindings(findings, &verdict);
+  for (const Finding& f : findings) {
+    if (f.kind != VerdictKind::kInconsistentViews) continue;
+    verdict.inconsistent_views = f.text;
+    verdict.inconsistent_views_next_step = kInconsistentViewsNextStep;
+  }
   switch (verdict.kind) {
     case VerdictKind::kModelError:
       SuggestModel(result.camera.model, grows_with_closeness,
                    evidence.residuals.max_angle_deg, options, &verdict);
+      break;
+    case VerdictKind::kInconsistentViews:
+      verdict.next_step = kInconsistentViewsNextStep;
       break;
     case VerdictKind::kBadDetections:
       verdict.next_step = num_bad_views > 0

@@ -2,7 +2,9 @@
 #define PUZZLECAL_EVIDENCE_VERDICT_H_
 
 // One verdict on a calibration, made from its result and its evidence
-// (evidence/evidence.h): good, model-error (the model cannot follow the lens:
+// (evidence/evidence.h): good, inconsistent-views (the photos do not share
+// one camera: the focal length changed between them), model-error (the
+// model cannot follow the lens:
 // the two halves of the views disagree far beyond their uncertainty, or the
 // residuals keep a systematic part), insufficient-data (the views do not
 // determine the model well enough) or bad-detections (outliers or a few
@@ -23,10 +25,12 @@ enum class VerdictKind {
   kGood,
   kModelError,
   kInsufficientData,
-  kBadDetections
+  kBadDetections,
+  kInconsistentViews
 };
 
-// "good", "model-error", "insufficient-data", "bad-detections".
+// "good", "model-error", "insufficient-data", "bad-detections",
+// "inconsistent-views".
 const char* VerdictKindName(VerdictKind kind);
 
 struct VerdictOptions {
@@ -115,6 +119,19 @@ struct VerdictOptions {
   bool check_distortion_determined = false;
   double min_undetermined_distortion_stddev = 0.05;
 
+  // --- inconsistent views ---
+  // The views disagree on the focal length (evidence/view_consistency.h:
+  // autofocus, zoom, another board) when their own focal lengths spread
+  // more than view_focal_spread_factor times their standard deviations
+  // (corner errors shared within a view make real sets spread up to about
+  // 3 times: 3.2 was measured on a good 64-view fisheye set) and freeing
+  // them moves the corners by more than noise predicts plus
+  // view_focal_floor_px (RMS over the views). Defaults 3 and 0.05 px.
+  double view_focal_spread_factor = 3.0;
+  double view_focal_floor_px = 0.05;
+  // Views named in a finding, the worst first. Default 5. >= 1.
+  int max_named_views = 5;
+
   bool Check(std::string* why = nullptr) const;
 };
 
@@ -123,11 +140,19 @@ struct Verdict {
   std::string reason;     // what the evidence shows, with figures
   std::string next_step;  // what to do
   // Every finding, in the order checked (the verdict names the first one of
-  // the highest-ranked kind: model-error, bad-detections,
-  // insufficient-data).
+  // the highest-ranked kind: model-error, inconsistent-views,
+  // bad-detections, insufficient-data).
   std::vector<std::string> findings;
   // A model name the next step suggests ("" if none).
   std::string suggested_model;
+  // The inconsistent-views finding and its next step, also when a
+  // model-error outranks it ("" if none): a model error and views that
+  // disagree on the focal length look alike in the per-view focal lengths
+  // (a model that cannot follow the lens is bent differently by each
+  // view), so the held-out comparison decides (evidence/model_advice.h):
+  // when no richer model wins there, the views are the explanation.
+  std::string inconsistent_views;
+  std::string inconsistent_views_next_step;
 
   // "verdict: <kind> — <reason> — <next step>"
   std::string Line() const;
