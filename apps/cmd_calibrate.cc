@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <climits>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +13,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <opencv2/core.hpp>
 #include <sstream>
 #include <string>
@@ -216,6 +219,62 @@ std::string BoardMismatchMessage(const std::vector<ImageResult>& images,
   return out.str();
 }
 
+// A plain checkerboard's board file that does not match the photos: most
+// views show a complete lattice of one size (every corner of a W x H
+// rectangle of ids, W x H in either orientation), none a larger one, and
+// that size is not the file's. The views alone cannot tell a checkerboard's
+// size otherwise (its corners carry no ids), so a 6 x 4 board calibrated as
+// 10 x 10 would be accepted with every distance scaled. Returns the message
+// ("" when the file fits or the photos cannot tell).
+std::string CheckerboardSizeMismatch(const std::vector<CalibrationView>& views,
+                                     const Board& board,
+                                     const std::string& board_file) {
+  constexpr double kMostViews = 0.8;  // share of views showing the size
+  constexpr int kMinViews = 3;
+  if (board.type != BoardType::kCheckerboard || views.empty()) return "";
+  std::map<std::pair<int, int>, int> complete;  // {short, long} side -> views
+  int largest_short = 0, largest_long = 0, counted = 0;
+  for (const CalibrationView& view : views) {
+    if (view.board_points.empty()) continue;
+    ++counted;
+    int min_x = INT_MAX, max_x = INT_MIN, min_y = INT_MAX, max_y = INT_MIN;
+    for (const Eigen::Vector3d& p : view.board_points) {
+      const int x = static_cast<int>(std::lround(p.x() / board.tile_size_m));
+      const int y = static_cast<int>(std::lround(p.y() / board.tile_size_m));
+      min_x = std::min(min_x, x);
+      max_x = std::max(max_x, x);
+      min_y = std::min(min_y, y);
+      max_y = std::max(max_y, y);
+    }
+    const int w = max_x - min_x + 1, h = max_y - min_y + 1;
+    const int short_side = std::min(w, h), long_side = std::max(w, h);
+    largest_short = std::max(largest_short, short_side);
+    largest_long = std::max(largest_long, long_side);
+    if (static_cast<int>(view.board_points.size()) == w * h) {
+      ++complete[{short_side, long_side}];
+    }
+  }
+  if (counted < kMinViews) return "";
+  for (const auto& [size, count] : complete) {
+    if (count < kMinViews || count < kMostViews * counted) continue;
+    const auto [short_side, long_side] = size;
+    if (largest_short > short_side || largest_long > long_side) return "";
+    const int file_short = std::min(board.cols, board.rows);
+    const int file_long = std::max(board.cols, board.rows);
+    if (short_side == file_short && long_side == file_long) return "";
+    std::ostringstream out;
+    out << board_file << " gives a checkerboard of " << board.cols << " x "
+        << board.rows << " inner corners, but " << count << " of " << counted
+        << " photos show a complete lattice of " << long_side << " x "
+        << short_side
+        << " inner corners and none a larger one: the file does not match "
+           "the board photographed. Set cols and rows to the inner corners "
+           "of the printed board (and tile_size_m to its square size)";
+    return out.str();
+  }
+  return "";
+}
+
 // Each image that gave no view, once: "NAME: outcome (reason)".
 void PrintImageProblems(const std::vector<ReportImage>& lines) {
   const Verbosity verbosity = ConsoleVerbosity();
@@ -352,7 +411,14 @@ int DetectAll(const CalibrateRequest& request, CalibrationRun* run) {
       run->images.begin(), run->images.end(), [](const ImageResult& r) {
         return r.outcome != ImageOutcome::kUnreadable;
       });
-  if (any_readable) return kExitOk;
+  if (any_readable) {
+    const std::string mismatch =
+        CheckerboardSizeMismatch(run->views, request.board, FLAGS_board);
+    if (mismatch.empty()) return kExitOk;
+    std::cerr << "puzzlecal calibrate: " << mismatch
+              << "; no calibration written.\n";
+    return kExitBadInput;
+  }
   for (const ImageResult& image : run->images) {
     std::cerr << image.reason << "\n";
   }
