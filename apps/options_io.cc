@@ -281,6 +281,7 @@ struct Fields<EvidenceOptions> {
     v.Field("report_azimuths", o.report_azimuths);
     v.Field("view_focal_min_corners", o.view_consistency.min_corners);
     v.Field("view_focal_max_iterations", o.view_consistency.max_iterations);
+    v.Field("grid_min_samples", o.grid_min_samples);
   }
 };
 

@@ -193,6 +193,7 @@ ResidualBin MakeBin(double lo, double hi, const std::vector<double>& radial,
 
 bool EvidenceOptions::Check(std::string* why) const {
   if (grid_step_px < 1) return Fail("grid_step_px must be >= 1", why);
+  if (grid_min_samples < 0) return Fail("grid_min_samples must be >= 0", why);
   if (!(band_width_deg > 0)) return Fail("band_width_deg must be > 0", why);
   if (distance_bins < 1) return Fail("distance_bins must be >= 1", why);
   if (min_bin_count < 1) return Fail("min_bin_count must be >= 1", why);
@@ -203,6 +204,16 @@ bool EvidenceOptions::Check(std::string* why) const {
     }
   }
   return view_consistency.Check(why);
+}
+
+int GridStep(const Camera& camera, const EvidenceOptions& options) {
+  int step = options.grid_step_px;
+  if (options.grid_min_samples > 0 && camera.width > 0 && camera.height > 0) {
+    const double area = static_cast<double>(camera.width) * camera.height;
+    step = std::min(step, std::max(1, static_cast<int>(std::floor(std::sqrt(
+                                          area / options.grid_min_samples)))));
+  }
+  return std::max(1, step);
 }
 
 bool ProjectionCovariance(const Camera& camera,
@@ -382,10 +393,11 @@ ProjectionUncertainty ComputeProjectionUncertainty(
   if (!result.covariance_ok || camera.width <= 0 || camera.height <= 0) {
     return out;
   }
-  out.gauge = RotationGauge(camera, options.grid_step_px, max_angle_deg);
+  const int step = GridStep(camera, options);
+  out.gauge = RotationGauge(camera, step, max_angle_deg);
   out.rotation_removed = out.gauge.size() > 0;
   out.sigma_px =
-      CovarianceTraceMap(camera, result.covariance, options.grid_step_px, 0.5,
+      CovarianceTraceMap(camera, result.covariance, step, 0.5,
                          out.rotation_removed ? &out.gauge : nullptr);
   out.bands =
       SummarizeByAngle(out.sigma_px, options.band_width_deg, max_angle_deg);
@@ -635,18 +647,18 @@ Eigen::Matrix3d FitRotationBetweenHalves(const CrossValidation& out,
 // between them.
 PixelMap ExpectedDifference(const CrossValidation& out,
                             const CalibrationResult halves[2],
-                            const PixelMap& difference, double max_angle_deg,
-                            const EvidenceOptions& options) {
+                            const PixelMap& difference, double max_angle_deg) {
+  const int step = difference.step_px;
   const Eigen::MatrixXd gauge_a =
-      RotationGauge(out.camera_a, options.grid_step_px, max_angle_deg);
+      RotationGauge(out.camera_a, step, max_angle_deg);
   const Eigen::MatrixXd gauge_b =
-      RotationGauge(out.camera_b, options.grid_step_px, max_angle_deg);
-  const PixelMap expected_a = CovarianceTraceMap(
-      out.camera_a, halves[0].covariance, options.grid_step_px, 1.0,
-      gauge_a.size() > 0 ? &gauge_a : nullptr);
-  const PixelMap expected_b = CovarianceTraceMap(
-      out.camera_b, halves[1].covariance, options.grid_step_px, 1.0,
-      gauge_b.size() > 0 ? &gauge_b : nullptr);
+      RotationGauge(out.camera_b, step, max_angle_deg);
+  const PixelMap expected_a =
+      CovarianceTraceMap(out.camera_a, halves[0].covariance, step, 1.0,
+                         gauge_a.size() > 0 ? &gauge_a : nullptr);
+  const PixelMap expected_b =
+      CovarianceTraceMap(out.camera_b, halves[1].covariance, step, 1.0,
+                         gauge_b.size() > 0 ? &gauge_b : nullptr);
   PixelMap expected = difference;
   for (size_t k = 0; k < difference.values.size(); ++k) {
     expected.values[k] =
@@ -681,7 +693,7 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
 
   // |project_B(R * unproject_A(pixel)) - pixel| after the rotation between
   // the halves is taken out.
-  PixelMap map = EmptyMap(camera, options.grid_step_px);
+  PixelMap map = EmptyMap(camera, GridStep(camera, options));
   const HalvesRays rays = RaysOfHalves(out, map, camera, max_angle_deg);
   out.b_from_a = FitRotationBetweenHalves(out, map, camera, rays);
   out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDeg;
@@ -697,8 +709,7 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
     }
   }
   out.difference_px = map;
-  out.expected_px =
-      ExpectedDifference(out, halves, map, max_angle_deg, options);
+  out.expected_px = ExpectedDifference(out, halves, map, max_angle_deg);
   out.difference_bands = SummarizeByAngle(
       out.difference_px, options.band_width_deg, max_angle_deg);
   out.expected_bands =

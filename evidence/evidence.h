@@ -28,9 +28,15 @@
 namespace puzzlecal {
 
 struct EvidenceOptions {
-  // Spacing in pixels of the grid on which the maps are computed. Default 40
-  // (1600 x 1200 -> 41 x 31 samples). >= 1.
+  // Largest spacing in pixels of the grid on which the maps are computed.
+  // Default 40. >= 1.
   int grid_step_px = 40;
+  // The grid is made finer than grid_step_px until it holds at least this
+  // many samples, so that the field-angle bands are judged on any image
+  // size (a fixed 40 px grid left 8 of 10 bands of a 640 x 720 fisheye
+  // under min_bin_count). Default 10000 (640 x 480: 5 px; 1600 x 1200:
+  // 13 px). 0: grid_step_px as it is.
+  int grid_min_samples = 10000;
   // Width of the field-angle bands of the summaries and of the residual
   // bins, degrees. Default 10. > 0.
   double band_width_deg = 10.0;
@@ -183,6 +189,10 @@ struct Evidence {
   ViewConsistency view_consistency;
   double seconds = 0;  // all of it
 };
+
+// The grid spacing used for `camera` (grid_step_px, finer for
+// grid_min_samples).
+int GridStep(const Camera& camera, const EvidenceOptions& options);
 
 // The binned residual means of `result` (no solves).
 SystematicResiduals ComputeSystematicResiduals(

@@ -75,8 +75,16 @@ TEST(ProjectionUncertainty, MapCoversTheImage) {
   const ProjectionUncertainty u =
       ComputeProjectionUncertainty(result, 60.0, options);
   ASSERT_TRUE(u.ok);
-  EXPECT_EQ(u.sigma_px.cols, (truth.width - 1 + 39) / 40 + 1);
-  EXPECT_EQ(u.sigma_px.rows, (truth.height - 1 + 39) / 40 + 1);
+  // 1280 x 960 with at least 10000 samples: an 11 px grid.
+  const int step = GridStep(result.camera, options);
+  EXPECT_EQ(step, 11);
+  EXPECT_EQ(u.sigma_px.step_px, step);
+  EXPECT_EQ(u.sigma_px.cols, (truth.width - 1 + step - 1) / step + 1);
+  EXPECT_EQ(u.sigma_px.rows, (truth.height - 1 + step - 1) / step + 1);
+  EXPECT_GE(u.sigma_px.cols * u.sigma_px.rows, options.grid_min_samples);
+  // Without the minimum, the 40 px grid.
+  options.grid_min_samples = 0;
+  EXPECT_EQ(GridStep(result.camera, options), 40);
   ASSERT_FALSE(u.points.empty());
   EXPECT_EQ(u.points[0].label, "centre");
   EXPECT_TRUE(u.points[0].in_image);
