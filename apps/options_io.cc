@@ -311,6 +311,8 @@ struct Fields<VerdictOptions> {
     v.Field("view_focal_spread_factor", o.view_focal_spread_factor);
     v.Field("view_focal_floor_px", o.view_focal_floor_px);
     v.Field("max_named_views", o.max_named_views);
+    v.Field("view_field_factor", o.view_field_factor);
+    v.Field("view_field_floor_px", o.view_field_floor_px);
   }
 };
 

@@ -820,6 +820,23 @@ std::string EvidenceText(const Evidence& evidence) {
   } else {
     text << "focal length per view: " << vc.error << "\n";
   }
+  if (!vc.fields.empty()) {
+    std::vector<ViewField> fields = vc.fields;
+    std::stable_sort(fields.begin(), fields.end(),
+                     [](const ViewField& a, const ViewField& b) {
+                       return a.smooth_rms_px / a.expected_smooth_px >
+                              b.smooth_rms_px / b.expected_smooth_px;
+                     });
+    text << "residual fields across the board (smooth part / noise gives / "
+            "rest, px), the strongest:\n";
+    for (size_t k = 0; k < fields.size() && k < 5; ++k) {
+      const ViewField& f = fields[k];
+      text << "  " << f.name
+           << Printf(": %.3f / %.3f / %.3f, %.0f of %.0f corners rejected\n",
+                     f.smooth_rms_px, f.expected_smooth_px, f.rest_rms_px,
+                     f.outliers, f.corners);
+    }
+  }
   bins("residual means by field angle:", evidence.residuals.by_angle, "deg", 0);
   bins("residual means by distance:", evidence.residuals.by_distance, "m", 2);
   return text.str();

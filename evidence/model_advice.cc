@@ -77,6 +77,14 @@ ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
                          ", so the model is not what to change)";
     return advice;
   }
+  if (verdict->kind == VerdictKind::kModelError &&
+      !verdict->view_errors.empty()) {
+    verdict->kind = VerdictKind::kViewErrors;
+    verdict->reason = verdict->view_errors + "; " + verdict->reason;
+    verdict->next_step = verdict->view_errors_next_step + " (" + why +
+                         ", so the model is not what to change)";
+    return advice;
+  }
   verdict->next_step =
       why +
       ", so no model change is advised: no model tried explains the "

@@ -21,6 +21,10 @@ struct Finding {
   std::string text;
 };
 
+constexpr char kViewErrorsNextStep[] =
+    "drop or retake those photos: a view-level error moves the whole view, "
+    "not single corners (keep the board flat and still, the focus fixed)";
+
 constexpr char kInconsistentViewsNextStep[] =
     "the photos do not share one camera: the focal length changed between "
     "them (autofocus, zoom) or the board was swapped. Fix focus and zoom "
@@ -197,12 +201,25 @@ bool AddSystematicResidualFindings(const SystematicResiduals& residuals,
 // median view (RMS over all of a view's corners, outliers included; a view
 // the rejection emptied counts too). Returns the number of such views.
 int AddBadDetectionFindings(const CalibrationResult& result,
+                            const std::vector<int>& view_errors,
                             const VerdictOptions& options,
                             std::vector<Finding>* findings) {
-  const int all_corners = result.num_corners_used + result.num_outliers;
+  auto is_view_error = [&](size_t v) {
+    return std::find(view_errors.begin(), view_errors.end(),
+                     static_cast<int>(v)) != view_errors.end();
+  };
+  // The corners of views with a view-level error are that view's matter.
+  int all_corners = result.num_corners_used + result.num_outliers;
+  int num_outliers = result.num_outliers;
+  for (int v : view_errors) {
+    if (v >= static_cast<int>(result.inlier.size())) continue;
+    for (bool inlier : result.inlier[v]) {
+      --all_corners;
+      if (!inlier) --num_outliers;
+    }
+  }
   const double outlier_fraction =
-      all_corners > 0 ? static_cast<double>(result.num_outliers) / all_corners
-                      : 0.0;
+      all_corners > 0 ? static_cast<double>(num_outliers) / all_corners : 0.0;
   if (outlier_fraction > options.max_outlier_fraction) {
     findings->push_back(
         {VerdictKind::kBadDetections,
@@ -231,6 +248,7 @@ int AddBadDetectionFindings(const CalibrationResult& result,
   std::string bad_views;
   int num_bad_views = 0;
   for (size_t v = 0; v < result.view_used.size(); ++v) {
+    if (is_view_error(v)) continue;
     // A view the outlier rejection emptied (Calibrate's reason says so)
     // is as bad as one can be.
     if (!result.view_used[v] && v < result.view_reason.size() &&
@@ -363,13 +381,75 @@ void AddInconsistentViewFindings(const ViewConsistency& vc,
            named});
 }
 
+// View-level errors: views whose residuals are mostly a smooth field
+// across the board, well above noise, in a few views only. Returns the
+// flagged views (their corners do not count as outliers).
+std::vector<int> AddViewErrorFindings(const ViewConsistency& vc,
+                                      size_t used_views,
+                                      const VerdictOptions& options,
+                                      std::vector<Finding>* findings) {
+  // Real views all carry some field (errors shared by a view's corners):
+  // a view-level error stands out from the median view's as well.
+  std::vector<double> smooth;
+  for (const ViewField& f : vc.fields) smooth.push_back(f.smooth_rms_px);
+  if (smooth.empty()) return {};
+  std::nth_element(smooth.begin(), smooth.begin() + smooth.size() / 2,
+                   smooth.end());
+  const double median = smooth[smooth.size() / 2];
+  std::vector<const ViewField*> flagged;
+  for (const ViewField& f : vc.fields) {
+    if (f.smooth_rms_px > options.view_field_factor *
+                              std::max(f.expected_smooth_px, median) &&
+        f.smooth_rms_px > options.view_field_floor_px &&
+        f.smooth_rms_px > f.rest_rms_px) {
+      flagged.push_back(&f);
+    }
+  }
+  if (flagged.empty() ||
+      flagged.size() > options.max_bad_view_fraction * used_views) {
+    return {};
+  }
+  std::stable_sort(flagged.begin(), flagged.end(),
+                   [](const ViewField* a, const ViewField* b) {
+                     return a->smooth_rms_px > b->smooth_rms_px;
+                   });
+  std::string named;
+  std::vector<int> views;
+  for (const ViewField* f : flagged) {
+    views.push_back(f->view);
+    if (static_cast<int>(views.size()) > options.max_named_views) continue;
+    named +=
+        (named.empty() ? "" : "; ") + f->name +
+        Printf(
+            " (its residuals form a smooth field of %.2f px RMS "
+            "across the board, the median view's %.3f px, noise "
+            "gives %.3f px, %.2f px left beside it",
+            f->smooth_rms_px, median, f->expected_smooth_px, f->rest_rms_px);
+    if (f->outliers > 0) {
+      named += Printf(
+          "; %.0f of its %.0f corners were rejected as outliers, "
+          "%.0f of them follow the field",
+          f->outliers, f->corners, f->outliers_explained);
+    }
+    named += ")";
+  }
+  findings->push_back(
+      {VerdictKind::kViewErrors,
+       Printf("view-level errors in %.0f view(s), a bent board, a focus "
+              "change or motion rather than bad corners: ",
+              views.size()) +
+           named});
+  return views;
+}
+
 // The verdict's kind and reason: the findings of the highest-ranked kind
 // (model-error, bad-detections, insufficient-data); good when none.
 void RankFindings(const std::vector<Finding>& findings, Verdict* verdict) {
   for (const Finding& f : findings) verdict->findings.push_back(f.text);
   for (VerdictKind kind :
        {VerdictKind::kModelError, VerdictKind::kInconsistentViews,
-        VerdictKind::kBadDetections, VerdictKind::kInsufficientData}) {
+        VerdictKind::kViewErrors, VerdictKind::kBadDetections,
+        VerdictKind::kInsufficientData}) {
     std::string reason;
     for (const Finding& f : findings) {
       if (f.kind != kind) continue;
@@ -454,6 +534,8 @@ const char* VerdictKindName(VerdictKind kind) {
       return "bad-detections";
     case VerdictKind::kInconsistentViews:
       return "inconsistent-views";
+    case VerdictKind::kViewErrors:
+      return "view-errors";
   }
   return "good";
 }
@@ -492,6 +574,12 @@ bool VerdictOptions::Check(std::string* why) const {
     return Fail("view_focal_floor_px must be >= 0", why);
   }
   if (max_named_views < 1) return Fail("max_named_views must be >= 1", why);
+  if (!(view_field_factor > 0)) {
+    return Fail("view_field_factor must be > 0", why);
+  }
+  if (!(view_field_floor_px >= 0)) {
+    return Fail("view_field_floor_px must be >= 0", why);
+  }
   if (!(min_coverage >= 0 && min_coverage <= 1)) {
     return Fail("min_coverage must be in [0, 1]", why);
   }
@@ -552,16 +640,24 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   AddInconsistentViewFindings(evidence.view_consistency, options, &findings);
   const bool grows_with_closeness = AddSystematicResidualFindings(
       evidence.residuals, min_count, options, &findings);
-  const int num_bad_views = AddBadDetectionFindings(result, options, &findings);
+  const std::vector<int> view_errors = AddViewErrorFindings(
+      evidence.view_consistency, static_cast<size_t>(result.num_views_used),
+      options, &findings);
+  const int num_bad_views =
+      AddBadDetectionFindings(result, view_errors, options, &findings);
   AddInsufficientDataFindings(result, evidence, evidence_options, options,
                               &findings);
 
   Verdict verdict;
   RankFindings(findings, &verdict);
   for (const Finding& f : findings) {
-    if (f.kind != VerdictKind::kInconsistentViews) continue;
-    verdict.inconsistent_views = f.text;
-    verdict.inconsistent_views_next_step = kInconsistentViewsNextStep;
+    if (f.kind == VerdictKind::kInconsistentViews) {
+      verdict.inconsistent_views = f.text;
+      verdict.inconsistent_views_next_step = kInconsistentViewsNextStep;
+    } else if (f.kind == VerdictKind::kViewErrors) {
+      verdict.view_errors = f.text;
+      verdict.view_errors_next_step = kViewErrorsNextStep;
+    }
   }
   switch (verdict.kind) {
     case VerdictKind::kModelError:
@@ -570,6 +666,9 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
       break;
     case VerdictKind::kInconsistentViews:
       verdict.next_step = kInconsistentViewsNextStep;
+      break;
+    case VerdictKind::kViewErrors:
+      verdict.next_step = kViewErrorsNextStep;
       break;
     case VerdictKind::kBadDetections:
       verdict.next_step = num_bad_views > 0

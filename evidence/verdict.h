@@ -26,11 +26,12 @@ enum class VerdictKind {
   kModelError,
   kInsufficientData,
   kBadDetections,
-  kInconsistentViews
+  kInconsistentViews,
+  kViewErrors
 };
 
 // "good", "model-error", "insufficient-data", "bad-detections",
-// "inconsistent-views".
+// "inconsistent-views", "view-errors".
 const char* VerdictKindName(VerdictKind kind);
 
 struct VerdictOptions {
@@ -132,6 +133,20 @@ struct VerdictOptions {
   // Views named in a finding, the worst first. Default 5. >= 1.
   int max_named_views = 5;
 
+  // --- view-level errors ---
+  // A view's residual field (ViewField: a smooth field across the board
+  // fitted to all of its corners' residuals) is a view-level error (a bent
+  // board, a focus change, motion) when its RMS exceeds view_field_factor
+  // times both what noise gives and the median view's (real views all carry
+  // some: 0.1-0.18 px on a good 64-view fisheye set, where noise gives
+  // 0.035 px), and view_field_floor_px, and exceeds what it leaves (the
+  // view's errors are mostly the field), in at most max_bad_view_fraction
+  // of the views (more is the model's doing). Such a view's rejected
+  // corners are not counted as outliers. Defaults 3 (as view_rms_factor)
+  // and 0.1 px.
+  double view_field_factor = 3.0;
+  double view_field_floor_px = 0.1;
+
   bool Check(std::string* why = nullptr) const;
 };
 
@@ -140,7 +155,7 @@ struct Verdict {
   std::string reason;     // what the evidence shows, with figures
   std::string next_step;  // what to do
   // Every finding, in the order checked (the verdict names the first one of
-  // the highest-ranked kind: model-error, inconsistent-views,
+  // the highest-ranked kind: model-error, inconsistent-views, view-errors,
   // bad-detections, insufficient-data).
   std::vector<std::string> findings;
   // A model name the next step suggests ("" if none).
@@ -153,6 +168,9 @@ struct Verdict {
   // when no richer model wins there, the views are the explanation.
   std::string inconsistent_views;
   std::string inconsistent_views_next_step;
+  // The same for the view-level errors finding.
+  std::string view_errors;
+  std::string view_errors_next_step;
 
   // "verdict: <kind> — <reason> — <next step>"
   std::string Line() const;

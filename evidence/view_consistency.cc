@@ -153,6 +153,7 @@ ViewConsistency ComputeViewConsistency(
         std::sqrt(std::max(0.0, cost_held - cost) / (2.0 * board.size()));
     out.views.push_back(focal);
   }
+  out.fields = ComputeViewFields(views, result, options);
   if (out.views.size() < 3) {
     out.error = "fewer than three views could fit their own focal length";
     return out;
@@ -177,6 +178,67 @@ ViewConsistency ComputeViewConsistency(
   out.effect_px = std::sqrt(effect2 / out.views.size());
   out.ok = true;
   return out;
+}
+
+std::vector<ViewField> ComputeViewFields(
+    const std::vector<CalibrationView>& views, const CalibrationResult& result,
+    const ViewConsistencyOptions& options) {
+  std::vector<ViewField> fields;
+  const double sigma =
+      result.noise_sigma_px > 0 ? result.noise_sigma_px : result.rms_px;
+  const double threshold =
+      result.outlier_threshold_px > 0 ? result.outlier_threshold_px : 4 * sigma;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (v >= result.view_used.size() || !result.view_used[v] ||
+        v >= result.residuals.size() || v >= result.inlier.size()) {
+      continue;
+    }
+    const std::vector<Eigen::Vector2d>& residuals = result.residuals[v];
+    const int n = static_cast<int>(
+        std::min(residuals.size(), views[v].board_points.size()));
+    if (n < std::max(options.min_corners, 12)) continue;
+    Eigen::Vector2d lo = views[v].board_points[0].head<2>(), hi = lo;
+    for (int i = 0; i < n; ++i) {
+      lo = lo.cwiseMin(views[v].board_points[i].head<2>());
+      hi = hi.cwiseMax(views[v].board_points[i].head<2>());
+    }
+    const Eigen::Vector2d centre = 0.5 * (lo + hi);
+    const Eigen::Vector2d half = (0.5 * (hi - lo)).cwiseMax(1e-9);
+    Eigen::MatrixXd basis(n, 6);
+    Eigen::MatrixXd r(n, 2);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d uv =
+          (views[v].board_points[i].head<2>() - centre).cwiseQuotient(half);
+      basis.row(i) << 1, uv.x(), uv.y(), uv.x() * uv.x(), uv.x() * uv.y(),
+          uv.y() * uv.y();
+      r.row(i) = residuals[i].transpose();
+    }
+    const Eigen::MatrixXd coefficients = basis.colPivHouseholderQr().solve(r);
+    const Eigen::MatrixXd smooth = basis * coefficients;
+    if (!smooth.allFinite()) continue;
+    ViewField field;
+    field.view = static_cast<int>(v);
+    field.name = v < result.view_name.size() && !result.view_name[v].empty()
+                     ? result.view_name[v]
+                     : views[v].name;
+    field.corners = n;
+    for (int i = 0; i < n; ++i) {
+      const bool inlier =
+          i < static_cast<int>(result.inlier[v].size()) && result.inlier[v][i];
+      if (inlier) continue;
+      ++field.outliers;
+      if ((r.row(i) - smooth.row(i)).norm() <= threshold) {
+        ++field.outliers_explained;
+      }
+    }
+    field.rms_px = std::sqrt(r.squaredNorm() / (2.0 * n));
+    field.smooth_rms_px = std::sqrt(smooth.squaredNorm() / (2.0 * n));
+    field.rest_rms_px =
+        std::sqrt((r - smooth).squaredNorm() / std::max(1.0, 2.0 * n - 12));
+    field.expected_smooth_px = sigma * std::sqrt(12.0 / (2.0 * n));
+    fields.push_back(field);
+  }
+  return fields;
 }
 
 std::vector<ViewFocal> MostInconsistentViews(const ViewConsistency& vc,

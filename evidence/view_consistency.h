@@ -27,6 +27,26 @@ struct ViewConsistencyOptions {
   bool Check(std::string* why = nullptr) const;
 };
 
+// One view's residual field: a smooth field (quadratic in the board
+// coordinates, for x and y apart) fitted to the residuals of all of the
+// view's corners, rejected ones included. A bent board, a focus change or
+// motion during the exposure move a view's corners together: a field
+// across the board that noise and isolated false corners do not make.
+struct ViewField {
+  int view = 0;
+  std::string name;
+  int corners = 0;
+  int outliers = 0;          // of them rejected by the calibration
+  double rms_px = 0;         // all corners, per coordinate
+  double smooth_rms_px = 0;  // the fitted field, per coordinate
+  double rest_rms_px = 0;    // what the field leaves, per coordinate
+  // The field's RMS noise alone would give: sigma * sqrt(12 / 2n).
+  double expected_smooth_px = 0;
+  // The rejected corners the field accounts for: within the calibration's
+  // outlier threshold of it.
+  int outliers_explained = 0;
+};
+
 // One view's focal length.
 struct ViewFocal {
   int view = 0;      // index into the calibration views
@@ -66,7 +86,16 @@ struct ViewConsistency {
   // sigma / sqrt(2n) (one parameter freed takes one sigma^2 from a view's
   // sum of squares), sigma the calibration's RMS.
   double expected_effect_px = 0;
+  // Each view's residual field (ComputeViewFields).
+  std::vector<ViewField> fields;
 };
+
+// Every used view's residual field (views with at least
+// options.min_corners corners). sigma: the calibration's robust noise
+// estimate (its RMS without one).
+std::vector<ViewField> ComputeViewFields(
+    const std::vector<CalibrationView>& views, const CalibrationResult& result,
+    const ViewConsistencyOptions& options);
 
 ViewConsistency ComputeViewConsistency(
     const std::vector<CalibrationView>& views, const CalibrationResult& result,
