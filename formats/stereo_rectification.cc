@@ -36,7 +36,30 @@ bool SeesRay(const Camera& camera, const Eigen::Vector3d& ray,
   }
   if (!CameraModelIsPinhole(camera.model)) return true;
   if (!(ray.z() > 0)) return false;
+  // The image radius must grow all the way from the axis to the ray: a
+  // ray beyond the fold (or where the polynomial turns negative and flips
+  // the point through the centre) lands on a pixel that is not its own.
   const Eigen::Vector2d centre(camera.params[2], camera.params[3]);
+  const Eigen::Vector2d normalized = ray.head<2>() / ray.z();
+  double previous = 0;
+  constexpr int kSteps = 16;
+  for (int k = 1; k <= kSteps; ++k) {
+    const double t = static_cast<double>(k) / kSteps;
+    Eigen::Vector2d step_pixel;
+    if (!camera.Project(
+            Eigen::Vector3d(t * normalized.x(), t * normalized.y(), 1.0),
+            &step_pixel)) {
+      return false;
+    }
+    const Eigen::Vector2d offset = step_pixel - centre;
+    const double radius = offset.norm();
+    // Growing, and on the same side as the undistorted point.
+    if (!(radius > previous) ||
+        (normalized.norm() > 0 && offset.dot(normalized) < 0)) {
+      return false;
+    }
+    previous = radius;
+  }
   Eigen::Vector3d outward = ray;
   outward.head<2>() *= 1.0 + 1e-4;
   Eigen::Vector2d further;
@@ -132,11 +155,16 @@ bool OwnTarget(const Camera& first, const Camera& second,
         "rectified view holds both",
         error);
   }
-  const double cap = options.max_field_of_view_deg;
-  if (high - low > cap) {
-    const double middle = 0.5 * (low + high);
-    low = middle - 0.5 * cap;
-    high = middle + 0.5 * cap;
+  // A pinhole view stretches its rim without bound towards 90 degrees from
+  // its axis: each side is clipped to half the largest field.
+  const double half = 0.5 * options.max_field_of_view_deg;
+  low = std::max(low, -half);
+  high = std::min(high, half);
+  if (!(high > low)) {
+    return Fail(StringPrintf("the cameras' common field lies more than %.0f "
+                             "deg from the rectified axis",
+                             half),
+                error);
   }
   const int w = first.width, h = first.height;
   const double f = (w - 1) / (std::tan(high * kDeg) - std::tan(low * kDeg));

@@ -12,8 +12,10 @@
 //   check): the rotations of cv::stereoRectify (they depend only on the
 //   relative pose) and a pinhole target chosen here: one focal length for
 //   both views, principal point at the image centre, and a horizontal field
-//   of view of the pair's common field (the smaller of the two cameras'
-//   fields along the rectified x axis) clipped to max_field_of_view_deg. A
+//   of view of the pair's common field (the part of the rectified
+//   horizontal plane both cameras see), each side clipped to half of
+//   max_field_of_view_deg from the rectified axis (the principal point may
+//   then lie off-centre, or outside the image for diverging cameras). A
 //   pinhole image cannot hold 180 degrees: a fisheye pair keeps the
 //   central part of its field.
 //

@@ -193,6 +193,29 @@ TEST(RigYamlTest, OpenCvFormatOfAFisheyePairRectifies) {
   EXPECT_NE(note.find("field 120.0"), std::string::npos) << note;
 }
 
+// A fisheye next to a pinhole turned 50 degrees away: the common field lies
+// off the rectified axis; the target keeps it (a sane focal length, both
+// cameras cover their rectified images) instead of a few-pixel focal length.
+TEST(RigYamlTest, OpenCvFormatOfADivergingFisheyePinholePairRectifies) {
+  const RigSceneSpec scene = FisheyePinholeRig(1280, 960);
+  const std::string path = TempPath("fisheye_pinhole_opencv.yaml");
+  std::string error;
+  ASSERT_TRUE(WriteRigFiles(path, CameraFileFormat::kOpenCv,
+                            ResultFromScene(scene), nullptr, &error))
+      << error;
+  ExpectRectifies(scene, path);
+  StereoRectification rect;
+  ASSERT_TRUE(StereoRectify(scene.cameras[0].camera, scene.cameras[1].camera,
+                            scene.cameras[1].cam_from_rig, &rect, &error))
+      << error;
+  EXPECT_TRUE(rect.own_target);
+  EXPECT_GT(rect.p1(0, 0), 0.5 * scene.cameras[1].camera.params[0]);
+  EXPECT_LT(rect.p1(0, 0), 2.0 * scene.cameras[1].camera.params[0]);
+  EXPECT_GT(rect.valid_fraction[0], 0.5);
+  EXPECT_GT(rect.valid_fraction[1], 0.5);
+  EXPECT_LT(rect.max_row_difference_px, 1e-3);
+}
+
 TEST(RigYamlTest, RosFormatWritesOneCameraInfoPerCamera) {
   const RigSceneSpec scene = StereoPinholeRig();
   const RigCalibrationResult result = ResultFromScene(scene);
