@@ -204,6 +204,12 @@ int AddBadDetectionFindings(const CalibrationResult& result,
                             const std::vector<int>& view_errors,
                             const VerdictOptions& options,
                             std::vector<Finding>* findings) {
+  // Views by their file name, as every finding and table names them.
+  auto view_label = [&](size_t v) {
+    return v < result.view_name.size() && !result.view_name[v].empty()
+               ? result.view_name[v]
+               : "view " + std::to_string(v);
+  };
   auto is_view_error = [&](size_t v) {
     return std::find(view_errors.begin(), view_errors.end(),
                      static_cast<int>(v)) != view_errors.end();
@@ -255,9 +261,8 @@ int AddBadDetectionFindings(const CalibrationResult& result,
         result.view_reason[v].find("outlier") != std::string::npos) {
       ++num_bad_views;
       if (num_bad_views <= 5) {
-        bad_views += (bad_views.empty() ? "" : ", ") + std::string("view ") +
-                     std::to_string(v) + " (dropped: " + result.view_reason[v] +
-                     ")";
+        bad_views += (bad_views.empty() ? "" : ", ") + view_label(v) +
+                     " (dropped: " + result.view_reason[v] + ")";
       }
       continue;
     }
@@ -265,8 +270,8 @@ int AddBadDetectionFindings(const CalibrationResult& result,
     if (all_rms[v] > limit) {
       ++num_bad_views;
       if (num_bad_views <= 5) {
-        bad_views += (bad_views.empty() ? "" : ", ") + std::string("view ") +
-                     std::to_string(v) + Printf(" (%.2f px)", all_rms[v]);
+        bad_views += (bad_views.empty() ? "" : ", ") + view_label(v) +
+                     Printf(" (%.2f px)", all_rms[v]);
       }
     }
   }

@@ -347,7 +347,9 @@ TEST(Verdict, OneBadViewIsBadDetections) {
   ASSERT_TRUE(judged.calibrated) << judged.error;
   EXPECT_EQ(judged.verdict.kind, VerdictKind::kBadDetections)
       << judged.verdict.Line();
-  EXPECT_NE(judged.verdict.reason.find("view 5"), std::string::npos)
+  // Named by its file (here the view's name), as the tables name it.
+  EXPECT_NE(judged.verdict.reason.find(data.views[5].name + " ("),
+            std::string::npos)
       << judged.verdict.reason << " used " << judged.result.view_used[5] << " "
       << judged.result.view_reason[5] << " rms " << judged.result.view_rms_px[5]
       << " outliers " << judged.result.num_outliers;
