@@ -22,6 +22,7 @@
 
 #include "apps/common_flags.h"
 #include "apps/options_io.h"
+#include "apps/report_folder.h"
 #include "apps/subcommand.h"
 #include "calib/calibrate.h"
 #include "evidence/evidence.h"
@@ -115,74 +116,16 @@ void OnInterrupt(int) {
 
 // ---- outputs ----
 
-// Files a report folder holds (WriteReport's names).
-bool IsReportFile(const fs::path& file) {
-  const std::string name = file.filename().string();
-  return name == "summary.md" || file.extension() == ".png";
-}
-
-// The report goes to `dir` by renaming a finished temporary folder into its
-// place. Checked before the work: `dir` is new, or a folder holding only a
-// report (it is replaced, old overlays included); its parent can be created
-// and written.
-bool CheckReportFolder(const fs::path& dir, std::string* error) {
-  std::error_code ec;
-  if (fs::exists(dir, ec)) {
-    if (!fs::is_directory(dir, ec)) {
-      *error = "--report " + dir.string() + " is a file, not a folder";
-      return false;
-    }
-    for (const auto& entry : fs::directory_iterator(dir, ec)) {
-      if (!entry.is_regular_file() || !IsReportFile(entry.path())) {
-        *error = "--report " + dir.string() + " holds " +
-                 entry.path().filename().string() +
-                 ", which is not part of a report; choose a new or empty "
-                 "folder (a report folder is replaced as a whole)";
-        return false;
-      }
-    }
-  }
-  const fs::path parent =
-      dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
-  fs::create_directories(parent, ec);
-  if (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK) != 0) {
-    *error = "cannot write the report folder " + dir.string() + ": " +
-             parent.string() + " is not a writable folder";
-    return false;
-  }
-  return true;
-}
-
-// Hidden names next to the report folder.
-fs::path SiblingPath(const fs::path& dir, const std::string& suffix) {
-  const fs::path parent =
-      dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
-  return parent / ("." + dir.filename().string() + suffix);
-}
-
-// Writes the report into a temporary folder, then puts it in place of `dir`
-// (the old report, overlays and all, goes).
+// Writes the report aside, then puts it in place of `dir`
+// (apps/report_folder.h).
 bool WriteReportInPlace(const fs::path& dir, const ReportInput& input,
                         std::string* error) {
-  std::error_code ec;
-  const fs::path partial = SiblingPath(dir, ".partial");
-  const fs::path old = SiblingPath(dir, ".old");
-  fs::remove_all(partial, ec);
-  fs::remove_all(old, ec);
-  if (!WriteReport(partial.string(), input, ReportOptions(), error)) {
-    fs::remove_all(partial, ec);
-    return false;
-  }
-  if (fs::exists(dir, ec)) fs::rename(dir, old, ec);
-  if (!ec) fs::rename(partial, dir, ec);
-  if (ec) {
-    *error = "cannot put the report in place at " + dir.string() + ": " +
-             ec.message();
-    fs::remove_all(partial, ec);
-    return false;
-  }
-  fs::remove_all(old, ec);
-  return true;
+  return WriteFolderInPlace(
+      dir,
+      [&](const std::string& folder, std::string* why) {
+        return WriteReport(folder, input, ReportOptions(), why);
+      },
+      error);
 }
 
 // ---- messages ----
