@@ -37,6 +37,7 @@ bool CalibrateAndJudge(const std::vector<CalibrationView>& views, int width,
                        std::string* error) {
   std::string why;
   if (!options.Check(&why)) return Fail("invalid options: " + why, error);
+  if (views.empty()) return Fail("no views to calibrate from", error);
   JudgedCalibration run;
   run.auto_model = model == "auto";
   CameraModelId id = CameraModelId::kPinholeRadtan;
@@ -51,7 +52,6 @@ bool CalibrateAndJudge(const std::vector<CalibrationView>& views, int width,
                     CameraModelNames() + " or auto",
                 error);
   }
-  if (views.empty()) return Fail("no views to calibrate from", error);
   if (!Calibrate(views, id, width, height, calibration, &run.result, error)) {
     return false;
   }

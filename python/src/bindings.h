@@ -11,6 +11,7 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -33,6 +34,18 @@ py::array_t<double> PointsArray(const std::vector<Eigen::Vector3d>& points);
 py::array_t<int> IdsArray(const std::vector<Eigen::Vector2i>& ids);
 // A matrix as a 2-D float64 array (a copy).
 py::array_t<double> MatrixArray(const Eigen::MatrixXd& matrix);
+
+// A single-channel cv::Mat of element type T (uint8_t for CV_8UC1, float
+// for CV_32FC1) as a rows x cols array (a copy, row by row: the Mat may
+// have a row step).
+template <typename T>
+py::array_t<T> MatArray(const cv::Mat& mat) {
+  py::array_t<T> out({mat.rows, mat.cols});
+  for (int r = 0; r < mat.rows; ++r) {
+    std::copy(mat.ptr<T>(r), mat.ptr<T>(r) + mat.cols, out.mutable_data(r, 0));
+  }
+  return out;
+}
 
 // Rows of an N x `cols` array of numbers (any real dtype, converted to
 // float64); ValueError naming `what` for any other shape or dtype.

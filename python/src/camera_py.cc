@@ -177,16 +177,8 @@ void BindCamera(py::module_& m) {
               chosen = ChooseUndistortTarget(c, options);
               MakeUndistortMaps(c, chosen.target, options, &map_x, &map_y);
             }
-            auto to_array = [](const cv::Mat& map) {
-              py::array_t<float> out({map.rows, map.cols});
-              for (int r = 0; r < map.rows; ++r) {
-                std::copy(map.ptr<float>(r), map.ptr<float>(r) + map.cols,
-                          out.mutable_data(r, 0));
-              }
-              return out;
-            };
-            return py::make_tuple(to_array(map_x), to_array(map_y),
-                                  chosen.target);
+            return py::make_tuple(MatArray<float>(map_x),
+                                  MatArray<float>(map_y), chosen.target);
           },
           py::arg("alpha") = 0.0, py::arg("max_angle_deg") = 60.0,
           "(map_x, map_y, target): float32 maps for cv2.remap(image, map_x, "

@@ -137,12 +137,7 @@ void BindDetection(py::module_& m) {
           ok = LoadGreyImage(path, ImageLoadOptions(), &grey, &error);
         }
         if (!ok) Raise(error);
-        py::array_t<uint8_t> out({grey.rows, grey.cols});
-        for (int r = 0; r < grey.rows; ++r) {
-          std::copy(grey.ptr<uint8_t>(r), grey.ptr<uint8_t>(r) + grey.cols,
-                    out.mutable_data(r, 0));
-        }
-        return out;
+        return MatArray<uint8_t>(grey);
       },
       py::arg("path"),
       "An image file as the program reads it: 8-bit grey, H x W uint8 "

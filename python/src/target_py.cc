@@ -100,12 +100,7 @@ void BindTarget(py::module_& m) {
             const cv::Mat png(1, static_cast<int>(bytes.size()), CV_8UC1,
                               bytes.data());
             const cv::Mat grey = cv::imdecode(png, cv::IMREAD_GRAYSCALE);
-            py::array_t<uint8_t> out({grey.rows, grey.cols});
-            for (int r = 0; r < grey.rows; ++r) {
-              std::copy(grey.ptr<uint8_t>(r), grey.ptr<uint8_t>(r) + grey.cols,
-                        out.mutable_data(r, 0));
-            }
-            return out;
+            return MatArray<uint8_t>(grey);
           },
           py::arg("dpi") = 150.0,
           "The printable page as a grey uint8 image at `dpi` (what "
