@@ -26,15 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // $PUZZLECAL_DATA/real, else ../shared/real; "" when neither is a folder.
-std::string RealFolder() {
-  std::error_code ec;
-  if (const char* data = std::getenv("PUZZLECAL_DATA")) {
-    const fs::path path = fs::path(data) / "real";
-    if (fs::is_directory(path, ec)) return path.string();
-  }
-  const fs::path shared = fs::path("..") / "shared" / "real";
-  return fs::is_directory(shared, ec) ? shared.string() : "";
-}
+std::string RealFolder() { return testing_data::SharedFolder("real"); }
 
 fs::path ProgramPath() {
   std::error_code ec;

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 namespace puzzlecal {
@@ -20,6 +21,19 @@ inline bool SharedDataRequired() {
   if (ci == nullptr) return false;
   const std::string value = ci;
   return !value.empty() && value != "0" && value != "false";
+}
+
+// $PUZZLECAL_DATA/<relative>, else ../shared/<relative> (from the working
+// directory, the repository root); "" when neither is a folder.
+inline std::string SharedFolder(const std::string& relative) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (const char* data = std::getenv("PUZZLECAL_DATA")) {
+    const fs::path path = fs::path(data) / relative;
+    if (fs::is_directory(path, ec)) return path.string();
+  }
+  const fs::path shared = fs::path("..") / "shared" / relative;
+  return fs::is_directory(shared, ec) ? shared.string() : "";
 }
 
 }  // namespace testing_data
