@@ -22,15 +22,12 @@
 #include "apps/report_folder.h"
 #include "apps/subcommand.h"
 #include "calib/rig_calibration.h"
-#include "evidence/evidence.h"
-#include "evidence/model_selection.h"
-#include "evidence/rig_evidence.h"
-#include "evidence/verdict.h"
 #include "formats/board_file.h"
 #include "formats/camera_yaml.h"
 #include "formats/image_io.h"
 #include "formats/rig_yaml.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/rig_run.h"
 #include "report/rig_report.h"
 #include "util/timer.h"
 
@@ -69,32 +66,6 @@ std::vector<std::string> SplitCommas(const std::string& text) {
   std::string part;
   while (std::getline(stream, part, ',')) parts.push_back(part);
   return parts;
-}
-
-// The camera subfolders of `root`, sorted by name.
-bool ListCameraFolders(const std::string& root, std::vector<fs::path>* folders,
-                       std::string* error) {
-  std::error_code ec;
-  if (!fs::is_directory(root, ec)) {
-    *error = root + ": not a folder (expected one subfolder per camera)";
-    return false;
-  }
-  for (fs::directory_iterator it(root, ec), end; !ec && it != end;
-       it.increment(ec)) {
-    if (it->is_directory(ec)) folders->push_back(it->path());
-  }
-  if (ec) {
-    *error = root + ": cannot read the folder (" + ec.message() + ")";
-    return false;
-  }
-  std::sort(folders->begin(), folders->end());
-  if (folders->size() < 2) {
-    *error = root + ": " + std::to_string(folders->size()) +
-             " camera subfolder" + (folders->size() == 1 ? "" : "s") +
-             " (a rig needs one per camera, at least two)";
-    return false;
-  }
-  return true;
 }
 
 constexpr const char* kName = "puzzlecal calibrate-rig";
@@ -207,10 +178,12 @@ int ParseRigRequest(RigRequest* request) {
     std::cerr << kName << ": " << error << "\n";
     return kExitOutputError;
   }
-  if (!ListCameraFolders(FLAGS_images, &request->folders, &error)) {
+  std::vector<std::string> folders;
+  if (!ListRigCameraFolders(FLAGS_images, &folders, &error)) {
     std::cerr << kName << ": " << error << "\n";
     return kExitBadInput;
   }
+  request->folders.assign(folders.begin(), folders.end());
   if (const int code = MatchModelsToFolders(request->folders, &request->models,
                                             &request->auto_model);
       code != kExitOk) {
@@ -234,30 +207,18 @@ int ParseRigRequest(RigRequest* request) {
   return kExitOk;
 }
 
-// The first few file names of a listing, for messages.
-std::string SomeNames(const ImageListing& listing) {
-  std::string names;
-  for (size_t i = 0; i < listing.images.size() && i < 3; ++i) {
-    names +=
-        (i > 0 ? ", " : "") + fs::path(listing.images[i]).filename().string();
-  }
-  return names + (listing.images.size() > 3 ? ", ..." : "");
-}
-
-// Every camera's images and the frame of each. By name (default): the
-// frames are the file names of all folders, in sorted order, and a camera
-// whose names no other camera has is refused with the rule and the way
-// out. By order (--match_by_order): the n-th image of every folder.
+// Every camera's images and the frame of each (pipeline/rig_run.h: by file
+// name, or by order with --match_by_order).
 int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
-               std::vector<std::map<std::string, int>>* frame_of_file,
-               int* num_frames) {
+               RigFrames* frames) {
   const size_t num_cameras = request.folders.size();
   listings->resize(num_cameras);
+  std::vector<std::string> names;
   for (size_t c = 0; c < num_cameras; ++c) {
+    names.push_back(request.folders[c].filename().string());
     std::string error;
     if (!ListImages(request.folders[c].string(), &(*listings)[c], &error)) {
-      std::cerr << kName << ": camera '"
-                << request.folders[c].filename().string() << "': " << error
+      std::cerr << kName << ": camera '" << names.back() << "': " << error
                 << "\n";
       return kExitBadInput;
     }
@@ -265,68 +226,11 @@ int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
       LOG(INFO) << "skipped " << skipped;
     }
   }
-  frame_of_file->assign(num_cameras, {});
-  if (FLAGS_match_by_order) {
-    for (size_t c = 0; c < num_cameras; ++c) {
-      if ((*listings)[c].images.size() != (*listings)[0].images.size()) {
-        std::cerr << kName << ": --match_by_order: camera '"
-                  << request.folders[c].filename().string() << "' has "
-                  << (*listings)[c].images.size() << " images, camera '"
-                  << request.folders[0].filename().string() << "' "
-                  << (*listings)[0].images.size()
-                  << "; pairing by order needs the same number in every "
-                     "folder.\n";
-        return kExitBadInput;
-      }
-      for (size_t i = 0; i < (*listings)[c].images.size(); ++i) {
-        (*frame_of_file)[c][(*listings)[c].images[i]] = static_cast<int>(i);
-      }
-    }
-    *num_frames = static_cast<int>((*listings)[0].images.size());
-    return kExitOk;
-  }
-  std::map<std::string, int> frame_of_name;
-  std::map<std::string, int> cameras_with_name;
-  for (const ImageListing& listing : *listings) {
-    for (const std::string& file : listing.images) {
-      const std::string name = fs::path(file).filename().string();
-      frame_of_name.emplace(name, 0);
-      ++cameras_with_name[name];
-    }
-  }
-  for (size_t c = 0; c < num_cameras; ++c) {
-    const ImageListing& listing = (*listings)[c];
-    const bool shares = std::any_of(
-        listing.images.begin(), listing.images.end(),
-        [&](const std::string& file) {
-          return cameras_with_name[fs::path(file).filename().string()] > 1;
-        });
-    if (shares || listing.images.empty()) continue;
-    const size_t other = c == 0 ? 1 : 0;
-    std::cerr << kName << ": camera '" << request.folders[c].filename().string()
-              << "' shares no frame with another camera: none of its file "
-                 "names ("
-              << SomeNames(listing) << ") is in another camera's folder ('"
-              << request.folders[other].filename().string()
-              << "': " << SomeNames((*listings)[other])
-              << "). Frames are matched by file name: the same name in "
-                 "every camera folder is the same instant. If these are the "
-                 "same instants under other names, rename the files so that "
-                 "they match, or pass --match_by_order to pair the n-th image "
-                 "(sorted by name) of every folder; otherwise take photos in "
-                 "which it and a neighbouring camera see the board "
-                 "together.\n";
+  std::string error;
+  if (!MatchRigFrames(names, *listings, FLAGS_match_by_order, frames, &error)) {
+    std::cerr << kName << ": " << error << "\n";
     return kExitBadInput;
   }
-  int index = 0;
-  for (auto& [name, frame] : frame_of_name) frame = index++;
-  for (size_t c = 0; c < num_cameras; ++c) {
-    for (const std::string& file : (*listings)[c].images) {
-      (*frame_of_file)[c][file] =
-          frame_of_name.at(fs::path(file).filename().string());
-    }
-  }
-  *num_frames = index;
   return kExitOk;
 }
 
@@ -334,18 +238,13 @@ int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
 // its own views (evidence/model_selection.h), then the format's fixed
 // parameters for it.
 int ChooseModel(const RigRequest& request, RigCameraInput* input) {
-  std::vector<CalibrationView> views;
-  for (const CalibrationView& view : input->frames) {
-    if (!view.board_points.empty()) views.push_back(view);
-  }
   ModelSelection selection;
   std::string error;
-  if (!SelectModel(views, input->width, input->height,
-                   request.options.calibration, request.options.model_selection,
-                   &selection, &error) ||
-      selection.chosen < 0) {
-    std::cerr << kName << ": camera '" << input->name << "': --model auto: "
-              << (error.empty() ? selection.reason : error) << "\n";
+  if (!ChooseRigCameraModel(*input, request.options.calibration,
+                            request.options.model_selection, &selection,
+                            &error)) {
+    std::cerr << kName << ": camera '" << input->name
+              << "': --model auto: " << error << "\n";
     return kExitNoResult;
   }
   input->model = selection.candidates[selection.chosen].model;
@@ -373,23 +272,14 @@ int DetectCamera(const RigRequest& request, size_t c,
   input->name = request.folders[c].filename().string();
   input->model = request.models[c];
   input->fixed_params = request.format_fixed[c];
-  input->frames.resize(num_frames);
-  frame_files->assign(num_frames, "");
-  std::vector<ImageResult> images = ProcessImageFiles(
-      listing.images, request.board, request.options.pipeline, request.threads);
-  std::vector<CalibrationView> views = MakeCalibrationViews(
-      request.board, &images, &input->width, &input->height);
-  int usable = 0;
+  std::vector<ImageResult> images;
+  const int usable = MakeRigCameraViews(
+      request.board, listing.images, frame_of_file, num_frames,
+      request.options.pipeline, request.threads, input, frame_files, &images);
   for (const ImageResult& image : images) {
-    const int frame = frame_of_file.at(image.file);
-    (*frame_files)[frame] = image.file;
-    if (image.view_index < 0) {
-      LOG(WARNING) << image.file << ": " << ImageOutcomeName(image.outcome)
-                   << (image.reason.empty() ? "" : " (" + image.reason + ")");
-      continue;
-    }
-    input->frames[frame] = std::move(views[image.view_index]);
-    ++usable;
+    if (image.view_index >= 0) continue;
+    LOG(WARNING) << image.file << ": " << ImageOutcomeName(image.outcome)
+                 << (image.reason.empty() ? "" : " (" + image.reason + ")");
   }
   if (!FLAGS_quiet) {
     std::cerr << "camera '" << input->name << "': " << usable << " of "
@@ -401,124 +291,6 @@ int DetectCamera(const RigRequest& request, size_t c,
             << request.folders[c].string()
             << "): no image shows the board; no calibration written.\n";
   return kExitBadInput;
-}
-
-// A plain checkerboard's corner grid is the same after half a turn about
-// its centre (which camera labels it which way is settled from the rig's
-// poses); a PuzzleBoard's ids are absolute.
-RigBoardSymmetry BoardSymmetry(const Board& board) {
-  RigBoardSymmetry symmetry;
-  symmetry.half_turn = board.type == BoardType::kCheckerboard;
-  symmetry.centre =
-      0.5 * (board.Point(board.origin) +
-             board.Point(board.origin +
-                         Eigen::Vector2i(board.cols - 1, board.rows - 1)));
-  return symmetry;
-}
-
-// A view of a plain checkerboard that the rig left out and that holds only
-// part of the board: say so (a part has no labels of its own).
-void NotePartialCheckerboards(const Board& board,
-                              const std::vector<RigCameraInput>& inputs,
-                              RigCalibrationResult* result) {
-  if (board.type != BoardType::kCheckerboard) return;
-  for (size_t c = 0; c < result->cameras.size(); ++c) {
-    RigCameraResult& cam = result->cameras[c];
-    for (size_t f = 0; f < cam.frame_note.size(); ++f) {
-      const size_t found = inputs[c].frames[f].board_points.size();
-      if (cam.frame_note[f].rfind("not used", 0) != 0 || found == 0 ||
-          static_cast<int>(found) >= board.NumCorners()) {
-        continue;
-      }
-      cam.frame_note[f] += " (" + std::to_string(found) + " of " +
-                           std::to_string(board.NumCorners()) +
-                           " corners found: a part of a plain checkerboard "
-                           "can be labelled in several ways)";
-    }
-  }
-}
-
-// Each camera's own calibration judged as `calibrate` judges one camera
-// (halves, uncertainty, binned residuals; evidence/evidence.h,
-// evidence/verdict.h), once, for the report and the output alike.
-struct CameraJudgements {
-  std::vector<Evidence> evidence;  // one per camera
-  std::vector<Verdict> verdicts;
-  // The rig's: per-frame consistency and its verdict.
-  RigEvidence rig;
-  RigVerdict rig_verdict;
-  RigFileJudgement file;  // what the puzzlecal rig file carries
-};
-
-// The frames' names: the first camera's file name that exists.
-std::vector<std::string> FrameNames(
-    const std::vector<std::vector<std::string>>& frame_files) {
-  std::vector<std::string> names(frame_files.empty() ? 0
-                                                     : frame_files[0].size());
-  for (size_t f = 0; f < names.size(); ++f) {
-    for (const std::vector<std::string>& files : frame_files) {
-      if (f < files.size() && !files[f].empty()) {
-        names[f] = fs::path(files[f]).filename().string();
-        break;
-      }
-    }
-  }
-  return names;
-}
-
-void JudgeRig(const std::vector<RigCameraInput>& inputs,
-              const RigEvidenceOptions& rig_options,
-              const RigCalibrationResult& result,
-              const std::vector<std::vector<std::string>>& frame_files,
-              CameraJudgements* judged) {
-  judged->rig = ComputeRigEvidence(inputs, result, rig_options);
-  judged->rig_verdict =
-      MakeRigVerdict(result, judged->rig, judged->verdicts,
-                     FrameNames(frame_files), rig_options);
-  RigFileJudgement& file = judged->file;
-  file.verdict_kind = judged->rig_verdict.kind;
-  file.verdict_reason = judged->rig_verdict.reason;
-  file.verdict_next_step = judged->rig_verdict.next_step;
-  for (size_t f = 0; f < judged->rig.frames.size(); ++f) {
-    const RigFrameEvidence& frame = judged->rig.frames[f];
-    RigFileFrame out;
-    for (size_t c = 0; c < result.cameras.size(); ++c) {
-      const RigFrameCamera& view = frame.cameras[c];
-      out.files.push_back(f < frame_files[c].size() ? frame_files[c][f] : "");
-      std::string use = view.used ? "used" : "";
-      if (!view.note.empty()) {
-        use = view.used ? "used; " + view.note : view.note;
-      } else if (!view.used) {
-        use = out.files.back().empty() ? "not used: no image"
-              : view.has_view          ? "not used"
-                                       : "not used: the board was not found";
-      }
-      out.use.push_back(use);
-      out.rms_px.push_back(view.rms_px);
-    }
-    out.compared = frame.compared;
-    out.transfer_px = frame.transfer_px;
-    out.pose_difference_mm = frame.pose_difference_mm;
-    out.epipolar_px = frame.epipolar_px;
-    out.moved = frame.moved;
-    file.frames.push_back(out);
-  }
-}
-
-CameraJudgements JudgeCameras(const std::vector<RigCameraInput>& inputs,
-                              const RigCalibrationOptions& options,
-                              const RunOptions& run_options,
-                              const RigCalibrationResult& result) {
-  CameraJudgements judged;
-  for (size_t c = 0; c < result.cameras.size(); ++c) {
-    const RigCameraResult& cam = result.cameras[c];
-    judged.evidence.push_back(ComputeEvidence(
-        inputs[c].frames, cam.single, options.camera, run_options.evidence));
-    judged.verdicts.push_back(MakeVerdict(cam.single, judged.evidence.back(),
-                                          run_options.evidence,
-                                          run_options.verdict));
-  }
-  return judged;
 }
 
 // The frames' notes (relabelled views of a symmetric board, views left
@@ -550,7 +322,7 @@ void PrintFrameNotes(const RigCalibrationResult& result,
 // the time and what was written.
 void PrintRigOutcome(const RigCalibrationResult& result,
                      const std::vector<std::vector<std::string>>& frame_files,
-                     CameraFileFormat format, const CameraJudgements& judged,
+                     CameraFileFormat format, const JudgedRig& judged,
                      int threads, double seconds_images, double seconds_total,
                      const std::vector<std::string>& written) {
   if (FLAGS_quiet) {
@@ -588,8 +360,7 @@ void PrintRigOutcome(const RigCalibrationResult& result,
 // The report (--report DIR) with the judgements when the calibration
 // succeeded.
 bool WriteReport(const RigCalibrationResult& result, bool calibrated,
-                 const std::string& calibration_error,
-                 const CameraJudgements& judged,
+                 const std::string& calibration_error, const JudgedRig& judged,
                  const std::vector<std::vector<std::string>>& frame_files,
                  double seconds_images, double seconds_total, int threads,
                  std::string* error) {
@@ -626,10 +397,8 @@ int RunCalibrateRig() {
     return code;
   }
   std::vector<ImageListing> listings;
-  std::vector<std::map<std::string, int>> frame_of_file;
-  int num_frames = 0;
-  if (const int code =
-          ListFrames(request, &listings, &frame_of_file, &num_frames);
+  RigFrames frames;
+  if (const int code = ListFrames(request, &listings, &frames);
       code != kExitOk) {
     return code;
   }
@@ -639,26 +408,26 @@ int RunCalibrateRig() {
   std::vector<RigCameraInput> inputs(num_cameras);
   std::vector<std::vector<std::string>> frame_files(num_cameras);
   for (size_t c = 0; c < num_cameras; ++c) {
-    if (const int code = DetectCamera(request, c, listings[c], frame_of_file[c],
-                                      num_frames, &inputs[c], &frame_files[c]);
+    if (const int code =
+            DetectCamera(request, c, listings[c], frames.frame_of_file[c],
+                         frames.num_frames, &inputs[c], &frame_files[c]);
         code != kExitOk) {
       return code;
     }
   }
   const double seconds_images = images_timer.Seconds();
 
-  RigCalibrationOptions options = request.options.rig;
-  options.camera.num_threads = request.threads;
-  RigCalibrationResult result;
+  RigRunOptions options;
+  options.rig = request.options.rig;
+  options.rig.camera.num_threads = request.threads;
+  options.evidence = request.options.evidence;
+  options.verdict = request.options.verdict;
+  options.rig_evidence = request.options.rig_evidence;
+  JudgedRig judged;
   std::string calibration_error, error;
-  const bool calibrated = CalibrateRig(inputs, BoardSymmetry(request.board),
-                                       options, &result, &calibration_error);
-  NotePartialCheckerboards(request.board, inputs, &result);
-  CameraJudgements judged =
-      calibrated ? JudgeCameras(inputs, options, request.options, result)
-                 : CameraJudgements();
-  if (calibrated)
-    JudgeRig(inputs, request.options.rig_evidence, result, frame_files, &judged);
+  const bool calibrated = CalibrateAndJudgeRig(
+      request.board, inputs, frame_files, options, &judged, &calibration_error);
+  const RigCalibrationResult& result = judged.result;
   if (!calibrated) {
     if (!FLAGS_report.empty() &&
         !WriteReport(result, calibrated, calibration_error, judged, frame_files,
