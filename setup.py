@@ -6,7 +6,7 @@ setuptools and pybind11 (no download):
 
 The module is built by the project's own CMake (the libraries it links,
 Release, no tests or benchmarks) in build-python/, then packaged with
-python/puzzlecal/*.py."""
+python/puzzlecal/*.py and the type stubs (*.pyi, py.typed)."""
 
 import os
 import pathlib
@@ -48,6 +48,7 @@ setup(
                 "checkerboard",
     packages=["puzzlecal"],
     package_dir={"puzzlecal": "python/puzzlecal"},
+    package_data={"puzzlecal": ["*.pyi", "py.typed"]},
     ext_modules=[Extension("puzzlecal._puzzlecal", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
     python_requires=">=3.9",

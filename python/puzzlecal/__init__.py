@@ -5,6 +5,8 @@
     result = puzzlecal.calibrate("photos/", board, model="auto")
     print(result.verdict.line())
     result.save("camera.yaml", format="opencv")
+    rig = puzzlecal.calibrate_rig("rig_photos/", board, models="auto")
+    print(rig.verdict.line(), rig.cameras[1].cam_from_rig)
 
 Images are numpy arrays (H x W grey or H x W x 3 BGR, as cv2 loads them);
 points and pixels are N x 2 / N x 3 float64 arrays; ids N x 2 int. Errors are
@@ -21,18 +23,23 @@ from ._puzzlecal import (  # noqa: F401  (the compiled part)
     Camera,
     Detection,
     Options,
+    RigCalibration,
+    RigCamera,
+    RigVerdict,
     Verdict,
     detect,
     detect_files,
     list_images,
     load_image,
+    render_rig,
 )
 from . import _puzzlecal
 
 __all__ = [
     "MODELS", "Board", "Calibration", "Camera", "Detection", "Options",
-    "Verdict", "calibrate", "detect", "detect_files", "list_images",
-    "load_image", "options",
+    "RigCalibration", "RigCamera", "RigVerdict", "Verdict", "calibrate",
+    "calibrate_rig", "detect", "detect_files", "list_images", "load_image",
+    "options", "render_rig",
 ]
 
 
@@ -95,3 +102,74 @@ def calibrate(source, board, model="auto", image_size=None, options=None,
     return _puzzlecal._calibrate_observations(source, board,
                                               tuple(image_size), model,
                                               options, threads)
+
+
+def calibrate_rig(source, board, models="auto", image_sizes=None, names=None,
+                  match_by_order=False, format="puzzlecal", options=None,
+                  threads=0):
+    """Calibrates a rig of cameras and judges it as ``puzzlecal
+    calibrate-rig`` does.
+
+    source: one of
+        - a folder (str) holding one subfolder per camera, as
+          ``calibrate-rig --images`` takes (sorted by name; the first camera
+          is the rig frame);
+        - a list of camera folders, one per camera (the first is the rig
+          frame);
+        - a list, per camera, of per-frame observations: each frame an
+          (ids, corners) pair (N x 2 int board ids, N x 2 float64 pixels) or
+          None where the camera did not see the board; every camera lists
+          the same frames. image_sizes is then required.
+        The same file name in different camera folders is the same instant
+        (match_by_order=True pairs the n-th image of every folder instead).
+    board: a Board.
+    models: one model name (puzzlecal.MODELS) or "auto" for all cameras, or
+        a list with one per camera; "auto" chooses a camera's model on its
+        held-out views.
+    image_sizes: with observations, (width, height) for all cameras or a
+        list with one per camera.
+    names: camera names (default: the folders' names, or cam0, cam1, ...).
+    format: the rig file format the result is meant for (puzzlecal, opencv,
+        ros, kalibr): a parameter the format cannot hold is held fixed, as
+        the program's --format does; save() writes it by default.
+    options: puzzlecal.options(...) (sections rig, rig_evidence,
+        calibration, evidence, verdict, model_selection, detection ones).
+    threads: workers (0: all cores); the result does not depend on it.
+
+    Returns a RigCalibration: cameras (RigCamera: camera, cam_from_rig (R, t)
+    with rotation_stddev_deg / translation_stddev_m, baseline_m with its
+    sigma, residuals, rms_px, its own verdict), poses (rig_from_board per
+    frame), rms_px, verdict (RigVerdict: kind, reason, next_step), frames
+    (per frame: files, use, transfer error, epipolar error, moved), summary(),
+    save(path, format). Raises ValueError with the program's message (naming
+    the camera, folder or file) when the input is refused or the rig cannot
+    be calibrated.
+    """
+    if options is None:
+        options = Options()
+    if isinstance(models, str):
+        models = [models]
+    models = list(models)
+    if names is not None:
+        names = [str(n) for n in names]
+    if isinstance(source, (str, _os.PathLike)):
+        folders = _puzzlecal._rig_camera_folders(str(source))
+        return _puzzlecal._calibrate_rig_folders(
+            folders, names or [], board, models, bool(match_by_order), format,
+            options, threads)
+    source = list(source)
+    if not source:
+        raise ValueError("calibrate_rig: no cameras given")
+    if all(isinstance(s, (str, _os.PathLike)) for s in source):
+        return _puzzlecal._calibrate_rig_folders(
+            [str(s) for s in source], names or [], board, models,
+            bool(match_by_order), format, options, threads)
+    if image_sizes is None:
+        raise ValueError("calibrate_rig: observations need image_sizes="
+                         "(width, height) or one per camera")
+    if (len(image_sizes) == 2
+            and all(isinstance(v, int) for v in image_sizes)):
+        image_sizes = [tuple(image_sizes)]
+    return _puzzlecal._calibrate_rig_observations(
+        source, names or [], [tuple(s) for s in image_sizes], board, models,
+        format, options, threads)

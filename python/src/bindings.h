@@ -16,6 +16,9 @@
 #include <string>
 #include <vector>
 
+#include "camera/camera_models.h"
+#include "evidence/evidence.h"
+
 namespace puzzlecal::python {
 
 namespace py = pybind11;
@@ -24,6 +27,15 @@ void BindTarget(py::module_& m);
 void BindDetection(py::module_& m);
 void BindCamera(py::module_& m);
 void BindCalibration(py::module_& m);
+void BindRig(py::module_& m);
+
+// The evidence's tables of one camera's calibration (halves, uncertainty,
+// residual means by field angle and distance), as the report shows them.
+py::dict EvidenceDict(const Evidence& evidence);
+// {parameter name: value} of the camera's model.
+py::dict ByName(const Camera& camera, const std::vector<double>& values);
+// Workers for `threads` (0: all cores); ValueError when negative.
+int Threads(int threads);
 
 // Raises ValueError(message).
 [[noreturn]] void Raise(const std::string& message);

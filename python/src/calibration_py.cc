@@ -25,12 +25,16 @@ struct PyCalibration {
   JudgedCalibration judged;
 };
 
+}  // namespace
+
 int Threads(int threads) {
   if (threads < 0) Raise("threads must be >= 0 (0: all cores)");
   return threads > 0 ? threads
                      : static_cast<int>(
                            std::max(1u, std::thread::hardware_concurrency()));
 }
+
+namespace {
 
 PyCalibration Run(const Board& board, std::vector<CalibrationView> views,
                   std::vector<std::string> view_files, int width, int height,
@@ -152,7 +156,8 @@ py::list Bins(const std::vector<ResidualBin>& bins) {
   return out;
 }
 
-// The evidence's tables, as the report shows them.
+}  // namespace
+
 py::dict EvidenceDict(const Evidence& e) {
   const CrossValidation& cv = e.cross_validation;
   py::dict halves(py::arg("ok") = cv.ok, py::arg("error") = cv.error,
@@ -190,8 +195,6 @@ py::dict ByName(const Camera& camera, const std::vector<double>& values) {
   }
   return named;
 }
-
-}  // namespace
 
 void BindCalibration(py::module_& m) {
   py::class_<Verdict>(m, "Verdict",

@@ -161,4 +161,5 @@ PYBIND11_MODULE(_puzzlecal, m) {
   puzzlecal::python::BindDetection(m);
   puzzlecal::python::BindCamera(m);
   puzzlecal::python::BindCalibration(m);
+  puzzlecal::python::BindRig(m);
 }
