@@ -723,26 +723,32 @@ void PoseAllViews(const Camera& camera,
   for (size_t i = 0; i < views.size(); ++i) result->view_ok[i] = ok[i] != 0;
 }
 
-// The distortion-free starting camera: the focal-length search with a
-// centred principal point and, for the pinhole models, Zhang's closed forms
-// competing with it (the best fit to the search views wins). `method` says
-// which.
-Camera StartingCamera(CameraModelId model, int width, int height,
-                      const std::vector<const CalibrationView*>& search_views,
-                      const InitializationOptions& options,
-                      std::string* method) {
-  double search_cost = 0;
+// A distortion-free starting camera, how it was found, and its fit to the
+// search views (ViewFitCost).
+struct StartCandidate {
+  Camera camera;
+  std::string method;
+  double cost = 0;
+};
+
+// The distortion-free starting cameras: the focal-length search with a
+// centred principal point, then Zhang's closed forms (full, and with a
+// centred principal point) where they give a plausible camera.
+std::vector<StartCandidate> StartingCandidates(
+    CameraModelId model, int width, int height,
+    const std::vector<const CalibrationView*>& search_views,
+    const InitializationOptions& options) {
+  std::vector<StartCandidate> candidates(1);
   const double f_search = SearchFocalLength(model, width, height, search_views,
-                                            options, &search_cost);
-  Camera camera = CandidateCamera(model, width, height, f_search);
-  *method = "focal-length search (f = " + std::to_string(f_search) +
-            " px, centred principal point)";
-  if (!CameraModelIsPinhole(model)) return camera;
+                                            options, &candidates[0].cost);
+  candidates[0].camera = CandidateCamera(model, width, height, f_search);
+  candidates[0].method = "focal-length search (f = " +
+                         std::to_string(f_search) +
+                         " px, centred principal point)";
   const double cx0 = 0.5 * (width - 1), cy0 = 0.5 * (height - 1);
   const double scale = 0.5 * std::max(width, height);
   const std::vector<Eigen::Matrix3d> homographies =
       NormalisedHomographies(search_views, cx0, cy0, scale, options);
-  double best_cost = search_cost;
   double fx, fy, u0, v0;
   if (ZhangFull(homographies, &fx, &fy, &u0, &v0)) {
     Camera full = CandidateCamera(model, width, height, fx * scale);
@@ -753,25 +759,28 @@ Camera StartingCamera(CameraModelId model, int width, int height,
                            fx / fy < options.max_focal_aspect &&
                            full.params[2] > 0 && full.params[2] < width &&
                            full.params[3] > 0 && full.params[3] < height;
-    const double cost = plausible ? ViewFitCost(full, search_views, options)
-                                  : std::numeric_limits<double>::infinity();
-    if (cost < best_cost) {
-      best_cost = cost;
-      camera = full;
-      *method = "Zhang closed form";
+    if (plausible) {
+      candidates.push_back({full, "Zhang closed form",
+                            ViewFitCost(full, search_views, options)});
     }
   }
   double f;
   if (ZhangCentred(homographies, &f)) {
     const Camera centred = CandidateCamera(model, width, height, f * scale);
-    const double cost = ViewFitCost(centred, search_views, options);
-    if (cost < best_cost) {
-      best_cost = cost;
-      camera = centred;
-      *method = "Zhang closed form, centred principal point";
-    }
+    candidates.push_back({centred,
+                          "Zhang closed form, centred principal point",
+                          ViewFitCost(centred, search_views, options)});
   }
-  return camera;
+  return candidates;
+}
+
+// The candidate that fits the search views best (the first among equals).
+size_t BestCandidate(const std::vector<StartCandidate>& candidates) {
+  size_t best = 0;
+  for (size_t i = 1; i < candidates.size(); ++i) {
+    if (candidates[i].cost < candidates[best].cost) best = i;
+  }
+  return best;
 }
 
 // The distortion-free start refined on a subset of the posed views (k1, k2
@@ -820,6 +829,48 @@ void RefineStart(const std::vector<CalibrationView>& views,
   result->start_refined = true;
   result->method += ", refined on " + std::to_string(subset.size()) +
                     " views with k1, k2 free";
+}
+
+// The start: the candidates of StartingCandidates, posed and refined
+// (RefineStart). A pinhole model's candidates compete before refining: a
+// distortion-free pinhole is already the model near the axis. A fisheye
+// model's compete only after it (without refining, the search's start is
+// taken): without distortion the search's truncated cost
+// can prefer a false basin on a narrow lens (steep views of a 70 deg lens
+// gave f = 139 px for 457), so each candidate is refined with k1, k2 free
+// and the best fit to the search views wins.
+void StartFromCandidates(const std::vector<CalibrationView>& views,
+                         const std::vector<bool>& use_view,
+                         CameraModelId model, int width, int height,
+                         const std::vector<const CalibrationView*>& search_views,
+                         const InitializationOptions& options, Camera* camera,
+                         InitializationResult* result) {
+  std::vector<StartCandidate> candidates =
+      StartingCandidates(model, width, height, search_views, options);
+  const bool refine = options.start_refine_iterations > 0;
+  const bool pinhole = CameraModelIsPinhole(model);
+  if (pinhole || !refine || candidates.size() == 1) {
+    // Unrefined, a fisheye model's start is the search's own.
+    const StartCandidate& best =
+        candidates[pinhole ? BestCandidate(candidates) : 0];
+    *camera = best.camera;
+    result->method = best.method;
+    PoseAllViews(*camera, views, use_view, options, result);
+    if (refine) RefineStart(views, use_view, model, options, camera, result);
+    return;
+  }
+  std::vector<InitializationResult> starts(candidates.size());
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    starts[i].method = candidates[i].method;
+    PoseAllViews(candidates[i].camera, views, use_view, options, &starts[i]);
+    RefineStart(views, use_view, model, options, &candidates[i].camera,
+                &starts[i]);
+    candidates[i].cost =
+        ViewFitCost(candidates[i].camera, search_views, options);
+  }
+  const size_t best = BestCandidate(candidates);
+  *camera = candidates[best].camera;
+  *result = std::move(starts[best]);
 }
 
 // The largest angle between the board normals of two posed views (radians);
@@ -879,14 +930,11 @@ bool InitializeCalibration(const std::vector<CalibrationView>& views,
     camera.height = height;
     camera.params = initial_params;
     result->method = "given by the caller";
+    PoseAllViews(camera, views, use_view, options, result);
   } else {
-    camera = StartingCamera(model, width, height,
-                            SpreadSubset(used, options.focal_search_max_views),
-                            options, &result->method);
-  }
-  PoseAllViews(camera, views, use_view, options, result);
-  if (initial_params.empty() && options.start_refine_iterations > 0) {
-    RefineStart(views, use_view, model, options, &camera, result);
+    StartFromCandidates(views, use_view, model, width, height,
+                        SpreadSubset(used, options.focal_search_max_views),
+                        options, &camera, result);
   }
   result->camera = camera;
   double spread = 0;

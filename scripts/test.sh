@@ -51,7 +51,10 @@ if [ "$full" = 1 ]; then
   export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
   export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:print_stacktrace=1"
   # Process-wide caches of system libraries only (each line says which).
-  export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp"
+  # print_suppressions=0: the list of suppressions used would otherwise be
+  # appended to every program's stderr, which tests of the program's output
+  # (--quiet prints only "wrote ...") read.
+  export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
   if build-asan/apps/puzzlecal version 2>&1 >/dev/null |
       grep -q "LeakSanitizer has encountered a fatal error"; then
     echo "test.sh: LeakSanitizer does not work here; leaks are not checked"

@@ -1,0 +1,141 @@
+#include "sim/synthetic_views.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <utility>
+
+namespace puzzlecal {
+namespace sim {
+
+Camera MakeCamera(CameraModelId model, int width, int height,
+                         std::vector<double> params) {
+  Camera camera;
+  camera.model = model;
+  camera.width = width;
+  camera.height = height;
+  camera.params = std::move(params);
+  return camera;
+}
+
+// A wide-angle lens with strong barrel distortion, 1280 x 960.
+Camera TruthRadtan() {
+  return MakeCamera(
+      CameraModelId::kPinholeRadtan, 1280, 960,
+      {820.0, 818.5, 642.3, 477.1, -0.28, 0.09, 0.0006, -0.0004, -0.012});
+}
+// OpenCV's rational model, 1280 x 960.
+Camera TruthRational() {
+  return MakeCamera(CameraModelId::kPinholeRational, 1280, 960,
+                    {760.0, 761.2, 637.8, 482.6, 0.3, 0.02, 0.0004, 0.0007,
+                     0.0005, 0.52, 0.06, 0.001});
+}
+// A 190 degree fisheye on a 1600 x 1200 sensor: the image circle is cut by
+// the top and bottom edges, the image corners see 114 degrees off the axis.
+Camera TruthFisheye190() {
+  return MakeCamera(CameraModelId::kKannalaBrandt, 1600, 1200,
+                    {495.0, 494.2, 801.7, 598.4, 0.02, -0.005, 0.001, -0.0002});
+}
+
+SyntheticData MakeSyntheticData(const SyntheticScene& scene) {
+  std::mt19937 rng(scene.seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const Camera& camera = scene.camera;
+  const double board_width = (scene.board_cols - 1) * scene.tile;
+  const Eigen::Vector3d board_centre(0.5 * (scene.board_cols - 1) * scene.tile,
+                                     0.5 * (scene.board_rows - 1) * scene.tile,
+                                     0);
+  const double deg = M_PI / 180.0;
+  SyntheticData data;
+  int attempts = 0;
+  while (static_cast<int>(data.views.size()) < scene.num_views &&
+         attempts < 100000) {
+    ++attempts;
+    // Direction of the board centre: uniform in the cap up to max_direction.
+    const double cos_max = std::cos(scene.max_direction_deg * deg);
+    const double cos_theta = 1.0 - uniform(rng) * (1.0 - cos_max);
+    const double theta = std::acos(cos_theta);
+    const double phi = 2 * M_PI * uniform(rng);
+    const Eigen::Vector3d dir(std::sin(theta) * std::cos(phi),
+                              std::sin(theta) * std::sin(phi), cos_theta);
+    // Board z along the viewing ray, then tilted about an axis across it.
+    const Eigen::Matrix3d face =
+        scene.fronto_parallel
+            ? Eigen::Matrix3d::Identity()
+            : Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), dir)
+                  .toRotationMatrix();
+    const double tilt =
+        scene.fronto_parallel
+            ? 0.0
+            : (scene.min_tilt_deg +
+               uniform(rng) * (scene.max_tilt_deg - scene.min_tilt_deg)) *
+                  deg;
+    const double axis_angle = 2 * M_PI * uniform(rng);
+    const Eigen::Vector3d axis =
+        face * Eigen::Vector3d(std::cos(axis_angle), std::sin(axis_angle), 0);
+    const double spin = (uniform(rng) - 0.5) * 2 * M_PI;
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(tilt, axis).toRotationMatrix() * face *
+        Eigen::AngleAxisd(spin, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const double distance =
+        board_width *
+        (scene.min_distance +
+         uniform(rng) * (scene.max_distance - scene.min_distance));
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = rotation;
+    pose.translation() = distance * dir - rotation * board_centre;
+
+    CalibrationView view;
+    std::vector<Eigen::Vector2d> exact;
+    for (int row = 0; row < scene.board_rows; ++row) {
+      for (int col = 0; col < scene.board_cols; ++col) {
+        const Eigen::Vector3d board(col * scene.tile, row * scene.tile, 0);
+        const Eigen::Vector3d cam = pose * board;
+        if (std::atan2(cam.head<2>().norm(), cam.z()) >
+            scene.max_corner_angle_deg * deg) {
+          continue;
+        }
+        // The board must face the camera (its front side is seen).
+        if ((cam).dot(rotation.col(2)) <= 0) continue;
+        Eigen::Vector2d pixel;
+        if (!camera.Project(cam, &pixel)) continue;
+        if (pixel.x() < 0 || pixel.y() < 0 || pixel.x() > camera.width - 1 ||
+            pixel.y() > camera.height - 1) {
+          continue;
+        }
+        view.board_points.push_back(board);
+        exact.push_back(pixel);
+      }
+    }
+    const int total = scene.board_cols * scene.board_rows;
+    if (view.board_points.size() <
+        std::max<size_t>(8, std::ceil(scene.min_visible_fraction * total))) {
+      continue;
+    }
+    std::vector<bool> outlier(exact.size(), false);
+    for (size_t i = 0; i < exact.size(); ++i) {
+      Eigen::Vector2d observed =
+          exact[i] + scene.noise_px * Eigen::Vector2d(normal(rng), normal(rng));
+      if (uniform(rng) < scene.outlier_fraction) {
+        // A gross error: 5 to 50 px away in a random direction.
+        const double angle = 2 * M_PI * uniform(rng);
+        const double size = 5 + 45 * uniform(rng);
+        observed =
+            exact[i] + size * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+        outlier[i] = true;
+      }
+      view.image_points.push_back(observed);
+    }
+    view.name = "synthetic_" + std::to_string(data.views.size());
+    data.num_corners += static_cast<int>(exact.size());
+    data.views.push_back(std::move(view));
+    data.cam_from_board.push_back(pose);
+    data.exact.push_back(std::move(exact));
+    data.is_outlier.push_back(std::move(outlier));
+  }
+  return data;
+}
+
+}  // namespace sim
+}  // namespace puzzlecal
