@@ -161,7 +161,10 @@ std::shared_ptr<PyRig> FromFolders(const std::vector<std::string>& folders,
                                    const RunOptions& options, int threads) {
   if (names.empty()) {
     for (const std::string& folder : folders) {
-      names.push_back(std::filesystem::path(folder).filename().string());
+      // "cam0/" names the camera cam0 too.
+      std::filesystem::path path(folder);
+      if (!path.has_filename()) path = path.parent_path();
+      names.push_back(path.filename().string());
     }
   }
   if (names.size() != folders.size()) {

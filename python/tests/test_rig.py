@@ -198,10 +198,13 @@ def test_result_outlives_what_it_came_from(rendered):
 
     def make():
         board = puzzlecal.Board.load(str(board_file))
-        return puzzlecal.calibrate_rig(str(root / "images"), board,
+        # A list of camera folders ("cam0/" names its camera cam0).
+        folders = [f"{root / 'images' / name}/" for name in ("cam0", "cam1")]
+        return puzzlecal.calibrate_rig(folders, board,
                                        models="pinhole-radtan").cameras
     cameras = make()
     gc.collect()
+    assert [c.name for c in cameras] == ["cam0", "cam1"]
     camera = cameras[1].camera
     R, _ = cameras[1].cam_from_rig
     verdict = cameras[1].verdict

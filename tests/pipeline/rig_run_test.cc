@@ -1,0 +1,119 @@
+// A rig's run as library calls: frames matched across camera listings by
+// name and by order, the refusals, and the judged calibration of a
+// synthetic stereo rig (sim/rig_scenes.h) against its truth.
+
+#include "pipeline/rig_run.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "sim/rig_scenes.h"
+
+namespace puzzlecal {
+namespace {
+
+ImageListing Listing(const std::vector<std::string>& images) {
+  ImageListing listing;
+  listing.images = images;
+  return listing;
+}
+
+TEST(RigRunTest, FramesAreMatchedByFileName) {
+  const std::vector<ImageListing> listings = {
+      Listing({"left/a.png", "left/b.png"}),
+      Listing({"right/b.png", "right/c.png"})};
+  RigFrames frames;
+  std::string error;
+  ASSERT_TRUE(MatchRigFrames({"left", "right"}, listings, false, &frames,
+                             &error))
+      << error;
+  EXPECT_EQ(frames.num_frames, 3);
+  EXPECT_EQ(frames.frame_of_file[0].at("left/a.png"), 0);
+  EXPECT_EQ(frames.frame_of_file[0].at("left/b.png"), 1);
+  EXPECT_EQ(frames.frame_of_file[1].at("right/b.png"), 1);
+  EXPECT_EQ(frames.frame_of_file[1].at("right/c.png"), 2);
+}
+
+TEST(RigRunTest, FramesAreMatchedByOrderWhenAsked) {
+  const std::vector<ImageListing> listings = {
+      Listing({"left/l01.png", "left/l02.png"}),
+      Listing({"right/r01.png", "right/r02.png"})};
+  RigFrames frames;
+  std::string error;
+  ASSERT_TRUE(
+      MatchRigFrames({"left", "right"}, listings, true, &frames, &error))
+      << error;
+  EXPECT_EQ(frames.num_frames, 2);
+  EXPECT_EQ(frames.frame_of_file[1].at("right/r02.png"), 1);
+}
+
+TEST(RigRunTest, ListingsThatCannotBePairedAreRefusedNamingTheCamera) {
+  RigFrames frames;
+  std::string error;
+  EXPECT_FALSE(MatchRigFrames({"left", "right"},
+                              {Listing({"left/l01.png", "left/l02.png"}),
+                               Listing({"right/r01.png", "right/r02.png"})},
+                              false, &frames, &error));
+  EXPECT_NE(error.find("camera 'left' shares no frame with another camera"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("--match_by_order"), std::string::npos) << error;
+  EXPECT_FALSE(MatchRigFrames(
+      {"left", "right"},
+      {Listing({"left/l01.png", "left/l02.png"}), Listing({"right/r01.png"})},
+      true, &frames, &error));
+  EXPECT_NE(error.find("camera 'right' has 1 images, camera 'left' 2"),
+            std::string::npos)
+      << error;
+}
+
+TEST(RigRunTest, JudgedStereoRigMeetsTheTruth) {
+  const RigSceneSpec scene = StereoPinholeRig();
+  const std::vector<RigCameraInput> inputs = RigCorrespondences(scene, 0.05);
+  std::vector<std::vector<std::string>> frame_files(inputs.size());
+  for (size_t c = 0; c < inputs.size(); ++c) {
+    for (size_t f = 0; f < inputs[c].frames.size(); ++f) {
+      frame_files[c].push_back(inputs[c].frames[f].board_points.empty()
+                                   ? ""
+                                   : inputs[c].name + "/" +
+                                         RigFrameFileName(static_cast<int>(f)));
+    }
+  }
+  JudgedRig judged;
+  std::string error;
+  ASSERT_TRUE(CalibrateAndJudgeRig(scene.board, inputs, frame_files,
+                                   RigRunOptions(), &judged, &error))
+      << error;
+  ASSERT_EQ(judged.result.cameras.size(), 2u);
+  const CamFromRigError cam1 =
+      CompareCamFromRig(judged.result.cameras[1], scene.cameras[1].cam_from_rig);
+  EXPECT_LT(cam1.rotation_deg, 0.01);
+  EXPECT_LT(cam1.translation_m, 1e-4);
+  ASSERT_EQ(judged.verdicts.size(), 2u);
+  for (const Verdict& verdict : judged.verdicts) {
+    EXPECT_EQ(verdict.kind, VerdictKind::kGood) << verdict.Line();
+  }
+  EXPECT_EQ(judged.rig_verdict.kind, "good") << judged.rig_verdict.Line();
+  EXPECT_EQ(judged.file.verdict_kind, "good");
+  ASSERT_EQ(judged.file.frames.size(), frame_files[0].size());
+  EXPECT_EQ(judged.file.frames[0].files[1], "cam1/frame_000.png");
+  EXPECT_EQ(judged.file.frames[0].use[0], "used");
+  EXPECT_EQ(RigFrameNames(frame_files)[0], "frame_000.png");
+}
+
+TEST(RigRunTest, OnlyAPlainCheckerboardHasTheHalfTurn) {
+  EXPECT_FALSE(RigSymmetryOf(StereoPinholeRig().board).half_turn);
+  // 9 x 6 inner corners of 30 mm from (0, 0): the grid's centre is at
+  // (4 tiles, 2.5 tiles).
+  const Board checkerboard = MakeBoard(BoardType::kCheckerboard, 9, 6,
+                                       Eigen::Vector2i::Zero(), 0.03);
+  const RigBoardSymmetry symmetry = RigSymmetryOf(checkerboard);
+  EXPECT_TRUE(symmetry.half_turn);
+  EXPECT_TRUE(symmetry.centre.isApprox(Eigen::Vector3d(0.12, 0.075, 0)))
+      << symmetry.centre.transpose();
+}
+
+}  // namespace
+}  // namespace puzzlecal
