@@ -26,8 +26,8 @@ TEST(RigRunTest, FramesAreMatchedByFileName) {
       Listing({"right/b.png", "right/c.png"})};
   RigFrames frames;
   std::string error;
-  ASSERT_TRUE(MatchRigFrames({"left", "right"}, listings, false, &frames,
-                             &error))
+  ASSERT_TRUE(
+      MatchRigFrames({"left", "right"}, listings, false, &frames, &error))
       << error;
   EXPECT_EQ(frames.num_frames, 3);
   EXPECT_EQ(frames.frame_of_file[0].at("left/a.png"), 0);
@@ -87,8 +87,8 @@ TEST(RigRunTest, JudgedStereoRigMeetsTheTruth) {
                                    RigRunOptions(), &judged, &error))
       << error;
   ASSERT_EQ(judged.result.cameras.size(), 2u);
-  const CamFromRigError cam1 =
-      CompareCamFromRig(judged.result.cameras[1], scene.cameras[1].cam_from_rig);
+  const CamFromRigError cam1 = CompareCamFromRig(judged.result.cameras[1],
+                                                 scene.cameras[1].cam_from_rig);
   EXPECT_LT(cam1.rotation_deg, 0.01);
   EXPECT_LT(cam1.translation_m, 1e-4);
   ASSERT_EQ(judged.verdicts.size(), 2u);
@@ -107,8 +107,8 @@ TEST(RigRunTest, OnlyAPlainCheckerboardHasTheHalfTurn) {
   EXPECT_FALSE(RigSymmetryOf(StereoPinholeRig().board).half_turn);
   // 9 x 6 inner corners of 30 mm from (0, 0): the grid's centre is at
   // (4 tiles, 2.5 tiles).
-  const Board checkerboard = MakeBoard(BoardType::kCheckerboard, 9, 6,
-                                       Eigen::Vector2i::Zero(), 0.03);
+  const Board checkerboard =
+      MakeBoard(BoardType::kCheckerboard, 9, 6, Eigen::Vector2i::Zero(), 0.03);
   const RigBoardSymmetry symmetry = RigSymmetryOf(checkerboard);
   EXPECT_TRUE(symmetry.half_turn);
   EXPECT_TRUE(symmetry.centre.isApprox(Eigen::Vector3d(0.12, 0.075, 0)))
