@@ -1,3 +1,7 @@
+#include <glog/logging.h>
+
+#include <cstdlib>
+
 #include "formats/image_io.h"
 #include "python/src/bindings.h"
 
@@ -162,4 +166,10 @@ PYBIND11_MODULE(_puzzlecal, m) {
   puzzlecal::python::BindCamera(m);
   puzzlecal::python::BindCalibration(m);
   puzzlecal::python::BindRig(m);
+  // Library logging (Ceres' solver warnings during the model choice) shows
+  // only errors, as in the program without --verbose; GLOG_minloglevel in
+  // the environment keeps its say.
+  if (std::getenv("GLOG_minloglevel") == nullptr) {
+    FLAGS_minloglevel = google::GLOG_ERROR;
+  }
 }

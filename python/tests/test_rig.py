@@ -132,6 +132,21 @@ def test_residuals_rms_and_verdict(rig):
     assert "cam1" in rig.summary()
 
 
+def test_auto_chooses_the_rendered_model_quietly(rendered, capfd):
+    root, truth, _ = rendered
+    # auto for the first camera, a model named for the second.
+    result = puzzlecal.calibrate_rig(str(root / "images"), truth["board"],
+                                     models=["auto", "pinhole-radtan"],
+                                     threads=2)
+    first, second = result.cameras
+    assert first.model == truth["cameras"][0]["camera"].model
+    assert "chosen: pinhole-radtan" in first.model_selection
+    assert second.model_selection is None
+    assert result.verdict.kind == "good"
+    # The solver's warnings on the models tried stay out of the way.
+    assert capfd.readouterr().err == ""
+
+
 def test_saved_file_equals_the_programs(rig, rendered, program, tmp_path):
     root, _, board_file = rendered
     for fmt in ("puzzlecal", "opencv"):
