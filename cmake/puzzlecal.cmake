@@ -8,6 +8,23 @@ include(GNUInstallDirs)
 # its folder's headers are installed (`cmake --install`, headers under
 # include/puzzlecal/<folder>/) and exported as puzzlecal::NAME through the
 # puzzlecal CMake package (find_package(puzzlecal)).
+#
+# The libraries' sources share one precompiled header (Eigen's dense core and
+# geometry, the standard library): most of them include both, and parsing
+# them again for each file was a large part of the build.
+function(puzzlecal_library_pch_host)
+  if(TARGET puzzlecal_library_pch)
+    return()
+  endif()
+  add_library(puzzlecal_library_pch OBJECT
+              ${PROJECT_SOURCE_DIR}/cmake/pch_host.cc)
+  target_link_libraries(puzzlecal_library_pch PRIVATE Eigen3::Eigen)
+  target_precompile_headers(puzzlecal_library_pch PRIVATE
+    <Eigen/Core> <Eigen/Geometry>
+    <algorithm> <array> <cmath> <cstdint> <cstdio> <functional> <limits>
+    <map> <memory> <sstream> <string> <utility> <vector>)
+endfunction()
+
 function(puzzlecal_add_library name)
   cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC;PRIVATE" ${ARGN})
   # Installed headers include each other as "camera/camera_models.h", so
@@ -19,6 +36,8 @@ function(puzzlecal_add_library name)
     add_library(${name} STATIC ${ARG_SOURCES})
     target_include_directories(${name} PUBLIC ${includes})
     target_link_libraries(${name} PUBLIC ${ARG_PUBLIC} PRIVATE ${ARG_PRIVATE})
+    puzzlecal_library_pch_host()
+    target_precompile_headers(${name} REUSE_FROM puzzlecal_library_pch)
   else()  # headers only
     add_library(${name} INTERFACE)
     target_include_directories(${name} INTERFACE ${includes})
@@ -51,8 +70,8 @@ function(puzzlecal_install_package)
           DESTINATION ${dir})
 endfunction()
 
-# puzzlecal_add_tests(DIR DEPS ...): one GoogleTest binary per *_test.cc file in
-# DIR, registered with CTest (gtest_discover_tests), run from the repository
+# puzzlecal_add_tests(DIR DEPS ...): one GoogleTest program of the *_test.cc
+# files in DIR, each test registered with CTest (gtest_discover_tests), run from the repository
 # root so tests can read configs/ and testdata/.
 #
 # The test binaries share one precompiled header (GoogleTest, Eigen, the
@@ -80,22 +99,24 @@ function(puzzlecal_test_compile_options target)
   endif()
 endfunction()
 
+# One test program per folder (tests/<folder>/*_test.cc -> <folder>_tests):
+# linking a program against OpenCV and Ceres and listing its tests costs
+# about two seconds, paid once per folder rather than once per file.
 function(puzzlecal_add_tests dir)
   cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
   puzzlecal_test_pch_host()
   file(GLOB test_sources CONFIGURE_DEPENDS ${dir}/*_test.cc)
-  foreach(source ${test_sources})
-    get_filename_component(stem ${source} NAME_WE)
-    get_filename_component(folder ${dir} NAME)
-    set(target ${folder}_${stem})
-    add_executable(${target} ${source})
-    target_link_libraries(${target} PRIVATE ${ARG_DEPS} GTest::gtest
-                          GTest::gtest_main)
-    puzzlecal_test_compile_options(${target})
-    target_precompile_headers(${target} REUSE_FROM puzzlecal_test_pch)
-    gtest_discover_tests(${target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-                         DISCOVERY_TIMEOUT 60
-                         PROPERTIES ENVIRONMENT
-                         "PUZZLECAL_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
-  endforeach()
+  get_filename_component(folder ${dir} NAME)
+  set(target ${folder}_tests)
+  add_executable(${target} ${test_sources})
+  target_link_libraries(${target} PRIVATE ${ARG_DEPS} GTest::gtest
+                        GTest::gtest_main)
+  puzzlecal_test_compile_options(${target})
+  target_precompile_headers(${target} REUSE_FROM puzzlecal_test_pch)
+  set_target_properties(${target} PROPERTIES UNITY_BUILD ON
+                        UNITY_BUILD_BATCH_SIZE 4)
+  gtest_discover_tests(${target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+                       DISCOVERY_TIMEOUT 60
+                       PROPERTIES ENVIRONMENT
+                       "PUZZLECAL_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
 endfunction()

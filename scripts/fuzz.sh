@@ -13,6 +13,8 @@ cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 shift || true
 build_dir="${PUZZLECAL_FUZZ_BUILD_DIR:-build-fuzz}"
+# clang and its libFuzzer runtime come with the full set of packages.
+scripts/install_deps.sh --full
 
 if [ ! -f "$build_dir/CMakeCache.txt" ]; then
   generator=()

@@ -1,20 +1,31 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package that puzzlecal's build, tests, benchmarks and
-# fuzzers need. Idempotent: does nothing when all are present.
+# Installs the Debian 12 packages that puzzlecal's build and tests need;
+# with --full also those of the benchmarks and the fuzzers (clang with its
+# libFuzzer runtime, Google Benchmark), which only `scripts/test.sh --full`
+# builds. Idempotent: does nothing when all are present.
 set -euo pipefail
+
+full=0
+case "${1:-}" in
+  "") ;;
+  --full) full=1 ;;
+  *) echo "install_deps.sh: unknown argument '$1' (use --full or nothing)" >&2; exit 2 ;;
+esac
 
 packages=(
   build-essential cmake ninja-build pkg-config git
   libopencv-dev libceres-dev libeigen3-dev
   libgflags-dev libgoogle-glog-dev libyaml-cpp-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev
   libcairo2-dev
   libplplot-dev plplot-driver-cairo
   libdeflate-dev zlib1g-dev
-  clang libclang-rt-14-dev
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
   python3-setuptools python3-pip python3-venv python3-yaml
 )
+if [ "$full" = 1 ]; then
+  packages+=(libbenchmark-dev clang libclang-rt-14-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

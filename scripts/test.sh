@@ -29,7 +29,7 @@ phase_done() {
   phase_start=$SECONDS
 }
 
-scripts/install_deps.sh
+if [ "$full" = 1 ]; then scripts/install_deps.sh --full; else scripts/install_deps.sh; fi
 phase_done "install deps"
 
 # The quick run leaves the benchmark programs out (they time, they do not

@@ -208,7 +208,7 @@ std::shared_ptr<PyRig> FromFolders(const std::vector<std::string>& folders,
              threads);
 }
 
-std::shared_ptr<PyRig> FromObservations(
+std::shared_ptr<PyRig> RigFromObservations(
     const py::list& observations, std::vector<std::string> names,
     const std::vector<std::pair<int, int>>& image_sizes, const Board& board,
     const std::vector<std::string>& models, const std::string& format,
@@ -616,7 +616,7 @@ void BindRig(py::module_& m) {
         py::arg("names"), py::arg("board"), py::arg("models"),
         py::arg("match_by_order"), py::arg("format"), py::arg("options"),
         py::arg("threads"));
-  m.def("_calibrate_rig_observations", &FromObservations,
+  m.def("_calibrate_rig_observations", &RigFromObservations,
         py::arg("observations"), py::arg("names"), py::arg("image_sizes"),
         py::arg("board"), py::arg("models"), py::arg("format"),
         py::arg("options"), py::arg("threads"));

@@ -35,51 +35,20 @@
 #include "camera/camera_models.h"
 #include "sim/render.h"
 #include "target/board.h"
+#include "tests/support/program_run.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
+using testing_files::ReadFile;
+using testing_files::WriteFile;
+using testing_program::ProgramPath;
+using testing_program::ProgramRun;
+using testing_program::Quote;
+using testing_program::RunProgram;
 
 // ---------------------------------------------------------------- helpers --
-
-fs::path ProgramPath() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  // Tests live in <build>/tests/, the program in <build>/apps/.
-  return self.parent_path().parent_path() / "apps" / "puzzlecal";
-}
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)),
-                     std::istreambuf_iterator<char>());
-}
-
-void WriteFile(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << bytes;
-}
-
-std::string Quote(const std::string& s) {
-  std::string quoted = "'";
-  for (char c : s) {
-    if (c == '\'') {
-      quoted += "'\\''";
-    } else {
-      quoted += c;
-    }
-  }
-  return quoted + "'";
-}
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-  std::string all() const { return out + err; }
-};
 
 // Files under the folder, recursively (to check for partial output).
 std::vector<std::string> FilesUnder(const fs::path& folder) {
@@ -234,30 +203,17 @@ class BadInputTest : public ::testing::Test {
 
   fs::path BoardFile() const { return *root_ / "board.yaml"; }
 
-  RunResult Run(const std::string& arguments) const {
-    const fs::path out = case_dir_ / "stdout.txt";
-    const fs::path err = case_dir_ / "stderr.txt";
-    const std::string command = Quote(program_.string()) + " " + arguments +
-                                " >" + Quote(out.string()) + " 2>" +
-                                Quote(err.string()) + " </dev/null";
-    const int status = std::system(command.c_str());
-    RunResult result;
-    result.exit_code =
-        WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    result.out = ReadFile(out);
-    result.err = ReadFile(err);
-    fs::remove(out);
-    fs::remove(err);
-    return result;
+  ProgramRun Run(const std::string& arguments) const {
+    return RunProgram(arguments, case_dir_);
   }
 
-  RunResult Detect(const fs::path& images, const fs::path& out) const {
+  ProgramRun Detect(const fs::path& images, const fs::path& out) const {
     return Run("detect --images " + Quote(images.string()) + " --out " +
                Quote(out.string()));
   }
 
-  RunResult Calibrate(const fs::path& images, const fs::path& out,
-                      const std::string& extra = "") const {
+  ProgramRun Calibrate(const fs::path& images, const fs::path& out,
+                       const std::string& extra = "") const {
     return Run("calibrate --images " + Quote(images.string()) + " --board " +
                Quote(BoardFile().string()) +
                " --model pinhole-radtan --threads 2 --out " +
@@ -295,14 +251,14 @@ fs::path* BadInputTest::root_ = nullptr;
 TEST_F(BadInputTest, MissingFolder) {
   const fs::path missing = case_dir_ / "no_such_folder";
   const fs::path out = case_dir_ / "detections.yaml";
-  const RunResult detect = Detect(missing, out);
+  const ProgramRun detect = Detect(missing, out);
   EXPECT_EQ(detect.exit_code, kExitBadInput) << detect.all();
   EXPECT_NE(detect.err.find(missing.string()), std::string::npos) << detect.err;
   EXPECT_NE(detect.err.find("no such file"), std::string::npos) << detect.err;
   EXPECT_FALSE(fs::exists(out));
 
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult calibrate = Calibrate(missing, camera);
+  const ProgramRun calibrate = Calibrate(missing, camera);
   EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
   EXPECT_NE(calibrate.err.find(missing.string()), std::string::npos)
       << calibrate.err;
@@ -313,14 +269,14 @@ TEST_F(BadInputTest, EmptyFolder) {
   const fs::path empty = case_dir_ / "empty";
   fs::create_directories(empty);
   const fs::path out = case_dir_ / "detections.yaml";
-  const RunResult detect = Detect(empty, out);
+  const ProgramRun detect = Detect(empty, out);
   EXPECT_EQ(detect.exit_code, kExitBadInput) << detect.all();
   EXPECT_NE(detect.err.find(empty.string()), std::string::npos) << detect.err;
   EXPECT_NE(detect.err.find("no image"), std::string::npos) << detect.err;
   EXPECT_FALSE(fs::exists(out));
 
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult calibrate = Calibrate(empty, camera);
+  const ProgramRun calibrate = Calibrate(empty, camera);
   EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
   EXPECT_NE(calibrate.err.find(empty.string()), std::string::npos)
       << calibrate.err;
@@ -338,7 +294,7 @@ TEST_F(BadInputTest, FolderOfNonImages) {
   for (size_t k = 0; k < noise.size(); ++k) noise[k] = char((k * 7919) >> 3);
   WriteFile(folder / "random.jpg", noise);
   const fs::path out = case_dir_ / "detections.yaml";
-  const RunResult detect = Detect(folder, out);
+  const ProgramRun detect = Detect(folder, out);
   EXPECT_EQ(detect.exit_code, kExitBadInput) << detect.all();
   EXPECT_NE(detect.err.find("fake.png"), std::string::npos) << detect.err;
   EXPECT_NE(detect.err.find("random.jpg"), std::string::npos) << detect.err;
@@ -347,7 +303,7 @@ TEST_F(BadInputTest, FolderOfNonImages) {
   EXPECT_FALSE(fs::exists(out)) << "nothing readable: no detections file";
 
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult calibrate = Calibrate(folder, camera);
+  const ProgramRun calibrate = Calibrate(folder, camera);
   EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
   EXPECT_NE(calibrate.all().find("fake.png"), std::string::npos)
       << calibrate.all();
@@ -383,7 +339,7 @@ TEST_F(BadInputTest, DetectWritesTruthIdsOfAGoodView) {
 
   for (const bool with_board : {true, false}) {
     SCOPED_TRACE(with_board ? "with --board" : "without --board");
-    const RunResult detect =
+    const ProgramRun detect =
         Run("detect --images " + Quote(folder.string()) + " --out " +
             Quote(out.string()) +
             (with_board ? " --board " + Quote(BoardFile().string()) : ""));
@@ -479,7 +435,7 @@ TEST_F(BadInputTest, BrokenFilesAmongGoodViews) {
   WriteFile(folder / "noise.png", EncodeImage(noise, ".png"));
 
   const fs::path out = case_dir_ / "detections.yaml";
-  const RunResult detect = Detect(folder, out);
+  const ProgramRun detect = Detect(folder, out);
   EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
   EXPECT_NE(detect.err.find("truncated.png: truncated PNG"), std::string::npos)
       << detect.err;
@@ -501,7 +457,7 @@ TEST_F(BadInputTest, BrokenFilesAmongGoodViews) {
   EXPECT_NE(detections.at("zero.png").reason.find("empty"), std::string::npos);
 
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult calibrate = Calibrate(folder, camera);
+  const ProgramRun calibrate = Calibrate(folder, camera);
   EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
   const std::string all = calibrate.all();
   for (const char* name : {"truncated.png", "truncated.jpg", "zero.png",
@@ -548,7 +504,7 @@ TEST_F(BadInputTest, SixteenBitRgbaAndJpegImages) {
   cv::cvtColor(Render(GoodPoses()[0]), colour, cv::COLOR_GRAY2BGR);
   WriteFile(folder / "colour.jpg", EncodeImage(colour, ".jpg"));
   const fs::path out = case_dir_ / "detections.yaml";
-  const RunResult detect = Detect(folder, out);
+  const ProgramRun detect = Detect(folder, out);
   EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
   const auto detections = ReadDetections(out);
   ASSERT_EQ(detections.size(), GoodPoses().size() + 1);
@@ -557,7 +513,7 @@ TEST_F(BadInputTest, SixteenBitRgbaAndJpegImages) {
   }
 
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult calibrate = Calibrate(folder, camera);
+  const ProgramRun calibrate = Calibrate(folder, camera);
   EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
   EXPECT_TRUE(fs::exists(camera));
 }
@@ -577,13 +533,13 @@ TEST_F(BadInputTest, TwoBoardsInOneImage) {
   WriteFile(folder / "two_boards.png", EncodeImage(both, ".png"));
 
   const fs::path out = case_dir_ / "detections.yaml";
-  const RunResult detect = Detect(folder, out);
+  const ProgramRun detect = Detect(folder, out);
   EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
   const auto detections = ReadDetections(out);
   EXPECT_GT(detections.at("two_boards.png").corners, 60);
 
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult calibrate = Calibrate(folder, camera);
+  const ProgramRun calibrate = Calibrate(folder, camera);
   EXPECT_EQ(calibrate.exit_code, kExitOk) << calibrate.all();
   EXPECT_NE(calibrate.all().find("two_boards.png"), std::string::npos)
       << calibrate.all();
@@ -600,7 +556,7 @@ TEST_F(BadInputTest, FiftyMegapixelImage) {
   huge.release();
 
   const fs::path out = case_dir_ / "detections.yaml";
-  const RunResult detect = Detect(folder, out);
+  const ProgramRun detect = Detect(folder, out);
   EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
   const auto detections = ReadDetections(out);
   EXPECT_GT(detections.at("view0.png").corners, 60);
@@ -616,7 +572,7 @@ TEST_F(BadInputTest, UnreadablePermissions) {
   fs::copy_file(folder / "view0.png", folder / "locked.png");
   fs::permissions(folder / "locked.png", fs::perms::none);
   const fs::path out = case_dir_ / "detections.yaml";
-  const RunResult detect = Detect(folder, out);
+  const ProgramRun detect = Detect(folder, out);
   fs::permissions(folder / "locked.png", fs::perms::owner_all);
   EXPECT_EQ(detect.exit_code, kExitOk) << detect.all();
   EXPECT_NE(detect.err.find("locked.png: cannot open"), std::string::npos)
@@ -627,7 +583,7 @@ TEST_F(BadInputTest, UnreadablePermissions) {
   const fs::path locked_folder = case_dir_ / "locked_folder";
   fs::create_directories(locked_folder);
   fs::permissions(locked_folder, fs::perms::none);
-  const RunResult folder_run = Detect(locked_folder, out);
+  const ProgramRun folder_run = Detect(locked_folder, out);
   fs::permissions(locked_folder, fs::perms::owner_all);
   EXPECT_EQ(folder_run.exit_code, kExitBadInput) << folder_run.all();
   EXPECT_NE(folder_run.err.find(locked_folder.string()), std::string::npos);
@@ -656,7 +612,7 @@ TEST_F(BadInputTest, BadBoardFiles) {
     const fs::path board = case_dir_ / (name + ".yaml");
     WriteFile(board, text);
     const fs::path camera = case_dir_ / (name + "_camera.yaml");
-    const RunResult run =
+    const ProgramRun run =
         Run("calibrate --images " + Quote(folder.string()) + " --board " +
             Quote(board.string()) + " --model pinhole-radtan --out " +
             Quote(camera.string()));
@@ -666,7 +622,7 @@ TEST_F(BadInputTest, BadBoardFiles) {
     EXPECT_FALSE(fs::exists(camera)) << name;
   }
   const fs::path missing = case_dir_ / "no_board.yaml";
-  const RunResult run =
+  const ProgramRun run =
       Run("calibrate --images " + Quote(folder.string()) + " --board " +
           Quote(missing.string()) + " --model pinhole-radtan --out " +
           Quote((case_dir_ / "camera.yaml").string()));
@@ -677,7 +633,7 @@ TEST_F(BadInputTest, BadBoardFiles) {
 TEST_F(BadInputTest, UnknownModelName) {
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult run = Calibrate(folder, camera, "--model fisheye-magic");
+  const ProgramRun run = Calibrate(folder, camera, "--model fisheye-magic");
   EXPECT_EQ(run.exit_code, kExitUsage) << run.all();
   EXPECT_NE(run.err.find("fisheye-magic"), std::string::npos) << run.err;
   EXPECT_FALSE(fs::exists(camera));
@@ -690,7 +646,7 @@ TEST_F(BadInputTest, UnknownModelName) {
 TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const fs::path camchain = case_dir_ / "camchain.yaml";
-  const RunResult run =
+  const ProgramRun run =
       Calibrate(folder, camchain, "--format kalibr --rostopic /left/image_raw");
   ASSERT_EQ(run.exit_code, kExitOk) << run.all();
   const YAML::Node cam0 = YAML::LoadFile(camchain.string())["cam0"];
@@ -704,11 +660,12 @@ TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
   EXPECT_NEAR(intrinsics[0], 560.0, 5.0);
 
   const fs::path rational = case_dir_ / "rational.yaml";
-  const RunResult refused = Run("calibrate --images " + Quote(folder.string()) +
-                                " --board " + Quote(BoardFile().string()) +
-                                " --model pinhole-rational --format "
-                                "kalibr --verbose --out " +
-                                Quote(rational.string()));
+  const ProgramRun refused =
+      Run("calibrate --images " + Quote(folder.string()) + " --board " +
+          Quote(BoardFile().string()) +
+          " --model pinhole-rational --format "
+          "kalibr --verbose --out " +
+          Quote(rational.string()));
   EXPECT_EQ(refused.exit_code, kExitUsage) << refused.all();
   EXPECT_NE(refused.err.find("kalibr"), std::string::npos) << refused.err;
   EXPECT_EQ(refused.all().find("view0"), std::string::npos)
@@ -740,7 +697,7 @@ TEST_F(BadInputTest, WrongBoardFileNamesTheBoard) {
     const fs::path board = case_dir_ / c.name;
     WriteFile(board, c.yaml);
     const fs::path camera = case_dir_ / "camera.yaml";
-    const RunResult run =
+    const ProgramRun run =
         Run("calibrate --images " + Quote(folder.string()) + " --board " +
             Quote(board.string()) + " --out " + Quote(camera.string()) +
             " --report " + Quote((case_dir_ / "report").string()));
@@ -769,7 +726,7 @@ TEST_F(BadInputTest, ImagesOfAnotherSizeAreNamed) {
                      cv::BORDER_REPLICATE);
   WriteFile(folder / "a_wider.png", EncodeImage(wider, ".png"));
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult run = Calibrate(folder, camera);
+  const ProgramRun run = Calibrate(folder, camera);
   ASSERT_EQ(run.exit_code, kExitOk) << run.all();
   EXPECT_NE(run.err.find("a_wider.png"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("700x500 differs from the 640x480 most images have"),
@@ -790,7 +747,7 @@ TEST_F(BadInputTest, OutputsCheckedFirstAndReportReplaced) {
   fs::create_directories(report);
   WriteFile(report / "overlay_from_an_old_run.png", "old");
   WriteFile(report / "summary.md", "old summary");
-  RunResult run =
+  ProgramRun run =
       Calibrate(folder, camera, "--report " + Quote(report.string()));
   ASSERT_EQ(run.exit_code, kExitOk) << run.all();
   EXPECT_TRUE(fs::exists(camera));
@@ -867,7 +824,7 @@ TEST_F(BadInputTest, InterruptSaysSoAndLeavesNothingHalfWritten) {
 
 // The console: --version, `help SUBCOMMAND`, required flags marked, --quiet.
 TEST_F(BadInputTest, ConsoleVersionHelpAndQuiet) {
-  RunResult run = Run("--version");
+  ProgramRun run = Run("--version");
   EXPECT_EQ(run.exit_code, kExitOk) << run.all();
   EXPECT_EQ(run.out.rfind("puzzlecal ", 0), 0u) << run.out;
   run = Run("help calibrate");
@@ -934,7 +891,7 @@ TEST_F(BadInputTest, BadFlagsExitTwoAndNameTheFlag) {
             "stray"},
            {"detect --images " + images + " --out", "--out"},
        }) {
-    const RunResult run = Run(c.arguments);
+    const ProgramRun run = Run(c.arguments);
     EXPECT_EQ(run.exit_code, kExitUsage) << c.arguments << "\n" << run.all();
     EXPECT_NE(run.err.find(c.named), std::string::npos) << run.err;
     EXPECT_FALSE(fs::exists(out)) << c.arguments;
@@ -955,11 +912,11 @@ TEST_F(BadInputTest, UnwritableOutput) {
     outputs.push_back(read_only / "out.yaml");
   }
   for (const fs::path& out : outputs) {
-    const RunResult detect = Detect(folder, out);
+    const ProgramRun detect = Detect(folder, out);
     EXPECT_EQ(detect.exit_code, kExitOutputError) << out << "\n"
                                                   << detect.all();
     EXPECT_NE(detect.err.find(out.string()), std::string::npos) << detect.err;
-    const RunResult calibrate = Calibrate(folder, out);
+    const ProgramRun calibrate = Calibrate(folder, out);
     EXPECT_EQ(calibrate.exit_code, kExitOutputError) << out << "\n"
                                                      << calibrate.all();
     EXPECT_NE(calibrate.err.find(out.string()), std::string::npos)
@@ -977,7 +934,7 @@ TEST_F(BadInputTest, UnwritableOutput) {
 TEST_F(BadInputTest, TooFewViewsWritesNothing) {
   const fs::path folder = ImagesWithGoodViews("one_view", 1);
   const fs::path camera = case_dir_ / "camera.yaml";
-  const RunResult run = Calibrate(folder, camera);
+  const ProgramRun run = Calibrate(folder, camera);
   EXPECT_EQ(run.exit_code, kExitNoResult) << run.all();
   EXPECT_FALSE(fs::exists(camera));
   for (const std::string& file : FilesUnder(case_dir_)) {
@@ -986,7 +943,7 @@ TEST_F(BadInputTest, TooFewViewsWritesNothing) {
 
   // With --report the failure is still exit 4, and the report says why.
   const fs::path report = case_dir_ / "report";
-  const RunResult reported =
+  const ProgramRun reported =
       Calibrate(folder, camera, "--report " + Quote(report.string()));
   EXPECT_EQ(reported.exit_code, kExitNoResult) << reported.all();
   EXPECT_FALSE(fs::exists(camera));

@@ -29,27 +29,21 @@
 #include "calib/rig_calibration.h"
 #include "formats/rig_yaml.h"
 #include "sim/rig_scenes.h"
+#include "tests/support/files.h"
+#include "tests/support/program_run.h"
 #include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
+using testing_files::ReadFile;
+using testing_program::ProgramPath;
+using testing_program::ProgramRun;
 
 constexpr double kMaxRotationErrorDeg = 0.005;
 constexpr double kMaxTranslationErrorOfBaseline = 0.001;
 constexpr double kMaxFocalRelativeError = 0.0005;
-
-fs::path ProgramPath() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  return self.parent_path().parent_path() / "apps" / "puzzlecal";
-}
-
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
 
 // A folder of this test process's own: ctest runs the test cases as
 // separate processes at the same time.
@@ -58,18 +52,8 @@ fs::path ScratchRoot() {
          ("puzzlecal_rig_test_" + std::to_string(getpid()));
 }
 
-RunResult RunProgram(const std::string& arguments) {
-  fs::create_directories(ScratchRoot());
-  const fs::path log = ScratchRoot() / "run.log";
-  const std::string command =
-      ProgramPath().string() + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  RunResult result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(log);
-  result.output.assign(std::istreambuf_iterator<char>(in),
-                       std::istreambuf_iterator<char>());
-  return result;
+ProgramRun RunProgram(const std::string& arguments) {
+  return testing_program::RunProgram(arguments, ScratchRoot());
 }
 
 std::string WriteBoardFile(const Board& board, const fs::path& dir) {
@@ -132,12 +116,6 @@ void ExpectMatchesTruth(const RigSceneSpec& scene,
   }
 }
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in),
-                     std::istreambuf_iterator<char>());
-}
-
 // The line of the program's output that starts with `prefix` ("" if none).
 std::string OutputLine(const std::string& output, const std::string& prefix) {
   std::istringstream lines(output);
@@ -155,7 +133,7 @@ void ExpectReportJudgesEachCamera(const RigSceneSpec& scene,
                                   const std::string& output,
                                   const YAML::Node& rig_file,
                                   const fs::path& report) {
-  const std::string summary = ReadText(report / "summary.md");
+  const std::string summary = ReadFile(report / "summary.md");
   ASSERT_FALSE(summary.empty()) << "no " << (report / "summary.md");
   const size_t first_section = summary.find("\n## ");
   for (size_t c = 0; c < scene.cameras.size(); ++c) {
@@ -207,21 +185,21 @@ TEST(CalibrateRigTest, FisheyeAndPinholeRendersMeetTheFigures) {
   EXPECT_GT(rig.summary.frames_seen_by_one_camera, 0);
   const fs::path out = rig.root / "rig.yaml";
   const fs::path report = rig.root / "report";
-  const RunResult run = RunProgram(
+  const ProgramRun run = RunProgram(
       "calibrate-rig --images " + rig.images.string() + " --board " +
       rig.board + " --model kannala-brandt,pinhole-radtan --out " +
       out.string() + " --report " + report.string() + " --threads 2");
-  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
   std::vector<RigFileCamera> cameras;
   std::string error;
   ASSERT_TRUE(ReadRigFile(out.string(), &cameras, &error)) << error;
   ExpectMatchesTruth(rig.scene, cameras);
-  ExpectReportJudgesEachCamera(rig.scene, run.output, YAML::LoadFile(out),
+  ExpectReportJudgesEachCamera(rig.scene, run.all(), YAML::LoadFile(out),
                                report);
   const cv::Mat pair = cv::imread((report / "rectified_pair.png").string());
   EXPECT_EQ(pair.cols, 2 * 1280);
   EXPECT_EQ(pair.rows, 960);
-  std::cout << run.output;
+  std::cout << run.all();
 }
 
 // One camera of a rectification file as a user reads it: K, D, R, P.
@@ -348,17 +326,17 @@ TEST(CalibrateRigTest, FisheyePairFilesRectifyTheirOwnCorners) {
     SCOPED_TRACE(format);
     const fs::path out = rig.root / (std::string(format) + ".yaml");
     const fs::path report = rig.root / (std::string(format) + "_report");
-    const RunResult run = RunProgram(
+    const ProgramRun run = RunProgram(
         "calibrate-rig --images " + rig.images.string() + " --board " +
         rig.board + " --model kannala-brandt --format " + format + " --out " +
         out.string() + " --threads 2" +
         (std::string(format) == "opencv" ? " --report " + report.string()
                                          : std::string()));
-    ASSERT_EQ(run.exit_code, kExitOk) << run.output;
-    std::cout << run.output;
-    EXPECT_NE(run.output.find("rectification: a pinhole target"),
+    ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+    std::cout << run.all();
+    EXPECT_NE(run.all().find("rectification: a pinhole target"),
               std::string::npos)
-        << run.output;
+        << run.all();
     if (std::string(format) == "opencv") {
       cv::FileStorage storage(out.string(), cv::FileStorage::READ);
       ASSERT_TRUE(storage.isOpened());
@@ -389,17 +367,17 @@ TEST(CalibrateRigTest, UnsynchronisedFramesAreNamedByFile) {
   const RenderedRig rig = Render(scene, "unsynchronised");
   const fs::path out = rig.root / "rig.yaml";
   const fs::path report = rig.root / "report";
-  const RunResult run =
+  const ProgramRun run =
       RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
                  rig.board + " --model pinhole-radtan --out " + out.string() +
                  " --report " + report.string() + " --threads 2");
-  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
-  const std::string verdict = OutputLine(run.output, "rig: verdict: ");
-  EXPECT_EQ(verdict.rfind("rig: verdict: moved-frames", 0), 0u) << run.output;
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  const std::string verdict = OutputLine(run.all(), "rig: verdict: ");
+  EXPECT_EQ(verdict.rfind("rig: verdict: moved-frames", 0), 0u) << run.all();
   const YAML::Node file = YAML::LoadFile(out.string());
   EXPECT_EQ(file["verdict"]["kind"].as<std::string>(), "moved-frames");
   ASSERT_EQ(file["frames"].size(), static_cast<size_t>(rig.summary.num_frames));
-  const std::string summary = ReadText(report / "summary.md");
+  const std::string summary = ReadFile(report / "summary.md");
   for (int f = 0; f < rig.summary.num_frames; ++f) {
     const bool moved = f == 2 || f == 6 || f == 11;
     const YAML::Node frame = file["frames"][f];
@@ -419,11 +397,11 @@ TEST(CalibrateRigTest, UnsynchronisedFramesAreNamedByFile) {
 TEST(CalibrateRigTest, StereoPinholeRendersInOpenCvFormat) {
   const RenderedRig rig = Render(StereoPinholeRig(), "stereo");
   const fs::path out = rig.root / "stereo.yaml";
-  const RunResult run =
+  const ProgramRun run =
       RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
                  rig.board + " --model pinhole-radtan --format opencv --out " +
                  out.string() + " --threads 2");
-  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
   cv::FileStorage storage(out.string(), cv::FileStorage::READ);
   ASSERT_TRUE(storage.isOpened());
   cv::Mat r, t, k2;
@@ -461,11 +439,11 @@ TEST(CalibrateRigTest, StereoPinholeRendersInOpenCvFormat) {
 TEST(CalibrateRigTest, KalibrFormatHoldsK3AtZeroAndRefusesRationalAtOnce) {
   const RenderedRig rig = Render(StereoPinholeRig(), "kalibr");
   const fs::path out = rig.root / "camchain.yaml";
-  const RunResult run =
+  const ProgramRun run =
       RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
                  rig.board + " --model pinhole-radtan --format kalibr --out " +
                  out.string() + " --threads 2");
-  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
   const YAML::Node chain = YAML::LoadFile(out.string());
   for (const char* cam : {"cam0", "cam1"}) {
     ASSERT_TRUE(chain[cam]) << cam;
@@ -476,13 +454,12 @@ TEST(CalibrateRigTest, KalibrFormatHoldsK3AtZeroAndRefusesRationalAtOnce) {
   EXPECT_TRUE(chain["cam1"]["T_cn_cnm1"]);
 
   const fs::path refused = rig.root / "rational.yaml";
-  const RunResult rational = RunProgram(
+  const ProgramRun rational = RunProgram(
       "calibrate-rig --images " + rig.images.string() + " --board " +
       rig.board + " --model pinhole-rational --format kalibr --out " +
       refused.string());
-  EXPECT_EQ(rational.exit_code, kExitUsage) << rational.output;
-  EXPECT_NE(rational.output.find("kalibr"), std::string::npos)
-      << rational.output;
+  EXPECT_EQ(rational.exit_code, kExitUsage) << rational.all();
+  EXPECT_NE(rational.all().find("kalibr"), std::string::npos) << rational.all();
   EXPECT_FALSE(fs::exists(refused));
 }
 
@@ -494,17 +471,17 @@ TEST(CalibrateRigTest, CameraThatNeverSharesAFrameIsNamedAndNothingWritten) {
                RigFrameFileName(f));
   }
   const fs::path out = rig.root / "rig.yaml";
-  const RunResult run =
+  const ProgramRun run =
       RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
                  rig.board + " --model pinhole-radtan --out " + out.string());
   // No file name is in both folders: refused before any image is read,
   // with the rule and both ways out.
-  EXPECT_EQ(run.exit_code, kExitBadInput) << run.output;
-  EXPECT_NE(run.output.find("'cam0' shares no frame with another camera"),
+  EXPECT_EQ(run.exit_code, kExitBadInput) << run.all();
+  EXPECT_NE(run.all().find("'cam0' shares no frame with another camera"),
             std::string::npos)
-      << run.output;
-  EXPECT_NE(run.output.find("see the board together"), std::string::npos)
-      << run.output;
+      << run.all();
+  EXPECT_NE(run.all().find("see the board together"), std::string::npos)
+      << run.all();
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -530,14 +507,14 @@ TEST(CalibrateRigTest, DifferentNamesAreRefusedWithTheRuleAndPairedByOrder) {
   const std::string arguments = "calibrate-rig --images " +
                                 rig.images.string() + " --board " + rig.board +
                                 " --out " + out.string() + " --threads 2";
-  const RunResult refused = RunProgram(arguments + " --model pinhole-radtan");
-  EXPECT_EQ(refused.exit_code, kExitBadInput) << refused.output;
-  EXPECT_NE(refused.output.find("matched by file name"), std::string::npos)
-      << refused.output;
-  EXPECT_NE(refused.output.find("--match_by_order"), std::string::npos)
-      << refused.output;
-  EXPECT_NE(refused.output.find("left_frame_000.png"), std::string::npos)
-      << refused.output;
+  const ProgramRun refused = RunProgram(arguments + " --model pinhole-radtan");
+  EXPECT_EQ(refused.exit_code, kExitBadInput) << refused.all();
+  EXPECT_NE(refused.all().find("matched by file name"), std::string::npos)
+      << refused.all();
+  EXPECT_NE(refused.all().find("--match_by_order"), std::string::npos)
+      << refused.all();
+  EXPECT_NE(refused.all().find("left_frame_000.png"), std::string::npos)
+      << refused.all();
   EXPECT_FALSE(fs::exists(out));
   // Every camera sees every frame of this rig only where the board is in
   // both views: drop the images one camera lacks so that the order pairs.
@@ -558,14 +535,14 @@ TEST(CalibrateRigTest, DifferentNamesAreRefusedWithTheRuleAndPairedByOrder) {
       fs::remove(rig.images / "cam1" / ("right_" + name));
     }
   }
-  const RunResult paired =
+  const ProgramRun paired =
       RunProgram(arguments + " --model pinhole-radtan --match_by_order");
-  ASSERT_EQ(paired.exit_code, kExitOk) << paired.output;
+  ASSERT_EQ(paired.exit_code, kExitOk) << paired.all();
   EXPECT_NE(
-      paired.output.find("shared frames: 0-1: " +
-                         std::to_string(std::min(left.size(), right.size()))),
+      paired.all().find("shared frames: 0-1: " +
+                        std::to_string(std::min(left.size(), right.size()))),
       std::string::npos)
-      << paired.output;
+      << paired.all();
   std::vector<RigFileCamera> cameras;
   std::string error;
   ASSERT_TRUE(ReadRigFile(out.string(), &cameras, &error)) << error;
@@ -580,15 +557,15 @@ TEST(CalibrateRigTest, DifferentNamesAreRefusedWithTheRuleAndPairedByOrder) {
   // 70 deg pinhole: auto gives it a pinhole model (a kannala-brandt start
   // in a false basin once made it skip them all, then call the rig a
   // model error).
-  const RunResult chosen =
+  const ProgramRun chosen =
       RunProgram(arguments + " --model auto,pinhole-radtan --match_by_order");
-  ASSERT_EQ(chosen.exit_code, kExitOk) << chosen.output;
-  EXPECT_NE(chosen.output.find("camera 'cam0': --model auto chose pinhole-"),
+  ASSERT_EQ(chosen.exit_code, kExitOk) << chosen.all();
+  EXPECT_NE(chosen.all().find("camera 'cam0': --model auto chose pinhole-"),
             std::string::npos)
-      << chosen.output;
-  EXPECT_NE(chosen.output.find("rig: verdict: good"), std::string::npos)
-      << chosen.output;
-  std::cout << OutputLine(chosen.output, "camera 'cam0': --model auto") << "\n";
+      << chosen.all();
+  EXPECT_NE(chosen.all().find("rig: verdict: good"), std::string::npos)
+      << chosen.all();
+  std::cout << OutputLine(chosen.all(), "camera 'cam0': --model auto") << "\n";
 }
 
 // Outputs are checked before the work; the rig file is written first and
@@ -603,21 +580,20 @@ TEST(CalibrateRigTest, OutputsAreCheckedFirstAndWrittenWhole) {
                                 out.string() + " --threads 2";
   const fs::path a_file = rig.root / "afile";
   std::ofstream(a_file) << "x";
-  RunResult run = RunProgram(arguments + " --report " + a_file.string());
-  EXPECT_EQ(run.exit_code, kExitOutputError) << run.output;
-  EXPECT_NE(run.output.find("is a file, not a folder"), std::string::npos)
-      << run.output;
-  EXPECT_EQ(run.output.find("images usable"), std::string::npos)
+  ProgramRun run = RunProgram(arguments + " --report " + a_file.string());
+  EXPECT_EQ(run.exit_code, kExitOutputError) << run.all();
+  EXPECT_NE(run.all().find("is a file, not a folder"), std::string::npos)
+      << run.all();
+  EXPECT_EQ(run.all().find("images usable"), std::string::npos)
       << "the work started:\n"
-      << run.output;
+      << run.all();
   EXPECT_FALSE(fs::exists(out));
   const fs::path other = rig.root / "other";
   fs::create_directories(other);
   std::ofstream(other / "notes.txt") << "mine";
   run = RunProgram(arguments + " --report " + other.string());
-  EXPECT_EQ(run.exit_code, kExitOutputError) << run.output;
-  EXPECT_NE(run.output.find("holds notes.txt"), std::string::npos)
-      << run.output;
+  EXPECT_EQ(run.exit_code, kExitOutputError) << run.all();
+  EXPECT_NE(run.all().find("holds notes.txt"), std::string::npos) << run.all();
   EXPECT_TRUE(fs::exists(other / "notes.txt"));
   EXPECT_FALSE(fs::exists(out));
 
@@ -625,8 +601,8 @@ TEST(CalibrateRigTest, OutputsAreCheckedFirstAndWrittenWhole) {
   fs::create_directories(report);
   std::ofstream(report / "old_chart.png") << "old";
   run = RunProgram(arguments + " --report " + report.string() + " --quiet");
-  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
-  std::istringstream lines(run.output);
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  std::istringstream lines(run.all());
   for (std::string line; std::getline(lines, line);) {
     EXPECT_EQ(line.rfind("wrote ", 0), 0u) << "--quiet printed: " << line;
   }
@@ -642,13 +618,12 @@ TEST(CalibrateRigTest, OutputsAreCheckedFirstAndWrittenWhole) {
   // Ctrl-C while the images are read.
   fs::remove(out);
   const fs::path log = ScratchRoot() / "interrupt.log";
-  const std::string command = ProgramPath().string() + " " + arguments +
-                              " --report " + report.string() + " > " +
-                              log.string() + " 2>&1 & p=$!; sleep 0.2; " +
-                              "kill -INT $p; wait $p; echo exit=$? >> " +
-                              log.string();
+  const std::string command =
+      ProgramPath().string() + " " + arguments + " --report " +
+      report.string() + " > " + log.string() + " 2>&1 & p=$!; sleep 0.2; " +
+      "kill -INT $p; wait $p; echo exit=$? >> " + log.string();
   ASSERT_EQ(std::system(command.c_str()), 0);
-  const std::string interrupted = ReadText(log);
+  const std::string interrupted = ReadFile(log);
   if (interrupted.find("exit=130") != std::string::npos) {
     EXPECT_NE(interrupted.find("interrupted; nothing written"),
               std::string::npos)
@@ -666,18 +641,18 @@ TEST(CalibrateRigTest, WrongNumberOfModelsIsAUsageError) {
   fs::create_directories(root / "c");
   const RigSceneSpec scene = StereoPinholeRig();
   const std::string board = WriteBoardFile(scene.board, root);
-  const RunResult run =
+  const ProgramRun run =
       RunProgram("calibrate-rig --images " + root.string() + " --board " +
                  board + " --model pinhole-radtan,kannala-brandt --out " +
                  (root / "rig.yaml").string());
-  EXPECT_EQ(run.exit_code, kExitUsage) << run.output;
-  EXPECT_NE(run.output.find("2 models for 3 cameras"), std::string::npos)
-      << run.output;
-  const RunResult one = RunProgram(
+  EXPECT_EQ(run.exit_code, kExitUsage) << run.all();
+  EXPECT_NE(run.all().find("2 models for 3 cameras"), std::string::npos)
+      << run.all();
+  const ProgramRun one = RunProgram(
       "calibrate-rig --images " + (root / "a").string() + " --board " + board +
       " --model pinhole-radtan --out " + (root / "rig.yaml").string());
-  EXPECT_EQ(one.exit_code, kExitBadInput) << one.output;
-  EXPECT_NE(one.output.find("at least two"), std::string::npos) << one.output;
+  EXPECT_EQ(one.exit_code, kExitBadInput) << one.all();
+  EXPECT_NE(one.all().find("at least two"), std::string::npos) << one.all();
 }
 
 }  // namespace

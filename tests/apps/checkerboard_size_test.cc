@@ -20,42 +20,15 @@
 #include "camera/camera_models.h"
 #include "sim/render.h"
 #include "target/board.h"
+#include "tests/support/program_run.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path ProgramPath() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path()
-            : self.parent_path().parent_path() / "apps" / "puzzlecal";
-}
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)),
-                     std::istreambuf_iterator<char>());
-}
-
-struct ProgramRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-ProgramRun RunProgram(const fs::path& dir, const std::string& arguments) {
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command = ProgramPath().string() + " " + arguments + " >" +
-                              out.string() + " 2>" + err.string() +
-                              " </dev/null";
-  const int status = std::system(command.c_str());
-  ProgramRun run;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = ReadFile(out);
-  run.err = ReadFile(err);
-  return run;
-}
+using testing_program::ProgramPath;
+using testing_program::ProgramRun;
+using testing_program::RunProgram;
 
 TEST(CheckerboardSize, WrongSizeFileIsRefusedNamingBothSizes) {
   const fs::path program = ProgramPath();
@@ -115,8 +88,9 @@ TEST(CheckerboardSize, WrongSizeFileIsRefusedNamingBothSizes) {
     std::ofstream(dir / c.file) << c.yaml;
     const fs::path camera_file = dir / "camera.yaml";
     const ProgramRun run = RunProgram(
-        dir, "calibrate --images " + (dir / "images").string() + " --board " +
-                 (dir / c.file).string() + " --out " + camera_file.string());
+        "calibrate --images " + (dir / "images").string() + " --board " +
+            (dir / c.file).string() + " --out " + camera_file.string(),
+        dir);
     EXPECT_EQ(run.exit_code, kExitBadInput) << run.out << run.err;
     EXPECT_NE(
         run.err.find((dir / c.file).string() + " gives a checkerboard of " +
@@ -132,9 +106,10 @@ TEST(CheckerboardSize, WrongSizeFileIsRefusedNamingBothSizes) {
   std::ofstream(dir / "right.yaml")
       << "type: checkerboard\ncols: 6\nrows: 4\ntile_size_m: 0.03\n";
   const ProgramRun right =
-      RunProgram(dir, "calibrate --images " + (dir / "images").string() +
-                          " --board " + (dir / "right.yaml").string() +
-                          " --out " + (dir / "camera.yaml").string());
+      RunProgram("calibrate --images " + (dir / "images").string() +
+                     " --board " + (dir / "right.yaml").string() + " --out " +
+                     (dir / "camera.yaml").string(),
+                 dir);
   EXPECT_EQ(right.exit_code, kExitOk) << right.out << right.err;
   EXPECT_TRUE(fs::exists(dir / "camera.yaml"));
   EXPECT_EQ(written, 10);

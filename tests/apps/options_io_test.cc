@@ -17,22 +17,17 @@
 #include <string>
 
 #include "apps/subcommand.h"
+#include "tests/support/program_run.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)),
-                     std::istreambuf_iterator<char>());
-}
-
-void WriteFile(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-}
+using testing_files::ReadFile;
+using testing_files::WriteFile;
+using testing_program::ProgramPath;
+using testing_program::ProgramRun;
+using testing_program::RunProgram;
 
 class OptionsIoTest : public ::testing::Test {
  protected:
@@ -212,37 +207,13 @@ TEST_F(OptionsIoTest, BadFilesAreRefusedNamingTheFileAndTheField) {
 
 // ---- the program ----
 
-fs::path ProgramPath() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  // Tests live in <build>/tests/, the program in <build>/apps/.
-  return self.parent_path().parent_path() / "apps" / "puzzlecal";
-}
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
 class OptionsProgramTest : public OptionsIoTest {
  protected:
-  RunResult Run(const std::string& arguments) const {
-    const fs::path program = ProgramPath();
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = "'" + program.string() + "' " + arguments +
-                                " >'" + out.string() + "' 2>'" + err.string() +
-                                "' </dev/null";
-    const int status = std::system(command.c_str());
-    RunResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = ReadFile(out);
-    result.err = ReadFile(err);
-    return result;
+  ProgramRun Run(const std::string& arguments) const {
+    return RunProgram(arguments, dir_);
   }
 
-  // `puzzlecal calibrate` on the sample views into OUT, with `extra` flags.
-  RunResult Calibrate(const fs::path& out, const std::string& extra) const {
+  ProgramRun Calibrate(const fs::path& out, const std::string& extra) const {
     return Run(
         "calibrate --images testdata/sample --board "
         "configs/boards/puzzleboard_23x16_30mm.yaml --threads 2 --out '" +
@@ -258,10 +229,10 @@ class OptionsProgramTest : public OptionsIoTest {
 
 TEST_F(OptionsProgramTest, PrintsTheDefaultsAsAnOptionsFile) {
   ASSERT_TRUE(fs::exists(ProgramPath())) << ProgramPath();
-  const RunResult run = Run("options");
+  const ProgramRun run = Run("options");
   EXPECT_EQ(run.exit_code, kExitOk) << run.err;
   EXPECT_EQ(run.out, OptionsYaml(RunOptions()));
-  const RunResult bad =
+  const ProgramRun bad =
       Run("options --options '" + File("bad.yaml", "verdict: {x: 1}\n") + "'");
   EXPECT_EQ(bad.exit_code, kExitBadInput);
   EXPECT_NE(bad.err.find("'verdict.x'"), std::string::npos) << bad.err;
@@ -270,7 +241,7 @@ TEST_F(OptionsProgramTest, PrintsTheDefaultsAsAnOptionsFile) {
 TEST_F(OptionsProgramTest, CalibrateRunsWithTheFilesOptions) {
   ASSERT_TRUE(fs::exists(ProgramPath())) << ProgramPath();
   const fs::path plain = dir_ / "plain.yaml";
-  const RunResult base = Calibrate(plain, "");
+  const ProgramRun base = Calibrate(plain, "");
   ASSERT_EQ(base.exit_code, kExitOk) << base.err;
   const std::string plain_camera = ReadFile(plain);
   // The sample set has a few rejected corners with the default outlier_k.
@@ -279,7 +250,7 @@ TEST_F(OptionsProgramTest, CalibrateRunsWithTheFilesOptions) {
   // A file of the defaults: the same camera file, byte for byte.
   const std::string defaults = File("defaults.yaml", OptionsYaml(RunOptions()));
   const fs::path same = dir_ / "same.yaml";
-  const RunResult with_defaults =
+  const ProgramRun with_defaults =
       Calibrate(same, "--options '" + defaults + "'");
   ASSERT_EQ(with_defaults.exit_code, kExitOk) << with_defaults.err;
   EXPECT_EQ(ReadFile(same), plain_camera);
@@ -288,7 +259,7 @@ TEST_F(OptionsProgramTest, CalibrateRunsWithTheFilesOptions) {
   const std::string no_rejection =
       File("no_rejection.yaml", "calibration: {outlier_k: 0}\n");
   const fs::path changed = dir_ / "changed.yaml";
-  const RunResult without = Calibrate(changed, "--options " + no_rejection);
+  const ProgramRun without = Calibrate(changed, "--options " + no_rejection);
   ASSERT_EQ(without.exit_code, kExitOk) << without.err;
   const std::string changed_camera = ReadFile(changed);
   EXPECT_EQ(Outliers(changed_camera), 0) << changed_camera;
@@ -297,7 +268,7 @@ TEST_F(OptionsProgramTest, CalibrateRunsWithTheFilesOptions) {
   // A bad file: exit 3 before any image is read, nothing written.
   const fs::path none = dir_ / "none.yaml";
   const std::string bad = File("bad.yaml", "calibration: {outlier_k: -1}\n");
-  const RunResult refused = Calibrate(none, "--options " + bad);
+  const ProgramRun refused = Calibrate(none, "--options " + bad);
   EXPECT_EQ(refused.exit_code, kExitBadInput);
   EXPECT_NE(refused.err.find(bad), std::string::npos) << refused.err;
   EXPECT_NE(refused.err.find("outlier_k"), std::string::npos) << refused.err;
@@ -315,8 +286,8 @@ TEST_F(OptionsProgramTest, DetectRunsWithTheFilesOptions) {
   const std::string strict =
       File("strict.yaml", "detector: {min_response: 1000}\n");
   const fs::path none = dir_ / "none.yaml";
-  const RunResult run = Run("detect --images " + image + " --out '" +
-                            none.string() + "' --options " + strict);
+  const ProgramRun run = Run("detect --images " + image + " --out '" +
+                             none.string() + "' --options " + strict);
   ASSERT_EQ(run.exit_code, kExitOk) << run.err;
   EXPECT_NE(ReadFile(plain).find("corners:\n      - ["), std::string::npos);
   EXPECT_NE(ReadFile(none).find("corners:\n      []"), std::string::npos)

@@ -28,9 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// $PUZZLECAL_DATA/real, else ../shared/real; "" when neither is a folder.
-std::string RealFolder() { return testing_data::SharedFolder("real"); }
-
 struct RealSet {
   std::string name;
   std::string images;  // folder
@@ -40,7 +37,7 @@ struct RealSet {
 
 std::vector<RealSet> RealSets() {
   std::vector<RealSet> sets;
-  const std::string real = RealFolder();
+  const std::string real = testing_data::SharedFolder("real");
   if (!real.empty()) {
     sets.push_back(
         {"sony", real + "/sony/images", real + "/sony/board.yaml", true});

@@ -15,6 +15,7 @@
 #include "formats/camera_yaml.h"
 #include "sim/synthetic_views.h"
 #include "tests/calib/opencv_reference.h"
+#include "tests/calib/scenes.h"
 
 namespace puzzlecal {
 namespace {
@@ -61,20 +62,6 @@ SyntheticScene PinholeScene(const Camera& camera) {
   return scene;
 }
 
-SyntheticScene FisheyeScene() {
-  SyntheticScene scene;
-  scene.camera = sim::TruthFisheye190();
-  scene.num_views = 20;
-  scene.max_direction_deg = 85;
-  scene.max_corner_angle_deg = 95;
-  scene.min_visible_fraction = 0.3;
-  scene.min_tilt_deg = 0;
-  scene.max_tilt_deg = 60;
-  scene.min_distance = 0.8;
-  scene.max_distance = 1.6;
-  return scene;
-}
-
 bool RunCalibration(const SyntheticData& data, const SyntheticScene& scene,
                     const CalibrationOptions& options,
                     CalibrationResult* result, std::string* error) {
@@ -91,7 +78,7 @@ SyntheticScene SceneFor(int index) {
     case 1:
       return PinholeScene(sim::TruthRational());
     default:
-      return FisheyeScene();
+      return testing_scenes::Fisheye190Scene(20);
   }
 }
 
@@ -175,7 +162,7 @@ TEST_P(AccuracyTest, AgreesWithOpenCvWhereOpenCvConverges) {
 // fisheye model cannot represent rays beyond 90 degrees and starts from
 // f = max(w, h) / pi; puzzlecal must still reach the truth.
 TEST(CalibrateTest, FisheyeBeyondNinetyDegreesWhereOpenCvFails) {
-  const SyntheticScene scene = FisheyeScene();
+  const SyntheticScene scene = testing_scenes::Fisheye190Scene(20);
   const SyntheticData data = MakeSyntheticData(scene);
   int beyond_90 = 0;
   for (size_t v = 0; v < data.views.size(); ++v) {

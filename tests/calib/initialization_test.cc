@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim/synthetic_views.h"
+#include "tests/calib/scenes.h"
 #include "util/statistics.h"
 
 namespace puzzlecal {
@@ -34,20 +35,6 @@ SyntheticScene WideAngleScene() {
   scene.max_distance = 1.2;
   scene.min_visible_fraction = 0.4;
   scene.noise_px = 0.05;
-  return scene;
-}
-
-SyntheticScene FisheyeScene() {
-  SyntheticScene scene;
-  scene.camera = sim::TruthFisheye190();
-  scene.num_views = 30;
-  scene.max_direction_deg = 85;
-  scene.max_corner_angle_deg = 95;
-  scene.min_visible_fraction = 0.3;
-  scene.min_tilt_deg = 0;
-  scene.max_tilt_deg = 60;
-  scene.min_distance = 0.8;
-  scene.max_distance = 1.6;
   return scene;
 }
 
@@ -114,7 +101,7 @@ TEST(InitializationTest, RefinedStartOfWideAngleLensIsCloseToTruth) {
 }
 
 TEST(InitializationTest, RefinedStartOfFisheyeIsCloseToTruth) {
-  const SyntheticScene scene = FisheyeScene();
+  const SyntheticScene scene = testing_scenes::Fisheye190Scene(30);
   const SyntheticData data = MakeSyntheticData(scene);
   const InitializationResult result =
       Initialise(data, scene.camera, InitializationOptions());
@@ -129,7 +116,7 @@ TEST(InitializationTest, RefinedStartOfFisheyeIsCloseToTruth) {
 // outliers, that finds the focal length of the scan over every view (to
 // the bracket the golden section leaves), close to the truth's.
 TEST(InitializationTest, FocalScanOnASubsetFindsTheFullScansFocalLength) {
-  SyntheticScene scene = FisheyeScene();
+  SyntheticScene scene = testing_scenes::Fisheye190Scene(30);
   scene.num_views = 40;
   scene.outlier_fraction = 0.05;
   const SyntheticData data = MakeSyntheticData(scene);
@@ -154,7 +141,7 @@ TEST(InitializationTest, FocalScanOnASubsetFindsTheFullScansFocalLength) {
 // lenses (focal lengths f and 1.6 f): the spread subset holds mostly the
 // first lens's views, all views mostly the second's.
 TEST(InitializationTest, FocalScanCandidatesAreScoredOnAllViews) {
-  SyntheticScene scene = FisheyeScene();
+  SyntheticScene scene = testing_scenes::Fisheye190Scene(30);
   scene.num_views = 40;
   const SyntheticData first = MakeSyntheticData(scene);
   SyntheticScene longer = scene;

@@ -22,14 +22,14 @@ namespace {
 // a printed board reach 0.05-0.1 px.
 constexpr double kNoisePx = 0.06;
 
-struct Judged {
+struct JudgedRig {
   RigCalibrationResult result;
   RigEvidence evidence;
   RigVerdict verdict;
 };
 
-Judged Judge(const RigSceneSpec& scene, uint64_t noise_seed) {
-  Judged judged;
+JudgedRig JudgeRig(const RigSceneSpec& scene, uint64_t noise_seed) {
+  JudgedRig judged;
   const std::vector<RigCameraInput> inputs =
       RigCorrespondences(scene, kNoisePx, noise_seed);
   std::string error;
@@ -54,7 +54,7 @@ TEST(RigEvidenceTest, NoCleanFrameIsNamedInTwentyCleanScenes) {
   int named = 0, frames = 0;
   double worst_ratio = 0;
   for (int s = 0; s < 20; ++s) {
-    const Judged judged = Judge(Scene(s % 2, 100 + s), 7 + s);
+    const JudgedRig judged = JudgeRig(Scene(s % 2, 100 + s), 7 + s);
     named += static_cast<int>(judged.evidence.moved_frames.size());
     for (const RigFrameEvidence& frame : judged.evidence.frames) {
       if (!frame.compared) continue;
@@ -77,7 +77,7 @@ TEST(RigEvidenceTest, FramesMovedByMoreThanTwoMillimetresAreNamed) {
     scene.moved_frames = {1, 5, 9, 13};
     scene.moved_by_m = 0.001 * (2.2 + 0.5 * (s % 6));  // 2.2 .. 4.7 mm
     scene.moved_seed = 300 + s;
-    const Judged judged = Judge(scene, 11 + s);
+    const JudgedRig judged = JudgeRig(scene, 11 + s);
     EXPECT_EQ(judged.verdict.kind, "moved-frames") << judged.verdict.Line();
     for (size_t f = 0; f < judged.evidence.frames.size(); ++f) {
       const RigFrameEvidence& frame = judged.evidence.frames[f];

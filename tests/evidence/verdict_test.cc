@@ -9,6 +9,7 @@
 #include "calib/calibrate.h"
 #include "evidence/evidence.h"
 #include "sim/synthetic_views.h"
+#include "tests/evidence/judge.h"
 
 namespace puzzlecal {
 namespace {
@@ -16,40 +17,9 @@ namespace {
 using sim::MakeSyntheticData;
 using sim::SyntheticData;
 using sim::SyntheticScene;
-
-struct Judged {
-  bool calibrated = false;
-  std::string error;
-  CalibrationResult result;
-  Evidence evidence;
-  Verdict verdict;
-};
-
-Judged Judge(const std::vector<CalibrationView>& views, CameraModelId model,
-             int width, int height,
-             CalibrationOptions options = CalibrationOptions()) {
-  Judged judged;
-  judged.calibrated = Calibrate(views, model, width, height, options,
-                                &judged.result, &judged.error);
-  if (!judged.calibrated) return judged;
-  const EvidenceOptions evidence_options;
-  judged.evidence =
-      ComputeEvidence(views, judged.result, options, evidence_options);
-  judged.verdict = MakeVerdict(judged.result, judged.evidence, evidence_options,
-                               VerdictOptions());
-  return judged;
-}
-
-SyntheticScene Scene(const Camera& camera, int num_views, unsigned seed) {
-  SyntheticScene scene;
-  scene.camera = camera;
-  scene.num_views = num_views;
-  scene.noise_px = 0.2;
-  scene.seed = seed;
-  scene.max_direction_deg = 40;
-  scene.min_visible_fraction = 0.6;
-  return scene;
-}
+using testing_judge::Judge;
+using testing_judge::Judged;
+using testing_judge::TiltedScene;
 
 TEST(VerdictOptions, CheckRejectsBadValues) {
   VerdictOptions options;
@@ -98,7 +68,8 @@ TEST(NextModel, NamesTheModelToTry) {
 TEST(Verdict, CleanScenesAreGood) {
   for (const Camera& truth :
        {sim::TruthRadtan(), sim::TruthRational(), sim::TruthFisheye190()}) {
-    const SyntheticData data = MakeSyntheticData(Scene(truth, 24, 3));
+    const SyntheticData data =
+        MakeSyntheticData(TiltedScene(truth, 24, 0.2, 3));
     const Judged judged =
         Judge(data.views, truth.model, truth.width, truth.height);
     ASSERT_TRUE(judged.calibrated) << judged.error;
@@ -112,7 +83,7 @@ TEST(Verdict, CleanScenesAreGood) {
 // axis): model-error, and the next step is kannala-brandt.
 TEST(Verdict, PinholeOnFisheyeIsModelErrorNamingKannalaBrandt) {
   const Camera truth = sim::TruthFisheye190();
-  SyntheticScene scene = Scene(truth, 24, 5);
+  SyntheticScene scene = TiltedScene(truth, 24, 0.2, 5);
   scene.max_corner_angle_deg = 80;
   scene.max_direction_deg = 60;
   scene.min_visible_fraction = 0.4;
@@ -150,7 +121,7 @@ bool ProjectNoncentral(const Camera& camera, double e1,
 // and the next step is kannala-brandt-noncentral.
 TEST(Verdict, CentralModelOnNoncentralLensNamesNoncentral) {
   const Camera truth = sim::TruthFisheye190();
-  SyntheticScene scene = Scene(truth, 40, 19);
+  SyntheticScene scene = TiltedScene(truth, 40, 0.2, 19);
   scene.noise_px = 0.1;
   scene.max_corner_angle_deg = 85;
   scene.max_direction_deg = 60;
@@ -234,7 +205,7 @@ TEST(Verdict, CentralModelOnNoncentralLensNamesNoncentral) {
 Judged HandMadeHalves(const std::vector<double>& ratio, double chi2 = 0,
                       int dof = 0) {
   const Camera truth = sim::TruthFisheye190();
-  const SyntheticData data = MakeSyntheticData(Scene(truth, 24, 3));
+  const SyntheticData data = MakeSyntheticData(TiltedScene(truth, 24, 0.2, 3));
   Judged judged = Judge(data.views, truth.model, truth.width, truth.height);
   CrossValidation& cv = judged.evidence.cross_validation;
   cv.ok = true;
@@ -310,7 +281,7 @@ TEST(Verdict, HalvesBandExcessNeedsSignificantIntrinsics) {
 // Four views: the halves cannot be calibrated alone and the views are few.
 TEST(Verdict, TooFewViewsIsInsufficientData) {
   const Camera truth = sim::TruthRadtan();
-  const SyntheticData data = MakeSyntheticData(Scene(truth, 4, 7));
+  const SyntheticData data = MakeSyntheticData(TiltedScene(truth, 4, 0.2, 7));
   const Judged judged =
       Judge(data.views, truth.model, truth.width, truth.height);
   ASSERT_TRUE(judged.calibrated) << judged.error;
@@ -322,7 +293,7 @@ TEST(Verdict, TooFewViewsIsInsufficientData) {
 // Gross outliers on 10 % of the corners: bad-detections.
 TEST(Verdict, ManyOutliersAreBadDetections) {
   const Camera truth = sim::TruthRadtan();
-  SyntheticScene scene = Scene(truth, 24, 13);
+  SyntheticScene scene = TiltedScene(truth, 24, 0.2, 13);
   scene.outlier_fraction = 0.1;
   const SyntheticData data = MakeSyntheticData(scene);
   const Judged judged =
@@ -336,7 +307,7 @@ TEST(Verdict, ManyOutliersAreBadDetections) {
 // detected view): a few views far worse than the rest.
 TEST(Verdict, OneBadViewIsBadDetections) {
   const Camera truth = sim::TruthRadtan();
-  SyntheticData data = MakeSyntheticData(Scene(truth, 24, 17));
+  SyntheticData data = MakeSyntheticData(TiltedScene(truth, 24, 0.2, 17));
   for (size_t i = 0; i < data.views[5].image_points.size(); ++i) {
     // Alternating 1 px shifts: no pose absorbs them.
     const double sign = i % 2 == 0 ? 1.0 : -1.0;

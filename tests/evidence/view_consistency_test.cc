@@ -16,47 +16,16 @@
 #include "evidence/verdict.h"
 #include "sim/synthetic_views.h"
 #include "sim/view_faults.h"
+#include "tests/evidence/judge.h"
 
 namespace puzzlecal {
 namespace {
 
 using sim::SyntheticData;
 using sim::SyntheticScene;
-
-SyntheticScene Scene(unsigned seed) {
-  SyntheticScene scene;
-  scene.camera = sim::TruthRadtan();
-  scene.num_views = 24;
-  scene.noise_px = 0.2;
-  scene.seed = seed;
-  scene.max_direction_deg = 40;
-  scene.min_visible_fraction = 0.6;
-  return scene;
-}
-
-struct Judged {
-  CalibrationResult result;
-  Evidence evidence;
-  Verdict verdict;
-};
-
-Judged Judge(const SyntheticData& data, const Camera& truth) {
-  Judged judged;
-  std::string error;
-  EXPECT_TRUE(Calibrate(data.views, truth.model, truth.width, truth.height,
-                        CalibrationOptions(), &judged.result, &error))
-      << error;
-  const EvidenceOptions evidence_options;
-  judged.evidence = ComputeEvidence(data.views, judged.result,
-                                    CalibrationOptions(), evidence_options);
-  judged.verdict = MakeVerdict(judged.result, judged.evidence, evidence_options,
-                               VerdictOptions());
-  // As `puzzlecal calibrate` does: a model is advised only after it has won
-  // on held-out views.
-  CheckModelAdvice(data.views, judged.result, CalibrationOptions(),
-                   ModelSelectionOptions(), nullptr, &judged.verdict);
-  return judged;
-}
+using testing_judge::JudgeAsTheProgram;
+using testing_judge::Judged;
+using testing_judge::TiltedScene;
 
 TEST(ViewConsistencyOptions, CheckRejectsBadValues) {
   ViewConsistencyOptions options;
@@ -71,9 +40,9 @@ TEST(ViewConsistencyOptions, CheckRejectsBadValues) {
 // One camera: the views' focal lengths agree within their sigma (chi-square
 // near its degrees of freedom) and nothing is said.
 TEST(ViewConsistency, CleanViewsAgree) {
-  const SyntheticScene scene = Scene(3);
+  const SyntheticScene scene = TiltedScene(sim::TruthRadtan(), 24, 0.2, 3);
   const SyntheticData data = sim::MakeSyntheticData(scene);
-  const Judged judged = Judge(data, scene.camera);
+  const Judged judged = JudgeAsTheProgram(data, scene.camera);
   const ViewConsistency& vc = judged.evidence.view_consistency;
   ASSERT_TRUE(vc.ok) << vc.error;
   EXPECT_EQ(vc.views.size(), data.views.size());
@@ -86,14 +55,14 @@ TEST(ViewConsistency, CleanViewsAgree) {
 // inconsistent-views, naming changed photos first, with the next step about
 // focus; their own focal lengths come out near the truth.
 TEST(ViewConsistency, FocalChangeBetweenPhotosIsNamed) {
-  const SyntheticScene scene = Scene(5);
+  const SyntheticScene scene = TiltedScene(sim::TruthRadtan(), 24, 0.2, 5);
   SyntheticData data = sim::MakeSyntheticData(scene);
   std::vector<int> changed;
   for (int v = 1; v < static_cast<int>(data.views.size()); v += 3) {
     changed.push_back(v);
   }
   sim::ApplyFocalChange(scene.camera, 1.02, changed, &data);
-  const Judged judged = Judge(data, scene.camera);
+  const Judged judged = JudgeAsTheProgram(data, scene.camera);
   const ViewConsistency& vc = judged.evidence.view_consistency;
   ASSERT_TRUE(vc.ok) << vc.error;
   EXPECT_EQ(judged.verdict.kind, VerdictKind::kInconsistentViews)
@@ -126,9 +95,9 @@ TEST(ViewConsistency, FocalChangeBetweenPhotosIsNamed) {
 // The same scene without the change: no such finding (the scene, not the
 // seed, makes the difference).
 TEST(ViewConsistency, SameSceneWithoutTheChangeIsGood) {
-  const SyntheticScene scene = Scene(5);
+  const SyntheticScene scene = TiltedScene(sim::TruthRadtan(), 24, 0.2, 5);
   const SyntheticData data = sim::MakeSyntheticData(scene);
-  const Judged judged = Judge(data, scene.camera);
+  const Judged judged = JudgeAsTheProgram(data, scene.camera);
   EXPECT_EQ(judged.verdict.kind, VerdictKind::kGood) << judged.verdict.Line();
 }
 

@@ -15,49 +15,21 @@
 #include "evidence/view_consistency.h"
 #include "sim/synthetic_views.h"
 #include "sim/view_faults.h"
+#include "tests/evidence/judge.h"
 
 namespace puzzlecal {
 namespace {
 
 using sim::SyntheticData;
 using sim::SyntheticScene;
-
-SyntheticScene Scene(unsigned seed) {
-  SyntheticScene scene;
-  scene.camera = sim::TruthRadtan();
-  scene.num_views = 24;
-  scene.noise_px = 0.15;
-  scene.seed = seed;
-  scene.max_direction_deg = 40;
-  scene.min_visible_fraction = 0.6;
-  return scene;
-}
-
-struct Judged {
-  CalibrationResult result;
-  Evidence evidence;
-  Verdict verdict;
-};
-
-Judged Judge(const SyntheticData& data, const Camera& truth) {
-  Judged judged;
-  std::string error;
-  EXPECT_TRUE(Calibrate(data.views, truth.model, truth.width, truth.height,
-                        CalibrationOptions(), &judged.result, &error))
-      << error;
-  const EvidenceOptions evidence_options;
-  judged.evidence = ComputeEvidence(data.views, judged.result,
-                                    CalibrationOptions(), evidence_options);
-  judged.verdict = MakeVerdict(judged.result, judged.evidence, evidence_options,
-                               VerdictOptions());
-  CheckModelAdvice(data.views, judged.result, CalibrationOptions(),
-                   ModelSelectionOptions(), nullptr, &judged.verdict);
-  return judged;
-}
+using testing_judge::JudgeAsTheProgram;
+using testing_judge::Judged;
+using testing_judge::TiltedScene;
 
 TEST(ViewErrors, CleanSceneIsGood) {
-  const SyntheticScene scene = Scene(7);
-  const Judged judged = Judge(sim::MakeSyntheticData(scene), scene.camera);
+  const SyntheticScene scene = TiltedScene(sim::TruthRadtan(), 24, 0.15, 7);
+  const Judged judged =
+      JudgeAsTheProgram(sim::MakeSyntheticData(scene), scene.camera);
   EXPECT_EQ(judged.verdict.kind, VerdictKind::kGood) << judged.verdict.Line();
 }
 
@@ -67,11 +39,11 @@ TEST(ViewErrors, BentBoardInTwoPhotosIsAViewLevelError) {
   for (const sim::BoardWarp warp :
        {sim::BoardWarp::kBowl, sim::BoardWarp::kTwist}) {
     SCOPED_TRACE(warp == sim::BoardWarp::kBowl ? "bowl" : "twist");
-    const SyntheticScene scene = Scene(7);
+    const SyntheticScene scene = TiltedScene(sim::TruthRadtan(), 24, 0.15, 7);
     SyntheticData data = sim::MakeSyntheticData(scene);
     const std::vector<int> bent = {5, 17};
     sim::ApplyBoardBend(scene, warp, 0.004, bent, &data);
-    const Judged judged = Judge(data, scene.camera);
+    const Judged judged = JudgeAsTheProgram(data, scene.camera);
     std::printf("%s\n", judged.verdict.Line().c_str());
     EXPECT_EQ(judged.verdict.kind, VerdictKind::kViewErrors)
         << judged.verdict.Line() << "\n"

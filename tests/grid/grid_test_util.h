@@ -16,6 +16,7 @@
 #include "camera/camera_models.h"
 #include "detection/corner.h"
 #include "grid/grid_component.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace grid_test {
@@ -39,6 +40,16 @@ struct SyntheticBoard {
   double tile_m = 0.02;
   Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
 };
+
+// The lattice of a printed board (its inner corners and tile size), posed
+// at the identity.
+inline SyntheticBoard GeometryOf(const Board& board) {
+  SyntheticBoard geometry;
+  geometry.cols = board.cols;
+  geometry.rows = board.rows;
+  geometry.tile_m = board.tile_size_m;
+  return geometry;
+}
 
 // A pose that looks at the board centre from `distance_m` along the optical
 // axis, with the board plane at `viewing_angle_deg` to the line of sight (90 =

@@ -186,21 +186,13 @@ std::pair<int, int> InjectAll(const Scene& scene,
   return {labelled_without, labelled_with};
 }
 
-grid_test::SyntheticBoard Geometry(const Board& board) {
-  grid_test::SyntheticBoard geometry;
-  geometry.cols = board.cols;
-  geometry.rows = board.rows;
-  geometry.tile_m = board.tile_size_m;
-  return geometry;
-}
-
 TEST(OffLatticeTest, FalseCornerInsideAPinholeViewHoldsNoLabel) {
   const Board board =
       MakeBoard(BoardType::kPuzzleBoard, 11, 8, Eigen::Vector2i(120, 40), 0.02);
   RenderOptions options;
   options.noise_sigma = 0.02;
   Eigen::Isometry3d pose =
-      grid_test::LookAtBoard(Geometry(board), 0.3, 50, 20, 15);
+      grid_test::LookAtBoard(grid_test::GeometryOf(board), 0.3, 50, 20, 15);
   pose.translation() -= pose.linear() * board.Point(board.origin);
   const Scene scene = RenderScene(
       board, grid_test::PinholeCamera(1280, 960, 1000), pose, options, 5.0);
@@ -221,8 +213,9 @@ TEST(OffLatticeTest, FalseCornerNearTheRimOfAFisheyeViewHoldsNoLabel) {
   options.noise_sigma = 0.02;
   options.vignetting = 0.6;
   const Camera camera = grid_test::FisheyeCamera(1280, 960);
-  const Eigen::Isometry3d pose = grid_test::LookAtBoard(
-      Geometry(board), 0.1, 60, 30, 20, Eigen::Vector3d(0.1, -0.06, -0.03));
+  const Eigen::Isometry3d pose =
+      grid_test::LookAtBoard(grid_test::GeometryOf(board), 0.1, 60, 30, 20,
+                             Eigen::Vector3d(0.1, -0.06, -0.03));
   const Scene scene = RenderScene(board, camera, pose, options, 12.0);
   // The detected board corners farthest from the image centre.
   const Eigen::Vector2d centre(639.5, 479.5);

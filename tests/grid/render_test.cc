@@ -94,14 +94,6 @@ Board PuzzleBoard11x8() {
                    0.02);
 }
 
-grid_test::SyntheticBoard Geometry(const Board& board) {
-  grid_test::SyntheticBoard geometry;
-  geometry.cols = board.cols;
-  geometry.rows = board.rows;
-  geometry.tile_m = board.tile_size_m;
-  return geometry;
-}
-
 TEST(GridRenderTest, TiltSeries) {
   const Board board = PuzzleBoard11x8();
   const Camera camera = grid_test::PinholeCamera(1280, 960, 1000);
@@ -116,8 +108,8 @@ TEST(GridRenderTest, TiltSeries) {
                                           ? std::vector<double>{15.0, 45.0}
                                           : std::vector<double>{15.0};
     for (double roll : rolls) {
-      const Eigen::Isometry3d pose =
-          grid_test::LookAtBoard(Geometry(board), 0.3, angle, 20, roll);
+      const Eigen::Isometry3d pose = grid_test::LookAtBoard(
+          grid_test::GeometryOf(board), 0.3, angle, 20, roll);
       // The offset of board ids (origin) does not matter to the labels.
       Eigen::Isometry3d cam_from_board = pose;
       cam_from_board.translation() -= pose.linear() * board.Point(board.origin);
@@ -147,8 +139,8 @@ TEST(GridRenderTest, StrongFisheye) {
   options.noise_sigma = 0.02;
   for (const Eigen::Vector3d& offset :
        {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.1, 0.06, 0)}) {
-    const Eigen::Isometry3d pose =
-        grid_test::LookAtBoard(Geometry(board), 0.12, 70, 30, 20, offset);
+    const Eigen::Isometry3d pose = grid_test::LookAtBoard(
+        grid_test::GeometryOf(board), 0.12, 70, 30, 20, offset);
     Eigen::Isometry3d cam_from_board = pose;
     cam_from_board.translation() -= pose.linear() * board.Point(board.origin);
     // Tiles are 50-80 px here; at the board's far corner the detector is off
@@ -202,7 +194,7 @@ TEST(GridRenderTest, SteepFisheyeCheckerboardIsOneComponent) {
   std::printf("angle  offset  detected  labelled  largest  wrong\n");
   for (const View& view : views) {
     const Eigen::Isometry3d cam_from_board = grid_test::LookAtBoard(
-        Geometry(board), 0.1, view.angle, 30, 20, view.offset);
+        grid_test::GeometryOf(board), 0.1, view.angle, 30, 20, view.offset);
     const RenderOutcome outcome =
         DetectAndLabel(board, camera, cam_from_board, options, 12.0);
     const LabelCheck& check = outcome.check;
@@ -240,8 +232,9 @@ TEST(GridRenderTest, AttachPassJoinsLeftOutCornersAndComponents) {
       "wrong  attached  joined\n");
   int joined = 0, attached = 0;
   for (int angle : {60, 45, 35}) {
-    const Eigen::Isometry3d cam_from_board = grid_test::LookAtBoard(
-        Geometry(board), 0.1, angle, 30, 20, Eigen::Vector3d(0.05, 0.03, 0));
+    const Eigen::Isometry3d cam_from_board =
+        grid_test::LookAtBoard(grid_test::GeometryOf(board), 0.1, angle, 30, 20,
+                               Eigen::Vector3d(0.05, 0.03, 0));
     for (int min_size : {4, 20}) {
       strict.cleanup.min_component_size = min_size;
       LabelCheck checks[2];
@@ -291,7 +284,7 @@ TEST(GridRenderTest, OccludersGiveConsistentComponents) {
   hole.grey = 0.7;
   options.occluders.push_back(hole);
   const Eigen::Isometry3d pose =
-      grid_test::LookAtBoard(Geometry(board), 0.3, 60, 10, 10);
+      grid_test::LookAtBoard(grid_test::GeometryOf(board), 0.3, 60, 10, 10);
   Eigen::Isometry3d cam_from_board = pose;
   cam_from_board.translation() -= pose.linear() * board.Point(board.origin);
   const RenderOutcome outcome =

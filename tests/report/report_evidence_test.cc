@@ -15,18 +15,13 @@
 #include "evidence/verdict.h"
 #include "report/report.h"
 #include "sim/synthetic_views.h"
+#include "tests/support/files.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+using testing_files::ReadFile;
 
 TEST(ReportEvidence, VerdictHeadsTheSummaryAndPlotsAreWritten) {
   sim::SyntheticScene scene;
@@ -80,7 +75,7 @@ TEST(ReportEvidence, VerdictHeadsTheSummaryAndPlotsAreWritten) {
     const cv::Mat image = cv::imread((dir / name).string());
     EXPECT_FALSE(image.empty()) << name;
   }
-  const std::string markdown = ReadText(dir / "summary.md");
+  const std::string markdown = ReadFile(dir / "summary.md");
   EXPECT_EQ(
       markdown.rfind("# Calibration report\n\n**" + verdict.Line() + "**", 0),
       0u)

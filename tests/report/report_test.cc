@@ -20,11 +20,13 @@
 #include "sim/render.h"
 #include "sim/synthetic_views.h"
 #include "target/board.h"
+#include "tests/support/files.h"
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
+using testing_files::ReadFile;
 
 // A fresh folder under the test temp dir.
 fs::path FreshDir(const std::string& name) {
@@ -41,16 +43,9 @@ void RemoveUnlessKept(const fs::path& dir) {
   if (std::getenv("PUZZLECAL_KEEP_TEST_OUTPUT") == nullptr) fs::remove_all(dir);
 }
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
 // A valid PNG: the signature, and OpenCV decodes it; returns its size.
 cv::Size PngSize(const fs::path& path) {
-  const std::string bytes = ReadText(path);
+  const std::string bytes = ReadFile(path);
   const std::string signature = "\x89PNG\r\n\x1a\n";
   EXPECT_EQ(bytes.substr(0, 8), signature) << path;
   const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
@@ -224,7 +219,7 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   const fs::path again = dir / "again";
   ASSERT_TRUE(WriteReport(again.string(), run.input, options, &error)) << error;
   for (const std::string& file : summary.files) {
-    EXPECT_EQ(ReadText(again / file), ReadText(report_dir / file)) << file;
+    EXPECT_EQ(ReadFile(again / file), ReadFile(report_dir / file)) << file;
   }
 
   // Overlays: the worst view by RMS, the view with the most outliers, and
@@ -268,7 +263,7 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
     EXPECT_LT(size.height, image_height + 200) << name;
   }
 
-  const std::string markdown = ReadText(report_dir / "summary.md");
+  const std::string markdown = ReadFile(report_dir / "summary.md");
   ASSERT_FALSE(markdown.empty());
   EXPECT_NE(markdown.find("pinhole-radtan"), std::string::npos);
   EXPECT_NE(markdown.find("640 x 480"), std::string::npos);
@@ -372,7 +367,7 @@ TEST(ReportTest, FisheyeRunWithMissingImagesStillWritesEverything) {
   EXPECT_EQ(overlays, 1);
   EXPECT_EQ(PngSize(dir / "report" / "distortion.png").width,
             options.image_plot_width);
-  const std::string markdown = ReadText(dir / "report" / "summary.md");
+  const std::string markdown = ReadFile(dir / "report" / "summary.md");
   EXPECT_NE(markdown.find("**Calibration failed:** too few views tilted"),
             std::string::npos);
   EXPECT_NE(markdown.find("kannala-brandt"), std::string::npos);

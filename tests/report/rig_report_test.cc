@@ -28,6 +28,7 @@
 #include "evidence/evidence.h"
 #include "evidence/verdict.h"
 #include "sim/rig_scenes.h"
+#include "tests/support/files.h"
 #include "util/string_format.h"
 
 namespace puzzlecal {
@@ -131,12 +132,7 @@ TEST(RigReportTest, ViewingRectificationPutsPointsOnOneRow) {
 }
 
 namespace fs = std::filesystem;
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in),
-                     std::istreambuf_iterator<char>());
-}
+using testing_files::ReadFile;
 
 // The text of summary.md from "## Camera <name>" to the next "## " heading.
 std::string CameraSection(const std::string& summary, const std::string& name) {
@@ -204,7 +200,7 @@ TEST(RigReportTest, EachCameraHasItsVerdictFiguresAndEvidenceCharts) {
   ASSERT_TRUE(
       WriteRigReport(dir.string(), MakeInput(rig), RigReportOptions(), &error))
       << error;
-  const std::string summary = ReadText(dir / "summary.md");
+  const std::string summary = ReadFile(dir / "summary.md");
   ASSERT_FALSE(summary.empty());
   std::vector<std::string> all_charts;
   for (size_t c = 0; c < rig.result.cameras.size(); ++c) {
