@@ -12,6 +12,8 @@
 
 #include <Eigen/Core>
 
+#include "camera/camera_models.h"
+
 namespace puzzlecal {
 
 // Pose block layout: angle-axis rotation then translation (metres).
@@ -147,6 +149,14 @@ ceres::CostFunction* ReprojectionError<Model>::Create(
     const Eigen::Vector3d& board_point, const Eigen::Vector2d& observed_pixel) {
   return new ReprojectionCost<Model>(board_point, observed_pixel);
 }
+
+// Each model's cost is compiled once, in reprojection_error.cc: its
+// Jacobian (Model::Project on dual numbers) is the heaviest code the solvers
+// instantiate, and three solver files create it.
+extern template class ReprojectionCost<PinholeRadtanModel>;
+extern template class ReprojectionCost<PinholeRationalModel>;
+extern template class ReprojectionCost<KannalaBrandtModel>;
+extern template class ReprojectionCost<KannalaBrandtNoncentralModel>;
 
 }  // namespace puzzlecal
 

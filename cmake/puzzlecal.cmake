@@ -74,18 +74,19 @@ endfunction()
 # files in DIR, each test registered with CTest (gtest_discover_tests), run from the repository
 # root so tests can read configs/ and testdata/.
 #
-# The test binaries share one precompiled header (GoogleTest, Eigen, the
-# standard library): they are half of the build, and parsing those headers
+# The test binaries share one precompiled header (GoogleTest, Eigen, OpenCV's
+# core, the standard library): they are half of the build, and parsing those headers
 # again for each was a third of their compile time.
 function(puzzlecal_test_pch_host)
   if(TARGET puzzlecal_test_pch)
     return()
   endif()
   add_executable(puzzlecal_test_pch ${PROJECT_SOURCE_DIR}/tests/support/pch_host.cc)
-  target_link_libraries(puzzlecal_test_pch PRIVATE GTest::gtest Eigen3::Eigen)
+  target_link_libraries(puzzlecal_test_pch PRIVATE GTest::gtest Eigen3::Eigen
+                        opencv_core)
   puzzlecal_test_compile_options(puzzlecal_test_pch)
   target_precompile_headers(puzzlecal_test_pch PRIVATE
-    <gtest/gtest.h> <Eigen/Core> <Eigen/Geometry>
+    <gtest/gtest.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
     <algorithm> <cmath> <filesystem> <fstream> <map> <memory> <random>
     <sstream> <string> <vector>)
 endfunction()
