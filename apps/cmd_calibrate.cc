@@ -513,6 +513,9 @@ void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
               << " s; calibration " << run.seconds_calibrate << " s\n";
   }
   std::cout << run.verdict.Line() << "\n";
+  for (const std::string& note : run.verdict.notes) {
+    std::cout << "note: " << note << "\n";
+  }
   std::cout << "wrote " << FLAGS_out
             << (FLAGS_report.empty() ? "" : " and the report " + FLAGS_report)
             << "\n";

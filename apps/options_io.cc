@@ -301,6 +301,7 @@ struct Fields<VerdictOptions> {
     v.Field("max_outlier_fraction", o.max_outlier_fraction);
     v.Field("view_rms_factor", o.view_rms_factor);
     v.Field("view_rms_floor_px", o.view_rms_floor_px);
+    v.Field("max_view_outlier_fraction", o.max_view_outlier_fraction);
     v.Field("max_bad_view_fraction", o.max_bad_view_fraction);
     v.Field("min_views", o.min_views);
     v.Field("min_coverage", o.min_coverage);

@@ -197,13 +197,46 @@ bool AddSystematicResidualFindings(const SystematicResiduals& residuals,
   return nearest_systematic || rms_grows;
 }
 
+// How one used view's corners fit: the RMS of its inliers, and its
+// rejected corners with the largest of their errors.
+struct ViewFit {
+  double inlier_rms_px = 0;
+  int corners = 0;
+  int rejected = 0;
+  double worst_rejected_px = 0;
+};
+
+ViewFit FitOfView(const CalibrationResult& result, size_t v) {
+  ViewFit fit;
+  double sum2 = 0;
+  int inliers = 0;
+  const std::vector<Eigen::Vector2d>& residuals = result.residuals[v];
+  for (size_t i = 0; i < residuals.size(); ++i) {
+    const bool inlier = v >= result.inlier.size() ||
+                        i >= result.inlier[v].size() || result.inlier[v][i];
+    ++fit.corners;
+    if (inlier) {
+      sum2 += residuals[i].squaredNorm();
+      ++inliers;
+    } else {
+      ++fit.rejected;
+      fit.worst_rejected_px =
+          std::max(fit.worst_rejected_px, residuals[i].norm());
+    }
+  }
+  fit.inlier_rms_px = inliers > 0 ? std::sqrt(sum2 / (2.0 * inliers)) : 0.0;
+  return fit;
+}
+
 // Bad detections: too many outliers, or a few views far worse than the
-// median view (RMS over all of a view's corners, outliers included; a view
-// the rejection emptied counts too). Returns the number of such views.
+// median view (their inliers fit badly, many of their corners were rejected,
+// or the rejection emptied them). Views whose few rejected corners were
+// handled go to `notes`. Returns the number of views that stand out.
 int AddBadDetectionFindings(const CalibrationResult& result,
                             const std::vector<int>& view_errors,
                             const VerdictOptions& options,
-                            std::vector<Finding>* findings) {
+                            std::vector<Finding>* findings,
+                            std::vector<std::string>* notes) {
   // Views by their file name, as every finding and table names them.
   auto view_label = [&](size_t v) {
     return v < result.view_name.size() && !result.view_name[v].empty()
@@ -233,56 +266,74 @@ int AddBadDetectionFindings(const CalibrationResult& result,
                 "%.1f %%)",
                 100 * outlier_fraction, 100 * options.max_outlier_fraction)});
   }
-  std::vector<double> all_rms(result.view_used.size(), 0.0);
-  std::vector<double> view_rms;
+  std::vector<ViewFit> fits(result.view_used.size());
+  std::vector<double> inlier_rms;
   for (size_t v = 0; v < result.view_used.size(); ++v) {
     if (!result.view_used[v] || v >= result.residuals.size()) continue;
-    double sum2 = 0;
-    for (const Eigen::Vector2d& r : result.residuals[v])
-      sum2 += r.squaredNorm();
-    const size_t n = result.residuals[v].size();
-    all_rms[v] = n > 0 ? std::sqrt(sum2 / (2.0 * n)) : 0.0;
-    view_rms.push_back(all_rms[v]);
+    fits[v] = FitOfView(result, v);
+    inlier_rms.push_back(fits[v].inlier_rms_px);
   }
-  if (view_rms.empty()) return 0;
-  std::vector<double> sorted = view_rms;
+  if (inlier_rms.empty()) return 0;
+  std::vector<double> sorted = inlier_rms;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
                    sorted.end());
   const double median = sorted[sorted.size() / 2];
   const double limit =
       std::max(options.view_rms_factor * median, options.view_rms_floor_px);
-  std::string bad_views;
-  int num_bad_views = 0;
+  std::string bad_views, handled_views;
+  int num_bad_views = 0, num_handled_views = 0;
+  auto add_bad = [&](size_t v, const std::string& why) {
+    ++num_bad_views;
+    if (num_bad_views <= 5) {
+      bad_views +=
+          (bad_views.empty() ? "" : ", ") + view_label(v) + " (" + why + ")";
+    }
+  };
   for (size_t v = 0; v < result.view_used.size(); ++v) {
     if (is_view_error(v)) continue;
     // A view the outlier rejection emptied (Calibrate's reason says so)
     // is as bad as one can be.
     if (!result.view_used[v] && v < result.view_reason.size() &&
         result.view_reason[v].find("outlier") != std::string::npos) {
-      ++num_bad_views;
-      if (num_bad_views <= 5) {
-        bad_views += (bad_views.empty() ? "" : ", ") + view_label(v) +
-                     " (dropped: " + result.view_reason[v] + ")";
-      }
+      add_bad(v, "dropped: " + result.view_reason[v]);
       continue;
     }
     if (!result.view_used[v] || v >= result.residuals.size()) continue;
-    if (all_rms[v] > limit) {
-      ++num_bad_views;
-      if (num_bad_views <= 5) {
-        bad_views += (bad_views.empty() ? "" : ", ") + view_label(v) +
-                     Printf(" (%.2f px)", all_rms[v]);
+    const ViewFit& fit = fits[v];
+    const std::string rejected_text =
+        Printf("%.0f of %.0f corners rejected", fit.rejected, fit.corners);
+    if (fit.inlier_rms_px > limit) {
+      add_bad(v, Printf("inliers %.2f px", fit.inlier_rms_px) +
+                     (fit.rejected > 0 ? ", " + rejected_text : ""));
+    } else if (fit.rejected > options.max_view_outlier_fraction * fit.corners) {
+      add_bad(v, rejected_text);
+    } else if (fit.rejected > 0) {
+      ++num_handled_views;
+      if (num_handled_views <= 5) {
+        handled_views += (handled_views.empty() ? "" : ", ") + view_label(v) +
+                         " (" + rejected_text +
+                         Printf(", up to %.1f px off; the rest fit at %.2f px)",
+                                fit.worst_rejected_px, fit.inlier_rms_px);
       }
     }
   }
   if (num_bad_views > 0 &&
-      num_bad_views <= options.max_bad_view_fraction * view_rms.size()) {
+      num_bad_views <= options.max_bad_view_fraction * inlier_rms.size()) {
     findings->push_back(
         {VerdictKind::kBadDetections,
-         Printf("%.0f view(s) dropped or with an RMS over all corners "
-                "above %.2f px (%.0f x the median view's %.3f px): ",
-                num_bad_views, limit, options.view_rms_factor, median) +
+         Printf("%.0f view(s) dropped, with more than %.0f %% of their "
+                "corners rejected, or with inliers above %.2f px (%.0f x the "
+                "median view's %.3f px): ",
+                num_bad_views, 100 * options.max_view_outlier_fraction, limit,
+                options.view_rms_factor, median) +
              bad_views});
+  }
+  if (num_handled_views > 0) {
+    notes->push_back(
+        Printf("isolated rejected corners, taken out by the outlier "
+               "rejection, in %.0f view(s) whose other corners fit: ",
+               num_handled_views) +
+        handled_views + (num_handled_views > 5 ? ", ..." : ""));
   }
   return num_bad_views;
 }
@@ -568,6 +619,9 @@ bool VerdictOptions::Check(std::string* why) const {
   if (!(view_rms_floor_px >= 0)) {
     return Fail("view_rms_floor_px must be >= 0", why);
   }
+  if (!(max_view_outlier_fraction >= 0 && max_view_outlier_fraction <= 1)) {
+    return Fail("max_view_outlier_fraction must be in [0, 1]", why);
+  }
   if (!(max_bad_view_fraction >= 0 && max_bad_view_fraction <= 1)) {
     return Fail("max_bad_view_fraction must be in [0, 1]", why);
   }
@@ -648,13 +702,15 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   const std::vector<int> view_errors = AddViewErrorFindings(
       evidence.view_consistency, static_cast<size_t>(result.num_views_used),
       options, &findings);
+  std::vector<std::string> notes;
   const int num_bad_views =
-      AddBadDetectionFindings(result, view_errors, options, &findings);
+      AddBadDetectionFindings(result, view_errors, options, &findings, &notes);
   AddInsufficientDataFindings(result, evidence, evidence_options, options,
                               &findings);
 
   Verdict verdict;
   RankFindings(findings, &verdict);
+  verdict.notes = notes;
   for (const Finding& f : findings) {
     if (f.kind == VerdictKind::kInconsistentViews) {
       verdict.inconsistent_views = f.text;

@@ -91,13 +91,18 @@ struct VerdictOptions {
   // More rejected corners than this fraction of all corners of the used
   // views. Default 0.05.
   double max_outlier_fraction = 0.05;
-  // A view whose RMS over all of its corners (outliers included, so a view
-  // the rejection emptied still shows) exceeds view_rms_factor times the
-  // median of that figure (and view_rms_floor_px) stands out; at most
-  // max_bad_view_fraction of the views standing out is "a few views" (more is
-  // the model's or the data's doing as a whole). Defaults 3, 0.2 px and 0.2.
+  // A view stands out when the RMS of its inlier corners exceeds
+  // view_rms_factor times the median view's (and view_rms_floor_px), when
+  // more than max_view_outlier_fraction of its corners were rejected, or
+  // when the rejection emptied it. A view with a few rejected corners and
+  // inliers that fit does not: the rejection handled them (an isolated
+  // false corner), and the verdict lists them as a note. At most
+  // max_bad_view_fraction of the views standing out is "a few views" (more
+  // is the model's or the data's doing as a whole). Defaults 3, 0.2 px,
+  // 0.2 and 0.2.
   double view_rms_factor = 3.0;
   double view_rms_floor_px = 0.2;
+  double max_view_outlier_fraction = 0.2;
   double max_bad_view_fraction = 0.2;
 
   // --- insufficient data ---
@@ -158,6 +163,10 @@ struct Verdict {
   // the highest-ranked kind: model-error, inconsistent-views, view-errors,
   // bad-detections, insufficient-data).
   std::vector<std::string> findings;
+  // What was seen and handled, which does not change the verdict: views
+  // whose few rejected corners the outlier rejection took out while the
+  // rest of the view fits (an isolated false corner).
+  std::vector<std::string> notes;
   // A model name the next step suggests ("" if none).
   std::string suggested_model;
   // The inconsistent-views finding and its next step, also when a

@@ -1100,6 +1100,13 @@ std::string EvidenceMarkdown(const Evidence& evidence, const Verdict* verdict,
       }
       md << "\n";
     }
+    if (!verdict->notes.empty()) {
+      md << "Seen and handled:\n\n";
+      for (const std::string& note : verdict->notes) {
+        md << "- " << note << "\n";
+      }
+      md << "\n";
+    }
   }
   const CrossValidation& cv = evidence.cross_validation;
   md << sub << " Cross-validation (two halves of the views)\n\n";

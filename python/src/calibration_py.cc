@@ -208,6 +208,7 @@ void BindCalibration(py::module_& m) {
       .def_readonly("reason", &Verdict::reason)
       .def_readonly("next_step", &Verdict::next_step)
       .def_readonly("findings", &Verdict::findings)
+      .def_readonly("notes", &Verdict::notes)
       .def_readonly("suggested_model", &Verdict::suggested_model)
       .def("line", &Verdict::Line, "the one-line form the program prints")
       .def("__repr__", [](const Verdict& v) {

@@ -33,6 +33,9 @@ TEST(VerdictOptions, CheckRejectsBadValues) {
   options.pinhole_max_field_deg = 95;
   EXPECT_FALSE(options.Check());
   options = VerdictOptions();
+  options.max_view_outlier_fraction = -0.1;
+  EXPECT_FALSE(options.Check());
+  options = VerdictOptions();
   options.min_views = 0;
   EXPECT_FALSE(options.Check());
 }
@@ -324,6 +327,60 @@ TEST(Verdict, OneBadViewIsBadDetections) {
       << judged.verdict.reason << " used " << judged.result.view_used[5] << " "
       << judged.result.view_reason[5] << " rms " << judged.result.view_rms_px[5]
       << " outliers " << judged.result.num_outliers;
+}
+
+// One false corner in a view (12 px off, as a printed mark or a reflection
+// gives): the outlier rejection takes it out and the view's other corners
+// fit, so the verdict stays good and names the view in a note. An RMS over
+// all of the view's corners would have called it a bad view.
+TEST(Verdict, OneFalseCornerIsANoteNotABadView) {
+  const Camera truth = sim::TruthRadtan();
+  SyntheticData data = MakeSyntheticData(TiltedScene(truth, 24, 0.1, 23));
+  CalibrationView& view = data.views[3];
+  view.image_points[view.image_points.size() / 2] += Eigen::Vector2d(9, -8);
+  const Judged judged =
+      Judge(data.views, truth.model, truth.width, truth.height);
+  ASSERT_TRUE(judged.calibrated) << judged.error;
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kGood) << judged.verdict.Line();
+  for (const std::string& finding : judged.verdict.findings) {
+    EXPECT_EQ(finding.find(view.name), std::string::npos) << finding;
+  }
+  ASSERT_EQ(judged.verdict.notes.size(), 1u);
+  const std::string& note = judged.verdict.notes[0];
+  EXPECT_NE(
+      note.find(view.name + " (1 of " +
+                std::to_string(view.image_points.size()) + " corners rejected"),
+      std::string::npos)
+      << note;
+  // The old rule's figure: the view's RMS over all corners, the false one
+  // included, stands out against the median view.
+  const std::vector<Eigen::Vector2d>& residuals = judged.result.residuals[3];
+  double sum2 = 0;
+  for (const Eigen::Vector2d& r : residuals) sum2 += r.squaredNorm();
+  EXPECT_GT(std::sqrt(sum2 / (2.0 * residuals.size())),
+            VerdictOptions().view_rms_factor * 0.1);
+}
+
+// A third of a view's corners off by 6-8 px (a mislabelled stretch of the
+// board): the view stands out by its rejected fraction although its
+// inliers fit and the rejected corners are under 2 % of all.
+TEST(Verdict, AViewWithManyRejectedCornersStandsOut) {
+  const Camera truth = sim::TruthRadtan();
+  SyntheticData data = MakeSyntheticData(TiltedScene(truth, 24, 0.1, 29));
+  CalibrationView& view = data.views[7];
+  for (size_t i = 0; i < view.image_points.size(); i += 3) {
+    const double sign = i % 2 == 0 ? 1.0 : -1.0;
+    view.image_points[i] += sign * Eigen::Vector2d(6, 4);
+  }
+  const Judged judged =
+      Judge(data.views, truth.model, truth.width, truth.height);
+  ASSERT_TRUE(judged.calibrated) << judged.error;
+  EXPECT_EQ(judged.verdict.kind, VerdictKind::kBadDetections)
+      << judged.verdict.Line();
+  EXPECT_NE(judged.verdict.reason.find(view.name + " ("), std::string::npos)
+      << judged.verdict.reason;
+  EXPECT_NE(judged.verdict.reason.find("corners rejected"), std::string::npos)
+      << judged.verdict.reason;
 }
 
 }  // namespace
