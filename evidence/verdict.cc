@@ -345,7 +345,8 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
                                  const Evidence& evidence,
                                  const EvidenceOptions& evidence_options,
                                  const VerdictOptions& options,
-                                 std::vector<Finding>* findings) {
+                                 std::vector<Finding>* findings,
+                                 std::vector<std::string>* notes) {
   const Camera& camera = result.camera;
   if (result.num_views_used < options.min_views) {
     findings->push_back({VerdictKind::kInsufficientData,
@@ -380,6 +381,7 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
                   options.max_uncertainty_px)});
     }
   }
+  std::string undetermined_coefficients;
   if (result.covariance_ok) {
     const std::vector<std::string> names = CameraModelParamNames(camera.model);
     for (size_t k = 0; k < names.size() && k < result.param_stddev.size() &&
@@ -388,15 +390,32 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
       if (k < result.param_fixed.size() && result.param_fixed[k]) continue;
       const double sigma = result.param_stddev[k];
       const bool distortion = static_cast<int>(k) >= kDistortionBegin;
-      if (distortion && !options.check_distortion_determined) continue;
-      if (sigma > std::abs(camera.params[k]) &&
-          (!distortion || sigma > options.min_undetermined_distortion_stddev)) {
+      if (!(sigma > std::abs(camera.params[k]) &&
+            (!distortion ||
+             sigma > options.min_undetermined_distortion_stddev))) {
+        continue;
+      }
+      const std::string text =
+          names[k] + Printf(" (%.4g +- %.3g)", camera.params[k], sigma);
+      if (distortion && !options.check_distortion_determined) {
+        undetermined_coefficients +=
+            (undetermined_coefficients.empty() ? "" : ", ") + text;
+      } else {
         findings->push_back(
             {VerdictKind::kInsufficientData,
              names[k] + Printf(" is undetermined (%.4g +- %.3g)",
                                camera.params[k], sigma)});
       }
     }
+  }
+  // Said, not judged: coupled coefficients can each be undetermined while
+  // the projection they make is determined (its uncertainty is judged above).
+  if (!undetermined_coefficients.empty()) {
+    notes->push_back(
+        "coefficients undetermined one by one: " + undetermined_coefficients +
+        "; their values mean nothing alone (the projection they make is "
+        "judged by its uncertainty), and a model with fewer coefficients "
+        "may fit as well (--model auto compares models on held-out views)");
   }
   const CrossValidation& cv = evidence.cross_validation;
   if (!cv.ok && cv.error != "not run") {
@@ -706,7 +725,7 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   const int num_bad_views =
       AddBadDetectionFindings(result, view_errors, options, &findings, &notes);
   AddInsufficientDataFindings(result, evidence, evidence_options, options,
-                              &findings);
+                              &findings, &notes);
 
   Verdict verdict;
   RankFindings(findings, &verdict);

@@ -165,7 +165,10 @@ struct Verdict {
   std::vector<std::string> findings;
   // What was seen and handled, which does not change the verdict: views
   // whose few rejected corners the outlier rejection took out while the
-  // rest of the view fits (an isolated false corner).
+  // rest of the view fits (an isolated false corner); distortion
+  // coefficients undetermined one by one (standard deviation above their
+  // value and min_undetermined_distortion_stddev) while
+  // check_distortion_determined is off.
   std::vector<std::string> notes;
   // A model name the next step suggests ("" if none).
   std::string suggested_model;

@@ -383,5 +383,40 @@ TEST(Verdict, AViewWithManyRejectedCornersStandsOut) {
       << judged.verdict.reason;
 }
 
+// The rational model on a lens without the rational terms: its
+// denominator coefficients are undetermined one by one while the projection
+// is well determined; the verdict says so in a note and does not change.
+// The radtan model on the same views needs no such note.
+TEST(Verdict, UndeterminedCoefficientsAreSaidInANote) {
+  const Camera truth = sim::TruthRadtan();
+  const SyntheticData data = MakeSyntheticData(TiltedScene(truth, 24, 0.2, 31));
+  const Judged rational = Judge(data.views, CameraModelId::kPinholeRational,
+                                truth.width, truth.height);
+  ASSERT_TRUE(rational.calibrated) << rational.error;
+  std::string notes;
+  for (const std::string& note : rational.verdict.notes) notes += note + "\n";
+  EXPECT_NE(notes.find("coefficients undetermined one by one: "),
+            std::string::npos)
+      << notes << rational.verdict.Line();
+  // Each coefficient named there is one whose sigma exceeds its value.
+  const std::vector<std::string> names =
+      CameraModelParamNames(CameraModelId::kPinholeRational);
+  for (size_t k = kDistortionBegin; k < names.size(); ++k) {
+    const bool named = notes.find(names[k] + " (") != std::string::npos;
+    const bool undetermined =
+        rational.result.param_stddev[k] >
+            std::abs(rational.result.camera.params[k]) &&
+        rational.result.param_stddev[k] >
+            VerdictOptions().min_undetermined_distortion_stddev;
+    EXPECT_EQ(named, undetermined) << names[k];
+  }
+  const Judged radtan =
+      Judge(data.views, truth.model, truth.width, truth.height);
+  ASSERT_TRUE(radtan.calibrated) << radtan.error;
+  for (const std::string& note : radtan.verdict.notes) {
+    EXPECT_EQ(note.find("undetermined"), std::string::npos) << note;
+  }
+}
+
 }  // namespace
 }  // namespace puzzlecal
