@@ -52,6 +52,11 @@ fs::path ScratchRoot() {
          ("puzzlecal_rig_test_" + std::to_string(getpid()));
 }
 
+// This process's folder goes when its tests are done.
+[[maybe_unused]] const ::testing::Environment* const kRigScratchCleanup =
+    ::testing::AddGlobalTestEnvironment(
+        new testing_program::RemoveAtEnd(ScratchRoot()));
+
 ProgramRun RunProgram(const std::string& arguments) {
   return testing_program::RunProgram(arguments, ScratchRoot());
 }

@@ -32,6 +32,11 @@ fs::path RealRigScratch() {
          ("puzzlecal_real_rig_test_" + std::to_string(getpid()));
 }
 
+// This process's folder goes when its tests are done.
+[[maybe_unused]] const ::testing::Environment* const kRealRigScratchCleanup =
+    ::testing::AddGlobalTestEnvironment(
+        new testing_program::RemoveAtEnd(RealRigScratch()));
+
 TEST(RealRigTest, Bumblebee2UsesEveryWholeBoardFrameAndItsBaseline) {
   const std::string real = testing_data::SharedFolder("real");
   if (real.empty()) {

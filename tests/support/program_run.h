@@ -4,11 +4,13 @@
 // The end-to-end tests run the built program the way a user does: one shell
 // command, its output and exit status read back.
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "tests/support/files.h"
 
@@ -68,6 +70,23 @@ inline ProgramRun RunProgram(const std::string& arguments,
   std::filesystem::remove(err);
   return run;
 }
+
+// Removes a scratch folder, with all in it, when the test program ends, so
+// that the runs' folders do not pile up in the temporary directory:
+//   const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(
+//       new testing_program::RemoveAtEnd(ScratchRoot()));
+class RemoveAtEnd : public ::testing::Environment {
+ public:
+  explicit RemoveAtEnd(std::filesystem::path folder)
+      : folder_(std::move(folder)) {}
+  void TearDown() override {
+    std::error_code ec;
+    std::filesystem::remove_all(folder_, ec);
+  }
+
+ private:
+  std::filesystem::path folder_;
+};
 
 }  // namespace testing_program
 }  // namespace puzzlecal
