@@ -10,7 +10,8 @@ namespace fs = std::filesystem;
 // Files a report folder holds (the reports' names).
 bool IsReportFile(const fs::path& file) {
   const std::string name = file.filename().string();
-  return name == "summary.md" || file.extension() == ".png";
+  return name == "summary.md" || name == "index.html" ||
+         file.extension() == ".png";
 }
 
 // Hidden names next to the report folder.

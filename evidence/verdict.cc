@@ -231,12 +231,14 @@ ViewFit FitOfView(const CalibrationResult& result, size_t v) {
 // Bad detections: too many outliers, or a few views far worse than the
 // median view (their inliers fit badly, many of their corners were rejected,
 // or the rejection emptied them). Views whose few rejected corners were
-// handled go to `notes`. Returns the number of views that stand out.
+// handled go to `notes`. Every view's standing goes to verdict->views
+// (view-level errors are marked by AddViewErrorFindings' caller). Returns
+// the number of views that stand out.
 int AddBadDetectionFindings(const CalibrationResult& result,
                             const std::vector<int>& view_errors,
                             const VerdictOptions& options,
                             std::vector<Finding>* findings,
-                            std::vector<std::string>* notes) {
+                            std::vector<std::string>* notes, Verdict* verdict) {
   // Views by their file name, as every finding and table names them.
   auto view_label = [&](size_t v) {
     return v < result.view_name.size() && !result.view_name[v].empty()
@@ -266,12 +268,18 @@ int AddBadDetectionFindings(const CalibrationResult& result,
                 "%.1f %%)",
                 100 * outlier_fraction, 100 * options.max_outlier_fraction)});
   }
-  std::vector<ViewFit> fits(result.view_used.size());
+  std::vector<ViewJudgement>& judged = verdict->views;
+  judged.assign(result.view_used.size(), ViewJudgement());
   std::vector<double> inlier_rms;
   for (size_t v = 0; v < result.view_used.size(); ++v) {
     if (!result.view_used[v] || v >= result.residuals.size()) continue;
-    fits[v] = FitOfView(result, v);
-    inlier_rms.push_back(fits[v].inlier_rms_px);
+    const ViewFit fit = FitOfView(result, v);
+    judged[v].standing = ViewStanding::kFits;
+    judged[v].inlier_rms_px = fit.inlier_rms_px;
+    judged[v].corners = fit.corners;
+    judged[v].rejected = fit.rejected;
+    judged[v].worst_rejected_px = fit.worst_rejected_px;
+    inlier_rms.push_back(fit.inlier_rms_px);
   }
   if (inlier_rms.empty()) return 0;
   std::vector<double> sorted = inlier_rms;
@@ -280,9 +288,13 @@ int AddBadDetectionFindings(const CalibrationResult& result,
   const double median = sorted[sorted.size() / 2];
   const double limit =
       std::max(options.view_rms_factor * median, options.view_rms_floor_px);
+  verdict->median_view_rms_px = median;
+  verdict->view_rms_limit_px = limit;
   std::string bad_views, handled_views;
   int num_bad_views = 0, num_handled_views = 0;
   auto add_bad = [&](size_t v, const std::string& why) {
+    judged[v].standing = ViewStanding::kStandsOut;
+    judged[v].why = why;
     ++num_bad_views;
     if (num_bad_views <= 5) {
       bad_views +=
@@ -299,21 +311,24 @@ int AddBadDetectionFindings(const CalibrationResult& result,
       continue;
     }
     if (!result.view_used[v] || v >= result.residuals.size()) continue;
-    const ViewFit& fit = fits[v];
+    ViewJudgement& view = judged[v];
     const std::string rejected_text =
-        Printf("%.0f of %.0f corners rejected", fit.rejected, fit.corners);
-    if (fit.inlier_rms_px > limit) {
-      add_bad(v, Printf("inliers %.2f px", fit.inlier_rms_px) +
-                     (fit.rejected > 0 ? ", " + rejected_text : ""));
-    } else if (fit.rejected > options.max_view_outlier_fraction * fit.corners) {
+        Printf("%.0f of %.0f corners rejected", view.rejected, view.corners);
+    if (view.inlier_rms_px > limit) {
+      add_bad(v, Printf("inliers %.2f px", view.inlier_rms_px) +
+                     (view.rejected > 0 ? ", " + rejected_text : ""));
+    } else if (view.rejected >
+               options.max_view_outlier_fraction * view.corners) {
       add_bad(v, rejected_text);
-    } else if (fit.rejected > 0) {
+    } else if (view.rejected > 0) {
+      view.standing = ViewStanding::kHandled;
+      view.why =
+          rejected_text + Printf(", up to %.1f px off; the rest fit at %.2f px",
+                                 view.worst_rejected_px, view.inlier_rms_px);
       ++num_handled_views;
       if (num_handled_views <= 5) {
         handled_views += (handled_views.empty() ? "" : ", ") + view_label(v) +
-                         " (" + rejected_text +
-                         Printf(", up to %.1f px off; the rest fit at %.2f px)",
-                                fit.worst_rejected_px, fit.inlier_rms_px);
+                         " (" + view.why + ")";
       }
     }
   }
@@ -515,6 +530,24 @@ std::vector<int> AddViewErrorFindings(const ViewConsistency& vc,
               views.size()) +
            named});
   return views;
+}
+
+// Marks the views with a view-level error in `views` (their figures were
+// filled by AddBadDetectionFindings).
+void MarkViewErrors(const ViewConsistency& vc, const std::vector<int>& flagged,
+                    std::vector<ViewJudgement>* views) {
+  for (const ViewField& f : vc.fields) {
+    if (f.view < 0 || f.view >= static_cast<int>(views->size()) ||
+        std::find(flagged.begin(), flagged.end(), f.view) == flagged.end()) {
+      continue;
+    }
+    ViewJudgement& view = (*views)[f.view];
+    view.standing = ViewStanding::kViewError;
+    view.why = Printf(
+        "a smooth residual field of %.2f px RMS across the board (noise "
+        "gives %.3f px): a bent board, a focus change or motion",
+        f.smooth_rms_px, f.expected_smooth_px);
+  }
 }
 
 // The verdict's kind and reason: the findings of the highest-ranked kind
@@ -722,12 +755,13 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
       evidence.view_consistency, static_cast<size_t>(result.num_views_used),
       options, &findings);
   std::vector<std::string> notes;
-  const int num_bad_views =
-      AddBadDetectionFindings(result, view_errors, options, &findings, &notes);
+  Verdict verdict;
+  const int num_bad_views = AddBadDetectionFindings(
+      result, view_errors, options, &findings, &notes, &verdict);
+  MarkViewErrors(evidence.view_consistency, view_errors, &verdict.views);
   AddInsufficientDataFindings(result, evidence, evidence_options, options,
                               &findings, &notes);
 
-  Verdict verdict;
   RankFindings(findings, &verdict);
   verdict.notes = notes;
   for (const Finding& f : findings) {

@@ -155,6 +155,27 @@ struct VerdictOptions {
   bool Check(std::string* why = nullptr) const;
 };
 
+// How one view of a calibration stands. This one rule names views in the
+// verdict's findings, in the report's table of worst views and in its
+// per-view chart.
+enum class ViewStanding {
+  kNotUsed,    // the calibration did not use it (and not for outliers)
+  kFits,       // its corners fit like the other views'
+  kHandled,    // a few rejected corners, the rest fits: a note
+  kStandsOut,  // bad detections: inliers far above the median view's, too
+               // many corners rejected, or the rejection emptied it
+  kViewError,  // a smooth residual field across the board (view-level)
+};
+
+struct ViewJudgement {
+  ViewStanding standing = ViewStanding::kNotUsed;
+  double inlier_rms_px = 0;  // RMS per coordinate of its inlier corners
+  int corners = 0;           // corners in the calibration, rejected ones too
+  int rejected = 0;          // rejected as outliers
+  double worst_rejected_px = 0;  // largest error of a rejected corner
+  std::string why;  // for kHandled, kStandsOut and kViewError, with figures
+};
+
 struct Verdict {
   VerdictKind kind = VerdictKind::kGood;
   std::string reason;     // what the evidence shows, with figures
@@ -183,6 +204,13 @@ struct Verdict {
   // The same for the view-level errors finding.
   std::string view_errors;
   std::string view_errors_next_step;
+  // Every view of the result, in its order, judged by the rule above; and
+  // the rule's figures: the median view's inlier RMS and the limit above
+  // which a view's inliers stand out (view_rms_factor times the median,
+  // at least view_rms_floor_px). Empty / 0 when the result has no views.
+  std::vector<ViewJudgement> views;
+  double median_view_rms_px = 0;
+  double view_rms_limit_px = 0;
 
   // "verdict: <kind> — <reason> — <next step>"
   std::string Line() const;

@@ -1,6 +1,7 @@
 #include "report/report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -10,6 +11,7 @@
 #include <sstream>
 
 #include "formats/png_writer.h"
+#include "report/html.h"
 #include "report/overlay.h"
 #include "report/plot.h"
 #include "util/atomic_file.h"
@@ -555,13 +557,50 @@ cv::Mat PlotHistogram(const ReportData& data, const ReportOptions& options) {
   return chart.Finish();
 }
 
+// The verdict's judgement of view v (null: no verdict, or none for v).
+const ViewJudgement* JudgementOf(const ReportData& data, size_t v) {
+  const Verdict* verdict = data.input->verdict;
+  if (verdict == nullptr || v >= verdict->views.size()) return nullptr;
+  return &verdict->views[v];
+}
+
+// Whether the verdict names view v (bad detections or a view-level error).
+bool StandsOut(const ReportData& data, size_t v) {
+  const ViewJudgement* judged = JudgementOf(data, v);
+  return judged != nullptr && (judged->standing == ViewStanding::kStandsOut ||
+                               judged->standing == ViewStanding::kViewError);
+}
+
+// The used views (and views the verdict names though the calibration
+// dropped them), worst first: the views the verdict names, then by inlier
+// RMS. The table of worst views and the overlays follow this order.
+std::vector<int> ViewsWorstFirst(const ReportData& data) {
+  std::vector<int> views;
+  for (size_t v = 0; v < data.view_rms.size(); ++v) {
+    if (std::isfinite(data.view_rms[v]) || StandsOut(data, v)) {
+      views.push_back(static_cast<int>(v));
+    }
+  }
+  auto rms_or_zero = [&](int v) {
+    return std::isfinite(data.view_rms[v]) ? data.view_rms[v] : 0.0;
+  };
+  std::stable_sort(views.begin(), views.end(), [&](int a, int b) {
+    if (StandsOut(data, a) != StandsOut(data, b)) return StandsOut(data, a);
+    return rms_or_zero(a) > rms_or_zero(b);
+  });
+  return views;
+}
+
 cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
   const int num_views = static_cast<int>(data.view_rms.size());
   const cv::Rect area(90, 80, options.chart_width - 90 - 30,
                       options.chart_height - 80 - 70);
   const double overall = data.result->rms_px;
-  const double high = options.high_rms_factor * overall;
-  double highest = high;
+  // The verdict's limit for a view's inliers (0: no verdict).
+  const double limit = data.input->verdict != nullptr
+                           ? data.input->verdict->view_rms_limit_px
+                           : 0.0;
+  double highest = std::max(limit, overall);
   int worst = -1;
   for (int v = 0; v < num_views; ++v) {
     if (std::isfinite(data.view_rms[v])) {
@@ -573,18 +612,19 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
   const double y_max = highest > 0 ? 1.12 * highest : 1;
   plot::Chart chart(options.chart_width, options.chart_height);
   chart.SetArea(area, 0.5, x_max, 0, y_max);
-  chart.Axes("", "RMS per coordinate (px)", true, /*x_numbers=*/false);
+  chart.Axes("", "RMS of the inliers per coordinate (px)", true,
+             /*x_numbers=*/false);
   const int label_every = std::max(1, (num_views + 29) / 30);
   const double bar_pitch =
       static_cast<double>(area.width) / std::max(1, num_views);
-  int num_high = 0, num_unused = 0;
+  int num_named = 0, num_unused = 0;
   std::vector<double> unused_x, unused_y;
   for (int v = 0; v < num_views; ++v) {
     if (std::isfinite(data.view_rms[v])) {
-      const bool is_high = data.view_rms[v] > high;
-      num_high += is_high;
+      const bool named = StandsOut(data, v);
+      num_named += named;
       chart.FilledRect(v + 1 - 0.375, 0, v + 1 + 0.375, data.view_rms[v],
-                       is_high ? Colour::kOrange : Colour::kBlue);
+                       named ? Colour::kOrange : Colour::kBlue);
     } else {
       ++num_unused;
       unused_x.push_back(v + 1);
@@ -602,21 +642,29 @@ cv::Mat PlotViewRms(const ReportData& data, const ReportOptions& options) {
   chart.Markers(unused_x, unused_y, plot::LegendEntry::Sample::kCross,
                 Colour::kGrey, 14);
   chart.Polyline({0.5, x_max}, {overall, overall}, Colour::kRed, 2, true);
-  chart.Polyline({0.5, x_max}, {high, high}, Colour::kOrange, 1, true);
+  if (limit > 0) {
+    chart.Polyline({0.5, x_max}, {limit, limit}, Colour::kOrange, 1, true);
+  }
   chart.CanvasText(area.x + area.width / 2.0, area.y + area.height + 46,
                    "image number (as in summary.md; red: the worst view)",
                    plot::kLabelHeight, Colour::kBlack, 0.5);
   chart.Title(
       "Reprojection RMS per view",
-      StringPrintf(
-          "%d views: %d used, %d not used; %d above %.3gx the overall RMS",
-          num_views, num_views - num_unused, num_unused, num_high,
-          options.high_rms_factor));
+      data.input->verdict != nullptr
+          ? StringPrintf("%d views: %d used, %d not used; %d named by the "
+                         "verdict",
+                         num_views, num_views - num_unused, num_unused,
+                         num_named)
+          : StringPrintf("%d views: %d used, %d not used (no verdict)",
+                         num_views, num_views - num_unused, num_unused));
   chart.Legend(
       {{plot::LegendEntry::Sample::kBox, Colour::kBlue, "view RMS"},
        {plot::LegendEntry::Sample::kBox, Colour::kOrange,
-        StringPrintf("view RMS above %gx overall (dashed): check the image",
-                     options.high_rms_factor)},
+        limit > 0 ? StringPrintf("named by the verdict (inliers above %.3f "
+                                 "px, dashed; many rejected corners; a "
+                                 "smooth field)",
+                                 limit)
+                  : std::string("named by the verdict")},
        {plot::LegendEntry::Sample::kDashedLine, Colour::kRed,
         StringPrintf("overall RMS %.3f px", overall)},
        {plot::LegendEntry::Sample::kCross, Colour::kGrey,
@@ -904,13 +952,12 @@ std::string SafeStem(const std::string& file) {
 // what was dropped), then the best; each view once.
 std::vector<std::pair<int, std::string>> PickOverlayViews(
     const ReportData& data, int count) {
-  std::vector<int> used;
-  for (size_t v = 0; v < data.view_rms.size(); ++v) {
-    if (std::isfinite(data.view_rms[v])) used.push_back(static_cast<int>(v));
-  }
-  std::stable_sort(used.begin(), used.end(), [&](int a, int b) {
-    return data.view_rms[a] > data.view_rms[b];
-  });
+  // Overlays show views with inliers only.
+  std::vector<int> used = ViewsWorstFirst(data);
+  used.erase(
+      std::remove_if(used.begin(), used.end(),
+                     [&](int v) { return !std::isfinite(data.view_rms[v]); }),
+      used.end());
   const int n = std::min<int>(count, used.size());
   const int num_worst = (n + 1) / 2;
   int most_outliers = -1;
@@ -934,8 +981,9 @@ std::vector<std::pair<int, std::string>> PickOverlayViews(
                                        data.view_outliers[most_outliers]));
       if (static_cast<int>(picked.size()) >= num_worst) break;
     }
-    take(used[k],
-         k == 0 ? "worst view" : StringPrintf("%d. worst view", k + 1));
+    take(used[k], StandsOut(data, used[k]) ? std::string("named by the verdict")
+                  : k == 0                 ? std::string("worst view")
+                           : StringPrintf("%d. worst view", k + 1));
   }
   for (int k = 0;
        k < static_cast<int>(used.size()) && static_cast<int>(picked.size()) < n;
@@ -1015,9 +1063,6 @@ bool ReportOptions::Check(std::string* why) const {
   }
   if (overlay_width < 400 || overlay_width > 10000) {
     return fail("overlay_width must be in [400, 10000]");
-  }
-  if (!(high_rms_factor > 1) || !std::isfinite(high_rms_factor)) {
-    return fail("high_rms_factor must be > 1");
   }
   std::string load_why;
   if (!load.Check(&load_why)) return fail("load: " + load_why);
@@ -1320,45 +1365,61 @@ void MarkdownParameters(const CalibrationResult& result,
   md << "\n\n";
 }
 
-// The used views of highest RMS.
+// The views the verdict names (bad detections, view-level errors), then
+// the other used views of highest inlier RMS, up to num_worst_views rows in
+// all (every named view gets a row).
 void MarkdownWorstViews(const ReportData& data, const CalibrationResult& result,
                         const ReportOptions& options, std::ostringstream& md) {
-  std::vector<int> used;
-  for (size_t v = 0; v < data.view_rms.size(); ++v) {
-    if (std::isfinite(data.view_rms[v])) used.push_back(static_cast<int>(v));
-  }
-  std::stable_sort(used.begin(), used.end(), [&](int a, int b) {
-    return data.view_rms[a] > data.view_rms[b];
-  });
+  const std::vector<int> used = ViewsWorstFirst(data);
   md << "## Worst views\n\n";
-  if (!used.empty()) {
-    md << StringPrintf(
-        "Highest RMS of the %zu used views (overall %.3f px).\n\n", used.size(),
-        result.rms_px);
-  }
   if (used.empty()) {
     md << "No view was used.\n\n";
-  } else {
-    md << "| # | image | RMS (px) | corners used | outliers | |\n"
-          "|---:|---|---:|---:|---:|---|\n";
-    for (int k = 0;
-         k < options.num_worst_views && k < static_cast<int>(used.size());
-         ++k) {
-      const int v = used[k];
-      const bool high =
-          data.view_rms[v] > options.high_rms_factor * result.rms_px;
-      md << "| " << data.view_number[v] << " | "
-         << Cell(FileName(data.view_file[v])) << " | "
-         << StringPrintf("%.3f", data.view_rms[v]) << " | "
-         << data.view_inliers[v] << " | " << data.view_outliers[v] << " | "
-         << (high ? StringPrintf("above %gx the overall RMS: check the image "
-                                 "(blur, a bent or moving board, wrong ids)",
-                                 options.high_rms_factor)
-                  : std::string(""))
-         << " |\n";
-    }
-    md << "\n";
+    return;
   }
+  const Verdict* verdict = data.input->verdict;
+  md << StringPrintf(
+      "The views the verdict names, then the highest inlier "
+      "RMS of the %zu used views (overall %.3f px",
+      used.size(), result.rms_px);
+  if (verdict != nullptr && verdict->view_rms_limit_px > 0) {
+    md << StringPrintf(
+        "; the median view's %.3f px, a view's inliers stand "
+        "out above %.3f px",
+        verdict->median_view_rms_px, verdict->view_rms_limit_px);
+  }
+  md << ").\n\n";
+  md << "| # | image | RMS (px) | corners used | outliers | verdict |\n"
+        "|---:|---|---:|---:|---:|---|\n";
+  for (int k = 0; k < static_cast<int>(used.size()); ++k) {
+    const int v = used[k];
+    if (k >= options.num_worst_views && !StandsOut(data, v)) break;
+    const ViewJudgement* judged = JudgementOf(data, v);
+    std::string standing;
+    if (judged != nullptr) {
+      switch (judged->standing) {
+        case ViewStanding::kStandsOut:
+          standing = "bad detections: " + judged->why;
+          break;
+        case ViewStanding::kViewError:
+          standing = "view-level error: " + judged->why;
+          break;
+        case ViewStanding::kHandled:
+          standing = "handled: " + judged->why;
+          break;
+        case ViewStanding::kFits:
+        case ViewStanding::kNotUsed:
+          break;
+      }
+    }
+    md << "| " << data.view_number[v] << " | "
+       << Cell(FileName(data.view_file[v])) << " | "
+       << (std::isfinite(data.view_rms[v])
+               ? StringPrintf("%.3f", data.view_rms[v])
+               : std::string("-"))
+       << " | " << data.view_inliers[v] << " | " << data.view_outliers[v]
+       << " | " << Cell(standing) << " |\n";
+  }
+  md << "\n";
 }
 
 // One row per input image: outcome, corners, RMS and details.
@@ -1408,7 +1469,7 @@ void MarkdownTime(const ReportInput& input, std::ostringstream& md) {
   }
 }
 
-// What each chart and overlay shows and how to read it.
+// Each chart and overlay, embedded, with what it shows and how to read it.
 void MarkdownPlots(const Camera& camera,
                    const std::vector<std::string>& png_files,
                    std::ostringstream& md) {
@@ -1420,54 +1481,53 @@ void MarkdownPlots(const Camera& camera,
       overlays.push_back(file);
       continue;
     }
-    md << "- `" << file << "`: ";
+    md << "### " << file << "\n\n![" << file << "](" << file << ")\n\n";
     if (file == "residuals.png") {
-      md << "an arrow from every detected corner towards its reprojection, "
+      md << "An arrow from every detected corner towards its reprojection, "
             "magnified (factor in the title). Random directions are noise; "
             "arrows that line up over a region show model error there. "
-            "Outliers are red.\n";
+            "Outliers are red.";
     } else if (file == "residual_histogram.png") {
-      md << "lengths of the residuals; for Gaussian corner noise the bars "
+      md << "Lengths of the residuals; for Gaussian corner noise the bars "
             "follow the orange curve. A long tail means bad corners or a "
-            "model that does not fit.\n";
+            "model that does not fit.";
     } else if (file == "view_rms.png") {
-      md << "RMS of each view; orange bars stand out and deserve a look at "
-            "the image (blur, motion, a bent board).\n";
+      md << "RMS of each view's inlier corners; orange bars are the views "
+            "the verdict names (the rule of the table of worst views), "
+            "which deserve a look at the image (blur, motion, a bent "
+            "board).";
     } else if (file == "coverage.png") {
-      md << "used corners per image cell; white cells saw no corner and the "
+      md << "Used corners per image cell; white cells saw no corner and the "
             "model is extrapolated there. Fill them with more views, "
-            "especially near the image corners.\n";
+            "especially near the image corners.";
     } else if (file == "distortion.png") {
-      md << "how far the model moves each pixel compared with the same "
+      md << "How far the model moves each pixel compared with the same "
             "camera without distortion"
          << (CameraModelIsPinhole(camera.model)
                  ? " (a pinhole)"
                  : " (the equidistant fisheye r = f * theta); hatched: rays "
                    "more than 90 deg off the axis")
          << ". White lines mark the angle of the ray from the optical "
-            "axis.\n";
-    } else if (const std::string about = EvidenceChartDescription(file);
+            "axis.";
+    } else if (std::string about = EvidenceChartDescription(file);
                !about.empty()) {
-      md << about << "\n";
-    } else {
-      md << "\n";
+      about[0] = static_cast<char>(std::toupper(about[0]));
+      md << about;
     }
+    md << "\n\n";
   }
   if (!overlays.empty()) {
     // PickOverlayViews order: the worst views first, then the best.
     const size_t worst = (overlays.size() + 1) / 2;
-    md << "- ";
-    for (size_t k = 0; k < overlays.size(); ++k) {
-      md << (k == 0       ? ""
-             : k == worst ? " and "
-                          : ", ")
-         << "`" << overlays[k] << "`"
-         << (k + 1 == worst ? " (the worst views by RMS)" : "")
-         << (k + 1 == overlays.size() && k >= worst ? " (the best)" : "");
-    }
-    md << ": the view image with its detected corners (green circles; red = "
+    md << "### Views over their photos\n\n"
+          "Each view's image with its detected corners (green circles; red = "
           "outlier) and their reprojections by the calibrated model (magenta "
-          "crosses), which should sit inside the circles.\n";
+          "crosses), which should sit inside the circles: first the worst "
+          "views, in the order of the table of worst views, then the best.\n\n";
+    for (size_t k = 0; k < overlays.size(); ++k) {
+      md << "![" << overlays[k] << (k < worst ? " (worst)" : " (best)") << "]("
+         << overlays[k] << ")\n\n";
+    }
   }
 }
 
@@ -1659,6 +1719,10 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
     return false;
   }
   summary->files.insert(summary->files.begin(), "summary.md");
+  // The same as one web page with the plots inline, for readers without a
+  // Markdown viewer.
+  if (!WriteHtmlReport(dir, "Calibration report", error)) return false;
+  summary->files.insert(summary->files.begin() + 1, "index.html");
   return true;
 }
 

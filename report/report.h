@@ -73,9 +73,6 @@ struct ReportOptions {
   // Width in pixels of the overlays: view images are scaled (up or down) to
   // it, so markers and text keep a readable size. Default 1400.
   int overlay_width = 1400;
-  // A view whose RMS exceeds this factor times the overall RMS is marked in
-  // the per-view chart and the summary. Default 2.
-  double high_rms_factor = 2.0;
   // Limits for re-loading view images for the overlays.
   ImageLoadOptions load;
 

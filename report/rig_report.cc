@@ -10,6 +10,7 @@
 
 #include "formats/image_io.h"
 #include "formats/png_writer.h"
+#include "report/html.h"
 #include "report/overlay.h"
 #include "report/plot.h"
 #include "util/atomic_file.h"
@@ -356,6 +357,26 @@ cv::Mat RectifiedPairImage(const cv::Mat& first, const cv::Mat& second,
   return DrawOverlay(pair, overlay, OverlayOptions());
 }
 
+// The first shared frame of a stereo pair, rectified, with horizontal
+// lines (rectified_pair.png).
+bool WriteRectifiedPair(const std::string& dir, const RigReportInput& input,
+                        int pair_frame, const StereoRectification& rect,
+                        const RigReportOptions& options, std::string* error) {
+  const RigCalibrationResult& result = *input.result;
+  cv::Mat first, second;
+  if (!LoadGreyImage(input.files[0][pair_frame], ImageLoadOptions(), &first,
+                     error) ||
+      !LoadGreyImage(input.files[1][pair_frame], ImageLoadOptions(), &second,
+                     error)) {
+    return false;
+  }
+  const cv::Mat pair =
+      RectifiedPairImage(first, second, result.cameras[0].camera,
+                         result.cameras[1].camera, rect, options);
+  return WritePngFile((fs::path(dir) / "rectified_pair.png").string(), pair,
+                      error);
+}
+
 bool WriteRigReport(const std::string& dir, const RigReportInput& input,
                     const RigReportOptions& options, std::string* error) {
   std::string why;
@@ -408,20 +429,12 @@ bool WriteRigReport(const std::string& dir, const RigReportInput& input,
           RigSummary(input, charts, pair_frame >= 0, rect_note), error)) {
     return false;
   }
-  if (pair_frame < 0) return true;
-  const RigCalibrationResult& result = *input.result;
-  cv::Mat first, second;
-  if (!LoadGreyImage(input.files[0][pair_frame], ImageLoadOptions(), &first,
-                     error) ||
-      !LoadGreyImage(input.files[1][pair_frame], ImageLoadOptions(), &second,
-                     error)) {
+  if (pair_frame >= 0 &&
+      !WriteRectifiedPair(dir, input, pair_frame, rect, options, error)) {
     return false;
   }
-  const cv::Mat pair =
-      RectifiedPairImage(first, second, result.cameras[0].camera,
-                         result.cameras[1].camera, rect, options);
-  return WritePngFile((fs::path(dir) / "rectified_pair.png").string(), pair,
-                      error);
+  // The same as one web page with the pictures inline.
+  return WriteHtmlReport(dir, "Rig calibration report", error);
 }
 
 }  // namespace puzzlecal

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages that puzzlecal's build and tests need;
 # with --full also those of the benchmarks and the fuzzers (clang with its
-# libFuzzer runtime, Google Benchmark), which only `scripts/test.sh --full`
-# builds. Idempotent: does nothing when all are present.
+# libFuzzer runtime, Google Benchmark) and Debian's chromium (a test opens the
+# report's web page in it; without it that test is skipped), which only
+# `scripts/test.sh --full` needs. Idempotent: does nothing when all are present.
 set -euo pipefail
 
 full=0
@@ -24,7 +25,8 @@ packages=(
   python3-setuptools python3-pip python3-venv python3-yaml
 )
 if [ "$full" = 1 ]; then
-  packages+=(libbenchmark-dev clang libclang-rt-14-dev)
+  # chromium: the report's web page is opened in a real headless browser.
+  packages+=(libbenchmark-dev clang libclang-rt-14-dev chromium)
 fi
 
 missing=()

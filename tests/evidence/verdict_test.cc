@@ -359,6 +359,21 @@ TEST(Verdict, OneFalseCornerIsANoteNotABadView) {
   for (const Eigen::Vector2d& r : residuals) sum2 += r.squaredNorm();
   EXPECT_GT(std::sqrt(sum2 / (2.0 * residuals.size())),
             VerdictOptions().view_rms_factor * 0.1);
+  // The per-view judgement the report's table and chart use says the same:
+  // this view handled, every other view fits.
+  ASSERT_EQ(judged.verdict.views.size(), data.views.size());
+  for (size_t v = 0; v < data.views.size(); ++v) {
+    EXPECT_EQ(judged.verdict.views[v].standing,
+              v == 3 ? ViewStanding::kHandled : ViewStanding::kFits)
+        << "view " << v;
+  }
+  EXPECT_EQ(judged.verdict.views[3].rejected, 1);
+  EXPECT_GT(judged.verdict.views[3].worst_rejected_px, 8.0);
+  EXPECT_NEAR(judged.verdict.view_rms_limit_px,
+              std::max(VerdictOptions().view_rms_factor *
+                           judged.verdict.median_view_rms_px,
+                       VerdictOptions().view_rms_floor_px),
+              1e-12);
 }
 
 // A third of a view's corners off by 6-8 px (a mislabelled stretch of the
@@ -381,6 +396,15 @@ TEST(Verdict, AViewWithManyRejectedCornersStandsOut) {
       << judged.verdict.reason;
   EXPECT_NE(judged.verdict.reason.find("corners rejected"), std::string::npos)
       << judged.verdict.reason;
+  // Exactly the view the reason names stands out in the per-view judgement.
+  ASSERT_EQ(judged.verdict.views.size(), data.views.size());
+  for (size_t v = 0; v < data.views.size(); ++v) {
+    const ViewStanding standing = judged.verdict.views[v].standing;
+    EXPECT_EQ(standing == ViewStanding::kStandsOut, v == 7) << "view " << v;
+  }
+  EXPECT_NE(judged.verdict.reason.find(judged.verdict.views[7].why),
+            std::string::npos)
+      << judged.verdict.views[7].why;
 }
 
 // The rational model on a lens without the rational terms: its

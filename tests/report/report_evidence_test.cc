@@ -15,6 +15,7 @@
 #include "evidence/verdict.h"
 #include "report/report.h"
 #include "sim/synthetic_views.h"
+#include "tests/evidence/judge.h"
 #include "tests/support/files.h"
 
 namespace puzzlecal {
@@ -90,6 +91,54 @@ TEST(ReportEvidence, VerdictHeadsTheSummaryAndPlotsAreWritten) {
       " |";
   EXPECT_NE(markdown.find(first_bin), std::string::npos) << first_bin;
   fs::remove_all(dir);
+}
+
+// One rule names views: a view whose inliers fit but a third of whose
+// corners were rejected stands out in the verdict, and the report's table
+// of worst views puts it first with the verdict's reason, although views of
+// higher inlier RMS exist.
+TEST(ReportEvidence, WorstViewsFollowTheVerdictsRule) {
+  const Camera truth = sim::TruthRadtan();
+  sim::SyntheticData data =
+      sim::MakeSyntheticData(testing_judge::TiltedScene(truth, 24, 0.1, 29));
+  CalibrationView& view = data.views[7];
+  for (size_t i = 0; i < view.image_points.size(); i += 3) {
+    const double sign = i % 2 == 0 ? 1.0 : -1.0;
+    view.image_points[i] += sign * Eigen::Vector2d(6, 4);
+  }
+  const testing_judge::Judged judged =
+      testing_judge::Judge(data.views, truth.model, truth.width, truth.height);
+  ASSERT_TRUE(judged.calibrated) << judged.error;
+  ASSERT_EQ(judged.verdict.views[7].standing, ViewStanding::kStandsOut);
+  int higher_rms = 0;
+  for (size_t v = 0; v < data.views.size(); ++v) {
+    higher_rms += judged.result.view_rms_px[v] > judged.result.view_rms_px[7];
+  }
+  ASSERT_GT(higher_rms, 0) << "the view should not lead by its RMS alone";
+
+  ReportInput input;
+  input.result = &judged.result;
+  input.views = &data.views;
+  input.evidence = &judged.evidence;
+  input.verdict = &judged.verdict;
+  for (size_t v = 0; v < data.views.size(); ++v) {
+    ReportImage image;
+    image.file = data.views[v].name + ".png";
+    image.outcome = ImageOutcome::kUsable;
+    image.use = ViewUse::kUsed;
+    image.view_index = static_cast<int>(v);
+    input.images.push_back(image);
+  }
+  const std::string markdown = ReportMarkdown(input, ReportOptions(), {});
+  const size_t table = markdown.find("|---:|", markdown.find("## Worst views"));
+  ASSERT_NE(table, std::string::npos) << markdown;
+  const size_t first_row = markdown.find('\n', table) + 1;
+  const std::string row =
+      markdown.substr(first_row, markdown.find('\n', first_row) - first_row);
+  EXPECT_NE(row.find(view.name + ".png"), std::string::npos) << row;
+  EXPECT_NE(row.find("bad detections: " + judged.verdict.views[7].why),
+            std::string::npos)
+      << row;
 }
 
 }  // namespace

@@ -134,6 +134,27 @@ void MakeRun(const sim::SyntheticScene& scene, const fs::path& image_dir,
   run->input.threads = 2;
 }
 
+// RFC 4648 base64, decoded independently of the writer's encoder.
+std::string Base64Decode(const std::string& text) {
+  const std::string alphabet =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  int bits = 0;
+  uint32_t buffer = 0;
+  for (char c : text) {
+    if (c == '=') break;
+    const size_t value = alphabet.find(c);
+    if (value == std::string::npos) return "";
+    buffer = buffer << 6 | static_cast<uint32_t>(value);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out += static_cast<char>((buffer >> bits) & 0xff);
+    }
+  }
+  return out;
+}
+
 sim::SyntheticScene SmallRadtanScene() {
   sim::SyntheticScene scene;
   scene.camera = sim::MakeCamera(
@@ -316,10 +337,93 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
       << worst;
   // Timing and the plot list.
   EXPECT_NE(markdown.find("| whole run | 2.50 |"), std::string::npos);
+  // Every picture is embedded in summary.md, and index.html holds each one
+  // inline: the bytes of its data: URI are the file's.
+  ASSERT_EQ(summary.files.size() > 1 ? summary.files[1] : "", "index.html");
+  const std::string page = ReadFile(report_dir / "index.html");
+  int inlined = 0;
   for (const std::string& file : summary.files) {
-    if (file == "summary.md") continue;
-    EXPECT_NE(markdown.find("`" + file + "`"), std::string::npos) << file;
+    if (file == "summary.md" || file == "index.html") continue;
+    EXPECT_NE(markdown.find("](" + file + ")"), std::string::npos) << file;
+    ++inlined;
   }
+  const std::string data_uri = "src=\"data:image/png;base64,";
+  std::vector<std::string> decoded;
+  for (size_t at = page.find(data_uri); at != std::string::npos;
+       at = page.find(data_uri, at + 1)) {
+    const size_t begin = at + data_uri.size();
+    decoded.push_back(
+        Base64Decode(page.substr(begin, page.find('"', begin) - begin)));
+  }
+  ASSERT_EQ(static_cast<int>(decoded.size()), inlined);
+  for (const std::string& file : summary.files) {
+    if (file == "summary.md" || file == "index.html") continue;
+    EXPECT_NE(
+        std::find(decoded.begin(), decoded.end(), ReadFile(report_dir / file)),
+        decoded.end())
+        << file << " is not inlined byte for byte";
+  }
+  RemoveUnlessKept(dir);
+}
+
+// Loads `page` in Debian's chromium, headless, and returns what a script
+// added to a copy of it finds: "decoded N of M" images (every <img> that
+// finished loading with a width); "" when chromium cannot be run.
+std::string ImagesDecodedInChromium(const fs::path& page,
+                                    const fs::path& scratch) {
+  const std::string check =
+      "<script>window.addEventListener('load', () => {"
+      "const images = Array.from(document.images);"
+      "const decoded = images.filter(i => i.complete && i.naturalWidth > 0);"
+      "document.title = 'decoded ' + decoded.length + ' of ' + "
+      "images.length;});</script>";
+  std::string html = ReadFile(page);
+  const size_t body_end = html.rfind("</body>");
+  if (body_end == std::string::npos) return "no </body>";
+  html.insert(body_end, check);
+  const fs::path copy = scratch / "check.html";
+  testing_files::WriteFile(copy, html);
+  const fs::path dom = scratch / "dom.html";
+  const std::string command =
+      "chromium --headless --no-sandbox --disable-gpu --no-first-run "
+      "--user-data-dir=" +
+      (scratch / "profile").string() +
+      " --virtual-time-budget=10000 --dump-dom 'file://" + copy.string() +
+      "' >'" + dom.string() + "' 2>/dev/null";
+  if (std::system(command.c_str()) != 0) return "";
+  const std::string out = ReadFile(dom);
+  const size_t title = out.find("<title>");
+  if (title == std::string::npos) return "";
+  return out.substr(title + 7, out.find("</title>", title) - title - 7);
+}
+
+// The page a report writes, opened in a real browser: every picture in it
+// decodes (issue: the report as a page, checked in a headless browser).
+TEST(ReportTest, IndexHtmlShowsEveryPictureInABrowser) {
+  if (std::system("command -v chromium >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "chromium is not installed (scripts/install_deps.sh "
+                    "--full installs it)";
+  }
+  const fs::path dir = FreshDir("browser");
+  const fs::path image_dir = dir / "images";
+  fs::create_directories(image_dir);
+  SyntheticRun run;
+  MakeRun(SmallRadtanScene(), image_dir, /*render=*/true, &run);
+  ASSERT_TRUE(run.calibrated) << run.calibrate_error;
+  std::string error;
+  ReportSummary summary;
+  const fs::path report_dir = dir / "report";
+  ASSERT_TRUE(WriteReport(report_dir.string(), run.input, ReportOptions(),
+                          &error, &summary))
+      << error;
+  int pictures = 0;
+  for (const std::string& file : summary.files) {
+    pictures += file.size() > 4 && file.substr(file.size() - 4) == ".png";
+  }
+  ASSERT_GT(pictures, 5);
+  EXPECT_EQ(ImagesDecodedInChromium(report_dir / "index.html", dir),
+            "decoded " + std::to_string(pictures) + " of " +
+                std::to_string(pictures));
   RemoveUnlessKept(dir);
 }
 
