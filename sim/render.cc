@@ -105,6 +105,11 @@ bool RenderOptions::Check(std::string* why) const {
   if (!IsFiniteRange(field_of_view_deg, 0.0, 360.0)) {
     return Fail("field_of_view_deg must be in [0, 360]", why);
   }
+  if (!IsFiniteRange(motion_blur.length_px, 0.0, 200.0) ||
+      !std::isfinite(motion_blur.angle_deg)) {
+    return Fail("motion_blur: length_px must be in [0, 200], angle_deg finite",
+                why);
+  }
   for (size_t i = 0; i < occluders.size(); ++i) {
     const Occluder& o = occluders[i];
     if (!o.center_px.allFinite() || !IsFiniteRange(o.radius_px, 0.0, 1e6) ||
@@ -433,6 +438,31 @@ void ApplyImageCircle(const PixelRayGrid& rays, double field_of_view_deg,
   });
 }
 
+// The kernel of a straight streak of `blur.length_px` through its centre:
+// the segment sampled finely, each sample splatted bilinearly, normalised.
+// Point-symmetric about the centre, so it moves no edge crossing.
+cv::Mat1f MotionKernel(const MotionBlur& blur) {
+  const double angle = blur.angle_deg * M_PI / 180.0;
+  const double dx = std::cos(angle), dy = std::sin(angle);
+  const int half = static_cast<int>(std::ceil(0.5 * blur.length_px)) + 1;
+  cv::Mat1f kernel = cv::Mat1f::zeros(2 * half + 1, 2 * half + 1);
+  const int samples = std::max(2, static_cast<int>(8 * blur.length_px));
+  for (int k = 0; k < samples; ++k) {
+    // Symmetric samples: t and -t both taken.
+    const double t = blur.length_px * ((k + 0.5) / samples - 0.5);
+    const double x = half + t * dx, y = half + t * dy;
+    const int x0 = static_cast<int>(std::floor(x));
+    const int y0 = static_cast<int>(std::floor(y));
+    const double fx = x - x0, fy = y - y0;
+    kernel(y0, x0) += static_cast<float>((1 - fx) * (1 - fy));
+    kernel(y0, x0 + 1) += static_cast<float>(fx * (1 - fy));
+    kernel(y0 + 1, x0) += static_cast<float>((1 - fx) * fy);
+    kernel(y0 + 1, x0 + 1) += static_cast<float>(fx * fy);
+  }
+  kernel /= cv::sum(kernel)[0];
+  return kernel;
+}
+
 // The 8-bit sensor image of the linear one: lighting gradient, vignetting,
 // gamma and Gaussian noise. Each row draws its noise from its own stream,
 // so the image is the same for any thread count.
@@ -533,6 +563,10 @@ cv::Mat RenderBoard(const Board& board, const PixelRayGrid& rays,
   if (options.blur_sigma_px > 0) {
     cv::GaussianBlur(linear, linear, cv::Size(0, 0), options.blur_sigma_px,
                      options.blur_sigma_px, cv::BORDER_REPLICATE);
+  }
+  if (options.motion_blur.length_px > 0) {
+    cv::filter2D(linear, linear, -1, MotionKernel(options.motion_blur),
+                 cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
   }
   cv::Mat1b image = ToSensorImage(linear, options);
 

@@ -35,6 +35,15 @@ struct PatternVariant {
   bool inverted = false;
 };
 
+// Motion during the exposure: the image streaks along a straight line of
+// `length_px`, centred on where the board is at the middle of the exposure
+// (the truth), so the streak does not move the corners' true positions, it
+// only smears them.
+struct MotionBlur {
+  double length_px = 0.0;  // streak length in pixels; 0 = none; in [0, 200]
+  double angle_deg = 0.0;  // its direction: 0 along +x, 90 along +y (down)
+};
+
 // Everything that turns the ideal pattern into a realistic 8-bit image.
 struct RenderOptions {
   // Supersamples per pixel along each axis (n x n per pixel) for
@@ -50,8 +59,8 @@ struct RenderOptions {
   double background_level = 0.45;
   // White paper around the printed pattern, in tiles. The pattern itself
   // ends half a tile outside the outermost inner corners for a PuzzleBoard
-  // (docs/puzzleboard.md's half border tiles) and one full tile outside for a plain
-  // checkerboard; this margin comes on top. >= 0.
+  // (docs/puzzleboard.md's half border tiles) and one full tile outside for a
+  // plain checkerboard; this margin comes on top. >= 0.
   double paper_margin_tiles = 1.0;
   // Linear lighting gradient across the image: relative change of brightness
   // from the left to the right edge (0 = uniform).
@@ -71,6 +80,8 @@ struct RenderOptions {
   // from the optical axis are black, which draws a fisheye's image circle;
   // 0 = unlimited. In [0, 360].
   double field_of_view_deg = 0.0;
+  // Motion blur (after the optical blur).
+  MotionBlur motion_blur;
   // Discs drawn over the image after the board (occluders).
   std::vector<Occluder> occluders;
   // True pattern or a variant for refusal tests.

@@ -110,14 +110,26 @@ bool ParseOccluders(const YAML::Node& map, const std::string& path,
   return true;
 }
 
+// An optional `motion_blur: {length_px, angle_deg}` of `map`.
+bool ParseMotionBlur(const YAML::Node& map, const std::string& path,
+                     FieldReader* r, MotionBlur* blur) {
+  const YAML::Node node = map["motion_blur"];
+  if (!node) return true;
+  const std::string blur_path = FieldReader::Join(path, "motion_blur");
+  return r->OnlyKeys(node, blur_path, {"length_px", "angle_deg"}) &&
+         r->Double(node, blur_path, "length_px", kRequired, &blur->length_px) &&
+         r->Double(node, blur_path, "angle_deg", kOptional, &blur->angle_deg);
+}
+
 bool ParseRender(const YAML::Node& node, FieldReader* r,
                  RenderOptions* options) {
   const std::string path = "render";
-  if (!r->OnlyKeys(node, path,
-                   {"supersampling", "blur_sigma_px", "black_level",
-                    "white_level", "background_level", "paper_margin_tiles",
-                    "lighting_gradient", "vignetting", "gamma", "noise_sigma",
-                    "seed", "field_of_view_deg", "occluders", "variant"})) {
+  if (!r->OnlyKeys(
+          node, path,
+          {"supersampling", "blur_sigma_px", "black_level", "white_level",
+           "background_level", "paper_margin_tiles", "lighting_gradient",
+           "vignetting", "gamma", "noise_sigma", "seed", "field_of_view_deg",
+           "motion_blur", "occluders", "variant"})) {
     return false;
   }
   RenderOptions& o = *options;
@@ -137,6 +149,7 @@ bool ParseRender(const YAML::Node& node, FieldReader* r,
       !r->Uint64(node, path, "seed", kOptional, &o.seed) ||
       !r->Double(node, path, "field_of_view_deg", kOptional,
                  &o.field_of_view_deg) ||
+      !ParseMotionBlur(node, path, r, &o.motion_blur) ||
       !ParseOccluders(node, path, r, &o.occluders)) {
     return false;
   }
@@ -196,8 +209,9 @@ bool ParseViews(const YAML::Node& list, FieldReader* r, const Board& board,
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string path = "views[" + std::to_string(i) + "]";
     const YAML::Node node = list[i];
-    if (!r->OnlyKeys(node, path,
-                     {"name", "pose", "cam_from_board", "occluders"})) {
+    if (!r->OnlyKeys(
+            node, path,
+            {"name", "pose", "cam_from_board", "occluders", "motion_blur"})) {
       return false;
     }
     SceneViewSpec spec;
@@ -230,7 +244,10 @@ bool ParseViews(const YAML::Node& list, FieldReader* r, const Board& board,
     } else {
       return r->Fail(path, "needs 'pose' or 'cam_from_board'");
     }
-    if (!ParseOccluders(node, path, r, &spec.occluders)) return false;
+    if (!ParseOccluders(node, path, r, &spec.occluders) ||
+        !ParseMotionBlur(node, path, r, &spec.motion_blur)) {
+      return false;
+    }
     views->push_back(spec);
   }
   return true;
@@ -361,6 +378,14 @@ void EmitOccluders(YAML::Emitter& out, const std::vector<Occluder>& list) {
   out << YAML::EndSeq;
 }
 
+void EmitMotionBlur(YAML::Emitter& out, const MotionBlur& blur) {
+  out << YAML::Key << "motion_blur" << YAML::Value << YAML::Flow
+      << YAML::BeginMap;
+  EmitExactField(out, "length_px", blur.length_px);
+  EmitExactField(out, "angle_deg", blur.angle_deg);
+  out << YAML::EndMap;
+}
+
 void EmitRender(YAML::Emitter& out, const RenderOptions& o) {
   out << YAML::Key << "render" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "supersampling" << YAML::Value << o.supersampling;
@@ -375,6 +400,7 @@ void EmitRender(YAML::Emitter& out, const RenderOptions& o) {
   EmitExactField(out, "noise_sigma", o.noise_sigma);
   out << YAML::Key << "seed" << YAML::Value << o.seed;
   EmitExactField(out, "field_of_view_deg", o.field_of_view_deg);
+  if (o.motion_blur.length_px > 0) EmitMotionBlur(out, o.motion_blur);
   if (!o.occluders.empty()) EmitOccluders(out, o.occluders);
   out << YAML::Key << "variant" << YAML::Value << YAML::Flow << YAML::BeginMap;
   out << YAML::Key << "random_code_seed" << YAML::Value
@@ -579,6 +605,9 @@ std::string SceneRecipeYaml(const SceneSpec& scene) {
       out << YAML::Key << "name" << YAML::Value << view.name;
       EmitCamFromBoard(out, view.cam_from_board);
       if (!view.occluders.empty()) EmitOccluders(out, view.occluders);
+      if (view.motion_blur.length_px > 0) {
+        EmitMotionBlur(out, view.motion_blur);
+      }
       out << YAML::EndMap;
     }
     out << YAML::EndSeq;

@@ -275,6 +275,9 @@ std::vector<SceneView> RenderScene(const SceneSpec& scene, std::string* why) {
     options.occluders.insert(options.occluders.end(),
                              specs[i].occluders.begin(),
                              specs[i].occluders.end());
+    if (specs[i].motion_blur.length_px > 0) {
+      options.motion_blur = specs[i].motion_blur;
+    }
     SceneView view;
     view.name = specs[i].name;
     RenderSummary summary;

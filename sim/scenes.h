@@ -79,6 +79,8 @@ struct SceneViewSpec {
   std::string name;  // file stem, e.g. "view_003"
   Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
   std::vector<Occluder> occluders;
+  // Motion blur of this view alone (none: the scene's render options).
+  MotionBlur motion_blur;
 };
 
 // Random poses: each draws uniformly from the ranges below (degrees, metres).

@@ -244,6 +244,7 @@ TEST_F(ConfigIoTest, EveryRecipeFieldRoundTrips) {
   o.seed = 12345678901234ull;
   o.field_of_view_deg = 120.0 / 7.0 * 7.0 + 1.0 / 3.0;
   o.occluders = {{Eigen::Vector2d(10.1, 20.2), 3.3, 0.25}};
+  o.motion_blur = {3.25, 17.0 / 3.0};
   o.variant.random_code_seed = 99;
   o.variant.mirrored = true;
   o.variant.inverted = true;
@@ -253,6 +254,7 @@ TEST_F(ConfigIoTest, EveryRecipeFieldRoundTrips) {
       Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()).toRotationMatrix();
   view.cam_from_board.translation() = Eigen::Vector3d(-0.3, -0.2, 0.9);
   view.occluders = {{Eigen::Vector2d(40.0 / 3.0, 7.0), 5.0, 0.75}};
+  view.motion_blur = {7.5, -40};  // this view's own, over the scene's
   scene.views = {view};
   RandomViews& rv = scene.random_views;
   rv.count = 2;
