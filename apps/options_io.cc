@@ -292,6 +292,8 @@ struct Fields<VerdictOptions> {
     v.Field("halves_factor", o.halves_factor);
     v.Field("halves_floor_px", o.halves_floor_px);
     v.Field("halves_min_bands", o.halves_min_bands);
+    v.Field("halves_max_scale", o.halves_max_scale);
+    v.Field("halves_uniform_floor_px", o.halves_uniform_floor_px);
     v.Field("halves_min_z", o.halves_min_z);
     v.Field("residual_se_factor", o.residual_se_factor);
     v.Field("residual_floor_px", o.residual_floor_px);

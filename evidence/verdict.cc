@@ -85,6 +85,39 @@ double HalvesScale(const CrossValidation& cv, int min_count,
 
 // ---- the findings of MakeVerdict, one function per kind of evidence ----
 
+// Inconsistent views: the halves differ by more than shared corner errors
+// can explain in every band (VerdictOptions::halves_max_scale), by a
+// difference that matters in pixels.
+void AddUniformHalvesFinding(const CrossValidation& cv, double halves_scale,
+                             int min_count, const VerdictOptions& options,
+                             std::vector<Finding>* findings) {
+  if (!cv.ok || halves_scale <= options.halves_max_scale) return;
+  const AngleBand* best = nullptr;
+  double best_ratio = 0;
+  for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
+    const AngleBand& d = cv.difference_bands[b];
+    const AngleBand& e = cv.expected_bands[b];
+    if (d.count < min_count || !(e.median > 0)) continue;
+    if (best == nullptr || d.median / e.median < best_ratio) {
+      best = &d;
+      best_ratio = d.median / e.median;
+    }
+  }
+  if (best == nullptr || !(best->median > options.halves_uniform_floor_px)) {
+    return;
+  }
+  findings->push_back(
+      {VerdictKind::kInconsistentViews,
+       Printf("the two halves of the views differ %.1f times more than their "
+              "uncertainty predicts in every field-angle band, by %.2f px or "
+              "more (median, at %.0f",
+              halves_scale, best->median, best->lo_deg) +
+           Printf("-%.0f deg where they agree best); corner errors shared "
+                  "within views explain up to about %.0f times, so the "
+                  "halves do not see one camera",
+                  best->hi_deg, options.halves_max_scale)});
+}
+
 // Model error: a field-angle band where the halves differ far beyond their
 // (scaled) predicted difference.
 void AddHalvesFindings(const CrossValidation& cv, double halves_scale,
@@ -652,6 +685,13 @@ bool VerdictOptions::Check(std::string* why) const {
   if (!(halves_factor > 0)) return Fail("halves_factor must be > 0", why);
   if (!(halves_floor_px >= 0)) return Fail("halves_floor_px must be >= 0", why);
   if (halves_min_bands < 0) return Fail("halves_min_bands must be >= 0", why);
+  if (!(halves_max_scale >= 1) || !std::isfinite(halves_max_scale)) {
+    return Fail("halves_max_scale must be >= 1", why);
+  }
+  if (!(halves_uniform_floor_px >= 0) ||
+      !std::isfinite(halves_uniform_floor_px)) {
+    return Fail("halves_uniform_floor_px must be >= 0", why);
+  }
   if (!std::isfinite(halves_min_z)) {
     return Fail("halves_min_z must be finite", why);
   }
@@ -748,6 +788,7 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   const double halves_scale = HalvesScale(cv, min_count, options);
   std::vector<Finding> findings;
   AddHalvesFindings(cv, halves_scale, min_count, options, &findings);
+  AddUniformHalvesFinding(cv, halves_scale, min_count, options, &findings);
   AddInconsistentViewFindings(evidence.view_consistency, options, &findings);
   const bool grows_with_closeness = AddSystematicResidualFindings(
       evidence.residuals, min_count, options, &findings);

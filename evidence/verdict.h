@@ -55,6 +55,18 @@ struct VerdictOptions {
   // exceeds 1, and the halves_factor test applies to the scaled
   // prediction. 0 turns the scaling off. Default 3.
   int halves_min_bands = 3;
+  // How far that excuse goes. Corner errors shared within views inflate the
+  // halves' difference by a factor of about 1.5-2.5 on real photo sets
+  // that calibrate well (1.66 on the 256-photo deltille fisheye set, 2.15
+  // on a 26-photo 180-degree fisheye), and up to about 10 on renders, whose
+  // corners are so exact (0.03 px) that the differences stay under 0.1 px.
+  // An excess above halves_max_scale in every band, with the best-agreeing
+  // band's median difference above halves_uniform_floor_px, is no shared
+  // corner error: the halves do not see one camera (focus, zoom or the
+  // board changed between photos), an inconsistent-views finding. Defaults
+  // 4 and 0.25 px.
+  double halves_max_scale = 4.0;
+  double halves_uniform_floor_px = 0.25;
   // A band's excess is judged a model error only when the halves' free
   // intrinsics as a whole also differ by more than their covariances allow:
   // the chi-square of their difference (CrossValidation::intrinsics_chi2),
