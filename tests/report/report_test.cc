@@ -385,7 +385,8 @@ std::string ImagesDecodedInChromium(const fs::path& page,
   testing_files::WriteFile(copy, html);
   const fs::path dom = scratch / "dom.html";
   const std::string command =
-      "chromium --headless --no-sandbox --disable-gpu --no-first-run "
+      "chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage "
+      "--no-first-run "
       "--user-data-dir=" +
       (scratch / "profile").string() +
       " --virtual-time-budget=10000 --dump-dom 'file://" + copy.string() +
