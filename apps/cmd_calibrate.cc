@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "apps/common_flags.h"
+#include "apps/fixed_params.h"
 #include "apps/options_io.h"
 #include "apps/report_folder.h"
 #include "apps/subcommand.h"
@@ -34,6 +35,7 @@
 #include "formats/image_io.h"
 #include "pipeline/pipeline.h"
 #include "report/report.h"
+#include "util/string_format.h"
 #include "util/timer.h"
 
 namespace puzzlecal {
@@ -48,14 +50,19 @@ constexpr char kUsage[] =
     "[--report DIR] [--threads N]\n"
     "                    [--rostopic TOPIC] [--camera-name NAME] "
     "[--quiet | --verbose]\n"
-    "                    [--options FILE]  (`puzzlecal options` writes one)\n\n"
+    "                    [--options FILE]  (`puzzlecal options` writes one)\n"
+    "                    [--fix NAMES] [--initial camera.yaml]\n\n"
     "Calibrates a camera from every image in DIR (png, jpg, tif, bmp; 8 or 16 "
     "bit; grey or colour)\nshowing the board of BOARD.yaml. --out is the "
     "camera file to write (a file path in an\nexisting folder; --format "
     "chooses what it holds). The camera file is written first and\n"
     "atomically; the report folder is replaced as a whole. A run that cannot "
     "produce a\ntrustworthy result exits non-zero and writes no camera "
-    "file.\n\nExit codes: 0 done, 2 bad command line, 3 bad input, 4 no "
+    "file.\n\n--fix holds parameters at their start (k3,p1,p2 as OpenCV's "
+    "CALIB_FIX_K3 and\nCALIB_ZERO_TANGENT_DIST; focal, principal-point, "
+    "distortion, all); --initial starts\nfrom a camera file (its model), so "
+    "--initial cam.yaml --fix all fits only the poses.\n\nExit codes: 0 done, "
+    "2 bad command line, 3 bad input, 4 no "
     "trustworthy result,\n5 an output cannot be written (checked before the "
     "work starts), 130 interrupted.";
 
@@ -247,6 +254,11 @@ struct CalibrateRequest {
   // The format decides the model's free parameters (Kalibr's radtan has no
   // k3), so they are settled here.
   CalibrationOptions calibration_options;
+  // The parameters the user holds (options file and --fix), added to the
+  // format's once the model is known.
+  std::vector<std::string> user_fixed;
+  // --initial: the camera to start from (empty params: none).
+  Camera initial;
   RunOptions options;  // --options FILE, or the defaults
   int threads = 1;
   Board board;
@@ -268,6 +280,62 @@ struct CalibrationRun {
   double seconds_load = 0, seconds_detect = 0, seconds_grid_decode = 0;
   double seconds_calibrate = 0;
 };
+
+// --initial FILE: the camera to start from. Its model is the run's unless
+// --model names another (a usage error) or auto (which would not start
+// from it).
+int ParseInitialCamera(CalibrateRequest* request) {
+  if (FLAGS_initial.empty()) return kExitOk;
+  std::string error;
+  if (!ReadCameraFile(FLAGS_initial, &request->initial, &error)) {
+    std::cerr << "puzzlecal calibrate: --initial: " << error << "\n";
+    return kExitBadInput;
+  }
+  const bool model_given =
+      !gflags::GetCommandLineFlagInfoOrDie("model").is_default;
+  if (model_given &&
+      (request->auto_model || request->model != request->initial.model)) {
+    std::cerr << "puzzlecal calibrate: --initial " << FLAGS_initial
+              << " holds a " << CameraModelName(request->initial.model)
+              << " camera, --model says " << FLAGS_model
+              << "; leave --model out to calibrate the file's model.\n";
+    return kExitUsage;
+  }
+  request->auto_model = false;
+  request->model = request->initial.model;
+  request->calibration_options.initial_params = request->initial.params;
+  return kExitOk;
+}
+
+// The user's fixed parameters (options file, --fix) for the run's model,
+// on top of the format's. Returns kExitOk or kExitUsage, having said why.
+int AddUserFixed(CalibrateRequest* request) {
+  std::vector<std::string> names;
+  std::string error;
+  if (!ExpandFixedParams(FLAGS_fix, request->model, &names, &error)) {
+    std::cerr << "puzzlecal calibrate: --fix: " << error << ".\n";
+    return kExitUsage;
+  }
+  for (const std::string& name : request->user_fixed) {
+    std::vector<std::string> one;
+    if (!ExpandFixedParams(name, request->model, &one, &error)) {
+      std::cerr << "puzzlecal calibrate: calibration.fixed_params: " << error
+                << ".\n";
+      return kExitUsage;
+    }
+    AddFixedParams(one, &names);
+  }
+  AddFixedParams(names, &request->calibration_options.fixed_params);
+  if (request->calibration_options.fixed_params.size() ==
+      static_cast<size_t>(CameraModelNumParams(request->model))) {
+    std::cerr << "puzzlecal calibrate: every parameter of "
+              << CameraModelName(request->model)
+              << " is held: nothing to calibrate (calibrate-rig --initial "
+                 "NAME=FILE --fix all fits a rig's poses to known cameras).\n";
+    return kExitUsage;
+  }
+  return kExitOk;
+}
 
 // Flags, formats, outputs, the board file and the image folder. Returns
 // kExitOk or the exit code, having said why.
@@ -291,6 +359,11 @@ int ParseRequest(CalibrateRequest* request) {
     return kExitBadInput;
   }
   request->calibration_options = request->options.calibration;
+  request->user_fixed = request->calibration_options.fixed_params;
+  request->calibration_options.fixed_params.clear();
+  if (const int code = ParseInitialCamera(request); code != kExitOk) {
+    return code;
+  }
   if (!CameraFileFormatFromName(FLAGS_format, &request->format)) {
     std::cerr << "puzzlecal calibrate: unknown format '" << FLAGS_format
               << "'; choose one of puzzlecal, opencv, ros, kalibr.\n";
@@ -303,6 +376,9 @@ int ParseRequest(CalibrateRequest* request) {
     std::cerr << "puzzlecal calibrate: --format " << FLAGS_format << ": "
               << error << ".\n";
     return kExitUsage;
+  }
+  if (!request->auto_model) {
+    if (const int code = AddUserFixed(request); code != kExitOk) return code;
   }
   if (FLAGS_threads < 0) {
     std::cerr << "puzzlecal calibrate: --threads must be >= 0.\n";
@@ -392,7 +468,7 @@ int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
               << error << "; choose --model explicitly.\n";
     return kExitUsage;
   }
-  return kExitOk;
+  return AddUserFixed(request);
 }
 
 // The model (--model auto chooses it), the calibration, its evidence
@@ -412,6 +488,13 @@ int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
       BoardMismatchMessage(run->images, request.board, FLAGS_board);
   if (run->views.empty()) {
     run->calibration_error = "no image gave a view";
+  } else if (!request.initial.params.empty() &&
+             (request.initial.width != run->width ||
+              request.initial.height != run->height)) {
+    run->calibration_error = StringPrintf(
+        "--initial %s is a camera of %d x %d pixels, the photos are %d x %d",
+        FLAGS_initial.c_str(), request.initial.width, request.initial.height,
+        run->width, run->height);
   } else {
     run->calibrated = Calibrate(run->views, request.model, run->width,
                                 run->height, request.calibration_options,
@@ -559,7 +642,7 @@ PUZZLECAL_REGISTER_SUBCOMMAND(calibrate, "calibrate",
                               kUsage,
                               {"images", "board", "model", "out", "format",
                                "report", "threads", "rostopic", "camera_name",
-                               "options"},
+                               "options", "fix", "initial"},
                               &RunCalibrate);
 
 }  // namespace

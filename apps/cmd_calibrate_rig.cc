@@ -2,7 +2,6 @@
 // a report) out.
 
 #include <glog/logging.h>
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -18,6 +17,7 @@
 #include <vector>
 
 #include "apps/common_flags.h"
+#include "apps/fixed_params.h"
 #include "apps/options_io.h"
 #include "apps/report_folder.h"
 #include "apps/subcommand.h"
@@ -98,6 +98,11 @@ struct RigRequest {
   // Per camera, the parameters the format holds fixed (Kalibr's radtan has
   // no k3).
   std::vector<std::vector<std::string>> format_fixed;
+  // The parameters the user holds (options file and --fix), added per
+  // camera once its model is known.
+  std::vector<std::string> user_fixed;
+  // --initial NAME=FILE: per camera folder name, the camera to start from.
+  std::map<std::string, Camera> initial;
   Board board;
   int threads = 1;
   RunOptions options;  // --options FILE, or the defaults
@@ -168,6 +173,23 @@ int ParseRigRequest(RigRequest* request) {
     std::cerr << kName << ": " << error << "\n";
     return kExitBadInput;
   }
+  request->user_fixed = request->options.calibration.fixed_params;
+  request->options.calibration.fixed_params.clear();
+  request->options.rig.camera.fixed_params.clear();
+  for (const std::string& item : SplitCommas(FLAGS_initial)) {
+    const size_t equals = item.find('=');
+    Camera camera;
+    if (equals == std::string::npos || equals == 0) {
+      std::cerr << kName << ": --initial takes NAME=FILE per camera folder "
+                << "(got '" << item << "').\n";
+      return kExitUsage;
+    }
+    if (!ReadCameraFile(item.substr(equals + 1), &camera, &error)) {
+      std::cerr << kName << ": --initial: " << error << "\n";
+      return kExitBadInput;
+    }
+    request->initial[item.substr(0, equals)] = camera;
+  }
   if (!LoadBoardFile(FLAGS_board, &request->board, &error)) {
     std::cerr << kName << ": " << error << "\n";
     return kExitBadInput;
@@ -188,6 +210,27 @@ int ParseRigRequest(RigRequest* request) {
                                             &request->auto_model);
       code != kExitOk) {
     return code;
+  }
+  for (const auto& [name, camera] : request->initial) {
+    const auto folder = std::find_if(
+        request->folders.begin(), request->folders.end(),
+        [&](const fs::path& f) { return f.filename().string() == name; });
+    if (folder == request->folders.end()) {
+      std::cerr << kName << ": --initial names camera '" << name
+                << "', which is not a camera folder of " << FLAGS_images
+                << ".\n";
+      return kExitUsage;
+    }
+    const size_t c = folder - request->folders.begin();
+    if (!request->auto_model[c] && request->models[c] != camera.model &&
+        !gflags::GetCommandLineFlagInfoOrDie("model").is_default) {
+      std::cerr << kName << ": --initial for camera '" << name << "' holds a "
+                << CameraModelName(camera.model) << " camera, --model says "
+                << CameraModelName(request->models[c]) << ".\n";
+      return kExitUsage;
+    }
+    request->models[c] = camera.model;  // the known camera's model
+    request->auto_model[c] = false;
   }
   request->format_fixed.resize(request->folders.size());
   for (size_t c = 0; c < request->folders.size(); ++c) {
@@ -248,9 +291,10 @@ int ChooseModel(const RigRequest& request, RigCameraInput* input) {
     return kExitNoResult;
   }
   input->model = selection.candidates[selection.chosen].model;
-  if (!FLAGS_quiet) std::cerr << "camera '" << input->name << "': --model auto chose "
-            << CameraModelName(input->model) << " (" << selection.reason
-            << ")\n";
+  if (!FLAGS_quiet)
+    std::cerr << "camera '" << input->name << "': --model auto chose "
+              << CameraModelName(input->model) << " (" << selection.reason
+              << ")\n";
   if (!CameraFormatFixedParams(request.format, input->model,
                                &input->fixed_params, &error)) {
     std::cerr << kName << ": --format " << FLAGS_format << ", camera '"
@@ -258,6 +302,38 @@ int ChooseModel(const RigRequest& request, RigCameraInput* input) {
               << CameraModelName(input->model) << "): " << error << ".\n";
     return kExitUsage;
   }
+  return kExitOk;
+}
+
+// The user's fixed parameters (options file, --fix) for camera `input`'s
+// model, and its --initial camera. Returns kExitOk or the exit code, having
+// said why.
+int AddKnownCamera(const RigRequest& request, RigCameraInput* input) {
+  std::vector<std::string> names;
+  std::string error;
+  std::vector<std::string> lists = request.user_fixed;
+  lists.push_back(FLAGS_fix);
+  for (const std::string& list : lists) {
+    std::vector<std::string> one;
+    if (!ExpandFixedParams(list, input->model, &one, &error)) {
+      std::cerr << kName << ": camera '" << input->name << "': fixed "
+                << "parameters: " << error << ".\n";
+      return kExitUsage;
+    }
+    AddFixedParams(one, &names);
+  }
+  AddFixedParams(names, &input->fixed_params);
+  const auto known = request.initial.find(input->name);
+  if (known == request.initial.end()) return kExitOk;
+  if (known->second.width != input->width ||
+      known->second.height != input->height) {
+    std::cerr << kName << ": --initial for camera '" << input->name
+              << "' is a camera of " << known->second.width << " x "
+              << known->second.height << " pixels, its photos are "
+              << input->width << " x " << input->height << ".\n";
+    return kExitBadInput;
+  }
+  input->initial_params = known->second.params;
   return kExitOk;
 }
 
@@ -285,8 +361,14 @@ int DetectCamera(const RigRequest& request, size_t c,
     std::cerr << "camera '" << input->name << "': " << usable << " of "
               << images.size() << " images usable\n";
   }
-  if (usable > 0)
-    return request.auto_model[c] ? ChooseModel(request, input) : kExitOk;
+  if (usable > 0) {
+    if (request.auto_model[c]) {
+      if (const int code = ChooseModel(request, input); code != kExitOk) {
+        return code;
+      }
+    }
+    return AddKnownCamera(request, input);
+  }
   std::cerr << kName << ": camera '" << input->name << "' ("
             << request.folders[c].string()
             << "): no image shows the board; no calibration written.\n";
@@ -448,9 +530,9 @@ int RunCalibrateRig() {
   }
   g_rig_written = 1;
   if (!FLAGS_report.empty()) {
-    if (!WriteReport(result, calibrated, calibration_error, judged,
-                     frame_files, seconds_images, run_timer.Seconds(),
-                     request.threads, &error)) {
+    if (!WriteReport(result, calibrated, calibration_error, judged, frame_files,
+                     seconds_images, run_timer.Seconds(), request.threads,
+                     &error)) {
       for (const std::string& path : written) {
         std::cout << "wrote " << path << "\n";
       }
@@ -468,7 +550,7 @@ PUZZLECAL_REGISTER_SUBCOMMAND(
     calibrate_rig, "calibrate-rig",
     "calibrate a multi-camera rig from one photo folder per camera", kUsage,
     {"images", "board", "model", "out", "format", "report", "threads",
-     "options", "match_by_order", "quiet"},
+     "options", "match_by_order", "quiet", "fix", "initial"},
     &RunCalibrateRig);
 
 }  // namespace

@@ -31,6 +31,14 @@ DEFINE_string(options, "",
               "model_selection and rig settings; a field it leaves out keeps "
               "its default. --threads and --format (its fixed parameters) "
               "win over it.");
+DEFINE_string(fix, "",
+              "Parameters held at their start (comma-separated names such as "
+              "k3,p1,p2, or the groups focal, principal-point, distortion, "
+              "all), on top of the options file's calibration.fixed_params.");
+DEFINE_string(initial, "",
+              "Start from this camera file (any format puzzlecal reads); with "
+              "--fix all only the poses are fitted. calibrate-rig: "
+              "NAME=FILE,... per camera folder.");
 DEFINE_bool(quiet, false, "Print only errors and what was written.");
 DEFINE_bool(verbose, false,
             "Print every image's outcome and the timings as well.");

@@ -18,6 +18,8 @@ DECLARE_int32(dpi);
 DECLARE_string(rostopic);
 DECLARE_string(camera_name);
 DECLARE_string(options);
+DECLARE_string(fix);
+DECLARE_string(initial);
 
 DECLARE_bool(quiet);
 DECLARE_bool(verbose);

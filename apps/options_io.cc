@@ -197,10 +197,11 @@ struct Fields<EdgeBitOptions> {
 
 template <>
 struct Fields<CalibrationOptions> {
-  // Not here: fixed_params (--format decides them) and num_threads
-  // (--threads).
+  // Not here: num_threads (--threads). fixed_params are held on top of the
+  // ones --format needs (Kalibr's radtan: k3) and --fix names.
   template <typename V, typename O>
   static void Visit(V& v, O& o) {
+    v.Field("fixed_params", o.fixed_params);
     v.Field("fix_focal_length", o.fix_focal_length);
     v.Field("fix_principal_point", o.fix_principal_point);
     v.Field("fix_distortion", o.fix_distortion);

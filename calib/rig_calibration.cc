@@ -479,6 +479,9 @@ bool CalibrateEachCamera(const std::vector<RigCameraInput>& cameras,
     camera_options.fixed_params.insert(camera_options.fixed_params.end(),
                                        cameras[c].fixed_params.begin(),
                                        cameras[c].fixed_params.end());
+    if (!cameras[c].initial_params.empty()) {
+      camera_options.initial_params = cameras[c].initial_params;
+    }
     single_ok[c] = Calibrate(cameras[c].frames, cameras[c].model,
                              cameras[c].width, cameras[c].height,
                              camera_options, &(*single)[c], &single_error[c]);

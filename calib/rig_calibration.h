@@ -42,6 +42,10 @@ struct RigCameraInput {
   // top of the options' fixed_params; e.g. {"k3"} for a pinhole-radtan
   // camera written to Kalibr's 4-coefficient radtan. Default empty.
   std::vector<std::string> fixed_params;
+  // Starting intrinsics of this camera (a known calibration), in the
+  // model's order; empty (the default): automatic initialisation. With
+  // every parameter in fixed_params, only the rig's poses are fitted.
+  std::vector<double> initial_params;
 };
 
 // A plain checkerboard whose corner grid maps onto itself under a half turn

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "util/failure.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
@@ -268,6 +269,31 @@ bool RigRunOptions::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+
+// Whether every intrinsic of a calibration was held (a known camera).
+bool IntrinsicsHeld(const CalibrationResult& result) {
+  return !result.param_fixed.empty() &&
+         std::all_of(result.param_fixed.begin(), result.param_fixed.end(),
+                     [](bool fixed) { return fixed; });
+}
+
+// The verdict of a camera whose intrinsics were given and held: nothing of
+// the lens was calibrated here, so nothing of it is judged; the rig's
+// poses are (the rig verdict).
+Verdict HeldIntrinsicsVerdict(const CalibrationResult& result) {
+  Verdict verdict;
+  verdict.kind = VerdictKind::kGood;
+  verdict.reason = StringPrintf(
+      "its intrinsics were given and held (every parameter fixed), not "
+      "calibrated or judged here; its views fit them with RMS %.3f px",
+      result.rms_px);
+  verdict.next_step = "none: the rig's poses are judged below";
+  return verdict;
+}
+
+}  // namespace
+
 bool CalibrateAndJudgeRig(
     const Board& board, const std::vector<RigCameraInput>& inputs,
     const std::vector<std::vector<std::string>>& frame_files,
@@ -288,8 +314,11 @@ bool CalibrateAndJudgeRig(
     const RigCameraResult& cam = out->result.cameras[c];
     out->evidence.push_back(ComputeEvidence(
         inputs[c].frames, cam.single, options.rig.camera, options.evidence));
-    out->verdicts.push_back(MakeVerdict(cam.single, out->evidence.back(),
-                                        options.evidence, options.verdict));
+    out->verdicts.push_back(IntrinsicsHeld(cam.single)
+                                ? HeldIntrinsicsVerdict(cam.single)
+                                : MakeVerdict(cam.single, out->evidence.back(),
+                                              options.evidence,
+                                              options.verdict));
   }
   JudgeRig(inputs, options.rig_evidence, frame_files, out);
   return true;

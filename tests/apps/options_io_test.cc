@@ -132,8 +132,10 @@ TEST_F(OptionsIoTest, WrittenDefaultsReadBackAsTheDefaults) {
   EXPECT_EQ(read.rig.min_shared_frames, defaults.rig.min_shared_frames);
   // The fields that are flags only are not in the file.
   EXPECT_EQ(text.find("num_threads"), std::string::npos);
-  EXPECT_EQ(text.find("fixed_params"), std::string::npos);
   EXPECT_EQ(text.find("run_decode"), std::string::npos);
+  // The fixed parameters are the file's to set (--fix adds to them).
+  EXPECT_NE(text.find("fixed_params: []"), std::string::npos);
+  EXPECT_EQ(read.calibration.fixed_params, defaults.calibration.fixed_params);
 }
 
 TEST_F(OptionsIoTest, AFileChangesExactlyTheFieldsItSets) {
