@@ -76,7 +76,10 @@ def calibrate(source, board, model="auto", image_size=None, options=None,
         (width, height) is required).
     board: a Board.
     model: one of puzzlecal.MODELS or "auto" (chosen on held-out views).
-    options: puzzlecal.options(...) (default: the defaults).
+    options: puzzlecal.options(...) (default: the defaults); parameters
+        held at their start: ``calibration={"fixed_params": ["k3"]}``, a
+        known start: ``calibration={"initial_params": [...]}`` (the model's
+        order), as ``puzzlecal calibrate --fix`` and ``--initial``.
     threads: workers for detection and calibration (0: all cores); the
         result does not depend on it.
 

@@ -146,3 +146,28 @@ def test_options_by_keyword(board, tmp_path):
     path = tmp_path / "options.yaml"
     path.write_text(options.yaml())
     assert puzzlecal.options(str(path)).yaml() == options.yaml()
+
+
+def test_fixed_parameters_and_a_known_start(board, radtan):
+    # The options file's calibration.fixed_params and initial_params, as
+    # `puzzlecal calibrate --fix` and `--initial` use them.
+    held = puzzlecal.calibrate(
+        str(SAMPLE), board, model="pinhole-radtan", threads=2,
+        options=puzzlecal.options(calibration={
+            "fixed_params": ["k3", "p1", "p2"]}))
+    for name in ("k3", "p1", "p2"):
+        assert held.params_by_name[name] == 0.0
+        assert held.stddev_by_name[name] == 0.0
+    assert held.stddev_by_name["k1"] > 0
+    start = [radtan.params_by_name[n] for n in
+             ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")]
+    known = puzzlecal.calibrate(
+        str(SAMPLE), board, model="pinhole-radtan", threads=2,
+        options=puzzlecal.options(calibration={
+            "initial_params": start, "fixed_params": ["fx", "fy"]}))
+    assert known.params_by_name["fx"] == start[0]
+    assert known.params_by_name["fy"] == start[1]
+    with pytest.raises(ValueError, match="not a parameter of pinhole-radtan"):
+        puzzlecal.calibrate(
+            str(SAMPLE), board, model="pinhole-radtan", threads=2,
+            options=puzzlecal.options(calibration={"fixed_params": ["k9"]}))
