@@ -12,7 +12,6 @@
 #include "formats/camera_yaml.h"
 #include "sim/scene_file.h"
 
-DEFINE_string(camera, "", "Camera file (any format puzzlecal writes).");
 DEFINE_string(truth, "", "truth.yaml written by `puzzlecal render`.");
 
 namespace puzzlecal {

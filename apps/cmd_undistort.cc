@@ -15,8 +15,6 @@
 #include "formats/png_writer.h"
 #include "pipeline/undistort.h"
 
-// Defined by `compare` (a camera file in any of the four formats).
-DECLARE_string(camera);
 DEFINE_double(alpha, 0.0,
               "Field of the undistorted images, as in "
               "cv::getOptimalNewCameraMatrix: 0 = no black border, 1 = every "

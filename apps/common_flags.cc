@@ -3,11 +3,14 @@
 DEFINE_string(images, "",
               "Folder of images (png, jpg, tif, bmp), or one image file.");
 DEFINE_string(board, "", "Board definition YAML (see configs/boards/).");
+DEFINE_string(camera, "",
+              "Camera file (any format puzzlecal reads: puzzlecal, opencv, "
+              "ros, kalibr).");
 DEFINE_string(out, "",
               "Output. calibrate: the camera file (.yaml); detect: the "
               "detections file (.yaml); board: the page (.svg, .pdf or .png); "
-              "render and undistort: a folder (created if missing). Files go "
-              "into an existing, writable folder.");
+              "render, undistort, check and diff: a folder (created if "
+              "missing). Files go into an existing, writable folder.");
 DEFINE_string(model, "pinhole-radtan",
               "Camera model: pinhole-radtan, pinhole-rational, "
               "kannala-brandt, kannala-brandt-noncentral, or auto (calibrate: "

@@ -7,6 +7,7 @@
 
 DECLARE_string(images);
 DECLARE_string(board);
+DECLARE_string(camera);
 DECLARE_string(out);
 DECLARE_string(model);
 DECLARE_string(format);

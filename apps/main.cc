@@ -110,14 +110,21 @@ bool IsLoggingFlag(const std::string& name) {
 }
 
 // Parses `args` (after the subcommand; args[0] is the program) as
-// --name=value, --name value, --bool_flag and --nobool_flag. Unknown flags,
-// flags the subcommand does not read, bad values and stray arguments are
-// errors (gflags would exit with 1 on its own; the documented code is 2).
+// --name=value, --name value, --bool_flag and --nobool_flag, and the plain
+// arguments the subcommand takes (max_arguments) into `plain`. Unknown
+// flags, flags the subcommand does not read, bad values and stray
+// arguments are errors (gflags would exit with 1 on its own; the
+// documented code is 2).
 bool ParseSubcommandFlags(const Subcommand& subcommand,
-                          const std::vector<char*>& args, std::string* error) {
+                          const std::vector<char*>& args,
+                          std::vector<std::string>* plain, std::string* error) {
   for (size_t i = 1; i < args.size(); ++i) {
     std::string arg = args[i];
     if (arg.size() < 2 || arg[0] != '-') {
+      if (static_cast<int>(plain->size()) < subcommand.max_arguments) {
+        plain->push_back(arg);
+        continue;
+      }
       *error = "unexpected argument '" + arg + "'";
       return false;
     }
@@ -209,7 +216,8 @@ int Main(int argc, char** argv) {
     return kExitOk;
   }
   std::string error;
-  if (!ParseSubcommandFlags(*it, args, &error)) {
+  std::vector<std::string> plain;
+  if (!ParseSubcommandFlags(*it, args, &plain, &error)) {
     std::cerr << "puzzlecal " << name << ": " << error << ". Run `puzzlecal "
               << name << " --help`.\n";
     return kExitUsage;
@@ -227,6 +235,7 @@ int Main(int argc, char** argv) {
     FLAGS_minloglevel = google::GLOG_ERROR;
   }
   google::InitGoogleLogging(argv[0]);
+  SetSubcommandArguments(plain);
   return it->run();
 }
 

@@ -8,6 +8,11 @@ std::vector<Subcommand>& Registry() {
   return registry;
 }
 
+std::vector<std::string>& Arguments() {
+  static std::vector<std::string> arguments;
+  return arguments;
+}
+
 }  // namespace
 
 bool RegisterSubcommand(const Subcommand& subcommand) {
@@ -16,5 +21,11 @@ bool RegisterSubcommand(const Subcommand& subcommand) {
 }
 
 const std::vector<Subcommand>& Subcommands() { return Registry(); }
+
+const std::vector<std::string>& SubcommandArguments() { return Arguments(); }
+
+void SetSubcommandArguments(const std::vector<std::string>& arguments) {
+  Arguments() = arguments;
+}
 
 }  // namespace puzzlecal

@@ -16,11 +16,15 @@ struct Subcommand {
   std::vector<std::string> flags;
   // Runs with flags already parsed; returns the process exit code.
   int (*run)();
+  // How many plain arguments (file names, anywhere among the flags) it
+  // takes; 0: none, a stray word is a usage error.
+  int max_arguments = 0;
 };
 
 // Process exit codes (documented in README.md).
 enum ExitCode {
   kExitOk = 0,
+  kExitDrifted = 1,      // check: the calibration has drifted
   kExitUsage = 2,        // bad command line, unknown subcommand or model
   kExitBadInput = 3,     // unreadable or invalid input file or folder
   kExitNoResult = 4,     // inputs fine but no trustworthy result (too few
@@ -30,6 +34,11 @@ enum ExitCode {
 
 bool RegisterSubcommand(const Subcommand& subcommand);
 const std::vector<Subcommand>& Subcommands();
+
+// The plain arguments of the command line (see max_arguments), in order;
+// set by main.cc before the subcommand runs.
+const std::vector<std::string>& SubcommandArguments();
+void SetSubcommandArguments(const std::vector<std::string>& arguments);
 
 }  // namespace puzzlecal
 

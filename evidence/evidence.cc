@@ -14,6 +14,7 @@
 
 #include "util/failure.h"
 #include "util/parallel_for.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
@@ -290,6 +291,8 @@ std::vector<AngleBand> SummarizeByAngle(const PixelMap& map,
     band.count = static_cast<int>(values.size());
     band.median = Quantile(values, 0.5);
     band.p95 = Quantile(values, 0.95);
+    band.max =
+        values.empty() ? kNaN : *std::max_element(values.begin(), values.end());
     bands.push_back(band);
   }
   return bands;
@@ -553,57 +556,85 @@ bool CalibrateHalves(const std::vector<CalibrationView>& views,
   return true;
 }
 
-// The rays of both halves at the grid pixels of `map` within the observed
-// field; valid[k] where both unproject and B's pixel Jacobian exists
-// (g[k]: the derivative of B's projection with respect to a small rotation
-// of the ray).
-struct HalvesRays {
+// The rays of two cameras at the grid pixels of `map` (camera A's grid)
+// within the field limit (0: none): unprojected[k] where both cameras
+// unproject the pixel; valid[k] where, besides, A projects its ray back
+// (`reference`, the pixel the difference is measured from) and B's pixel
+// Jacobian exists (g[k]: the derivative of B's projection with respect to
+// a small rotation of the ray).
+struct PairRays {
   std::vector<Eigen::Vector3d> a, b;
+  std::vector<Eigen::Vector2d> reference;
   std::vector<Eigen::Matrix<double, 2, 3>> g;
-  std::vector<bool> unprojected;  // both halves unproject the pixel
-  std::vector<bool> valid;        // and B's pixel Jacobian exists
+  std::vector<bool> unprojected;
+  std::vector<bool> valid;
 };
 
-HalvesRays RaysOfHalves(const CrossValidation& out, const PixelMap& map,
-                        const Camera& camera, double max_angle_deg) {
-  HalvesRays rays;
-  rays.a.resize(map.values.size());
-  rays.b.resize(map.values.size());
-  rays.g.resize(map.values.size());
-  rays.unprojected.assign(map.values.size(), false);
-  rays.valid.assign(map.values.size(), false);
+PairRays RaysOfPair(const Camera& a, const Camera& b, const PixelMap& map,
+                    double max_angle_deg) {
+  PairRays rays;
+  const size_t n = map.values.size();
+  rays.a.resize(n);
+  rays.b.resize(n);
+  rays.reference.resize(n);
+  rays.g.resize(n);
+  rays.unprojected.assign(n, false);
+  rays.valid.assign(n, false);
   for (int j = 0; j < map.rows; ++j) {
     for (int i = 0; i < map.cols; ++i) {
       const int k = j * map.cols + i;
       const double angle = map.angle_deg[k];
-      if (!std::isfinite(angle) || angle > max_angle_deg) continue;
-      const Eigen::Vector2d pixel = MapPixel(map, camera, i, j);
-      if (!out.camera_a.Unproject(pixel, &rays.a[k]).converged ||
-          !out.camera_b.Unproject(pixel, &rays.b[k]).converged) {
+      if (!std::isfinite(angle) ||
+          (max_angle_deg > 0 && angle > max_angle_deg)) {
+        continue;
+      }
+      const Eigen::Vector2d pixel = MapPixel(map, a, i, j);
+      if (!a.Unproject(pixel, &rays.a[k]).converged ||
+          !b.Unproject(pixel, &rays.b[k]).converged) {
         continue;
       }
       rays.unprojected[k] = true;
       Eigen::MatrixXd unused;
-      rays.valid[k] = PixelJacobians(out.camera_b, pixel, &unused, &rays.g[k]);
+      rays.valid[k] = ProjectDirection(a, rays.a[k], &rays.reference[k]) &&
+                      PixelJacobians(b, pixel, &unused, &rays.g[k]);
     }
   }
   return rays;
 }
 
-// The two halves' camera frames are each tied to their own board poses
-// only: rotating a camera frame together with all of its poses changes no
-// projection of the boards, and a small such rotation is nearly the same as
-// a shift of the principal point. Two independent fits therefore differ by
-// a rotation that is no disagreement about the lens. As mrcal does
-// (projection_diff), the rotation that best aligns the rays of the two
-// solutions over the observed field is fitted first (Kabsch: least squares
-// over the unit rays of the grid pixels), then refined by a few
+// How well `b_from_a` aligns the cameras: the pixels where B does not
+// project the turned ray, then the sum of squared differences where it does.
+struct RotationCost {
+  int unprojected = 0;
+  double sum2 = 0;
+  bool NoWorseThan(const RotationCost& other) const {
+    return unprojected < other.unprojected ||
+           (unprojected == other.unprojected && sum2 <= other.sum2);
+  }
+};
+
+RotationCost CostOfRotation(const Camera& b, const PairRays& rays,
+                            const Eigen::Matrix3d& b_from_a) {
+  RotationCost cost;
+  for (size_t k = 0; k < rays.valid.size(); ++k) {
+    if (!rays.valid[k]) continue;
+    Eigen::Vector2d projected;
+    if (ProjectDirection(b, b_from_a * rays.a[k], &projected)) {
+      cost.sum2 += (projected - rays.reference[k]).squaredNorm();
+    } else {
+      ++cost.unprojected;
+    }
+  }
+  return cost;
+}
+
+// The rotation taking A's camera frame to B's that best aligns their rays.
+// As mrcal does (projection_diff), the least-squares alignment of the unit
+// rays of the two cameras at the same pixels (Kabsch) is a start, unless
+// the identity aligns them no worse (a camera against itself); a few
 // Gauss-Newton steps on the pixel differences themselves, the measure the
-// expected figures use (RotationGauge).
-Eigen::Matrix3d FitRotationBetweenHalves(const CrossValidation& out,
-                                         const PixelMap& map,
-                                         const Camera& camera,
-                                         const HalvesRays& rays) {
+// expected figures use (RotationGauge), refine it.
+Eigen::Matrix3d FitRotation(const Camera& b, const PairRays& rays) {
   Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();
   for (size_t k = 0; k < rays.valid.size(); ++k) {
     if (rays.unprojected[k]) cross += rays.b[k] * rays.a[k].transpose();
@@ -613,22 +644,23 @@ Eigen::Matrix3d FitRotationBetweenHalves(const CrossValidation& out,
   Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
   d(2, 2) =
       (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
-  Eigen::Matrix3d b_from_a = svd.matrixU() * d * svd.matrixV().transpose();
+  const Eigen::Matrix3d kabsch = svd.matrixU() * d * svd.matrixV().transpose();
+  Eigen::Matrix3d b_from_a = Eigen::Matrix3d::Identity();
+  if (!CostOfRotation(b, rays, b_from_a)
+           .NoWorseThan(CostOfRotation(b, rays, kabsch))) {
+    b_from_a = kabsch;
+  }
   for (int iteration = 0; iteration < 3; ++iteration) {
     Eigen::Matrix3d gtg = Eigen::Matrix3d::Zero();
     Eigen::Vector3d gtr = Eigen::Vector3d::Zero();
-    for (int j = 0; j < map.rows; ++j) {
-      for (int i = 0; i < map.cols; ++i) {
-        const int k = j * map.cols + i;
-        Eigen::Vector2d projected;
-        if (!rays.valid[k] ||
-            !ProjectDirection(out.camera_b, b_from_a * rays.a[k], &projected)) {
-          continue;
-        }
-        gtg += rays.g[k].transpose() * rays.g[k];
-        gtr +=
-            rays.g[k].transpose() * (projected - MapPixel(map, camera, i, j));
+    for (size_t k = 0; k < rays.valid.size(); ++k) {
+      Eigen::Vector2d projected;
+      if (!rays.valid[k] ||
+          !ProjectDirection(b, b_from_a * rays.a[k], &projected)) {
+        continue;
       }
+      gtg += rays.g[k].transpose() * rays.g[k];
+      gtr += rays.g[k].transpose() * (projected - rays.reference[k]);
     }
     const Eigen::FullPivLU<Eigen::Matrix3d> lu(gtg);
     if (!lu.isInvertible()) break;
@@ -642,34 +674,115 @@ Eigen::Matrix3d FitRotationBetweenHalves(const CrossValidation& out,
 }
 
 // What noise alone would give at each pixel of `difference`: the two
-// halves' projection covariances add, each with its own rotation gauge
-// removed over the same field, as the comparison removes the rotation
-// between them.
-PixelMap ExpectedDifference(const CrossValidation& out,
-                            const CalibrationResult halves[2],
+// cameras' projection covariances add (a camera without one adds nothing),
+// each with its own rotation gauge removed over the same field, as the
+// comparison removes the rotation between them.
+PixelMap ExpectedDifference(const Camera& a,
+                            const Eigen::MatrixXd* covariance_a,
+                            const Camera& b,
+                            const Eigen::MatrixXd* covariance_b,
                             const PixelMap& difference, double max_angle_deg) {
   const int step = difference.step_px;
-  const Eigen::MatrixXd gauge_a =
-      RotationGauge(out.camera_a, step, max_angle_deg);
-  const Eigen::MatrixXd gauge_b =
-      RotationGauge(out.camera_b, step, max_angle_deg);
-  const PixelMap expected_a =
-      CovarianceTraceMap(out.camera_a, halves[0].covariance, step, 1.0,
-                         gauge_a.size() > 0 ? &gauge_a : nullptr);
-  const PixelMap expected_b =
-      CovarianceTraceMap(out.camera_b, halves[1].covariance, step, 1.0,
-                         gauge_b.size() > 0 ? &gauge_b : nullptr);
+  std::vector<double> variance(difference.values.size(), 0.0);
+  for (const auto& [camera, covariance] :
+       {std::pair(&a, covariance_a), std::pair(&b, covariance_b)}) {
+    if (covariance == nullptr) continue;
+    const Eigen::MatrixXd gauge = RotationGauge(*camera, step, max_angle_deg);
+    const PixelMap sigma = CovarianceTraceMap(
+        *camera, *covariance, step, 1.0, gauge.size() > 0 ? &gauge : nullptr);
+    for (size_t k = 0; k < variance.size(); ++k) {
+      variance[k] += sigma.values[k] * sigma.values[k];
+    }
+  }
   PixelMap expected = difference;
   for (size_t k = 0; k < difference.values.size(); ++k) {
     expected.values[k] =
-        std::isfinite(difference.values[k])
-            ? std::hypot(expected_a.values[k], expected_b.values[k])
-            : kNaN;
+        std::isfinite(difference.values[k]) ? std::sqrt(variance[k]) : kNaN;
   }
   return expected;
 }
 
+// Why a covariance cannot serve `camera` ("" when it can).
+std::string CovarianceProblem(const Camera& camera,
+                              const Eigen::MatrixXd* covariance,
+                              const char* name) {
+  const Eigen::Index n = CameraModelNumParams(camera.model);
+  if (covariance == nullptr ||
+      (covariance->rows() == n && covariance->cols() == n &&
+       covariance->allFinite())) {
+    return "";
+  }
+  return StringPrintf("the covariance of camera %s is not %d x %d and finite",
+                      name, static_cast<int>(n), static_cast<int>(n));
+}
+
 }  // namespace
+
+ProjectionDiff ProjectionDifference(const Camera& a, const Camera& b,
+                                    double max_angle_deg,
+                                    const EvidenceOptions& options,
+                                    const Eigen::MatrixXd* covariance_a,
+                                    const Eigen::MatrixXd* covariance_b) {
+  ProjectionDiff out;
+  std::string why;
+  if (!options.Check(&why)) {
+    out.error = "evidence options: " + why;
+    return out;
+  }
+  if (a.width <= 0 || a.height <= 0 ||
+      static_cast<int>(a.params.size()) != CameraModelNumParams(a.model) ||
+      static_cast<int>(b.params.size()) != CameraModelNumParams(b.model)) {
+    out.error =
+        "a camera without an image size or with the wrong number of "
+        "parameters";
+    return out;
+  }
+  if (a.width != b.width || a.height != b.height) {
+    out.error = StringPrintf(
+        "the cameras image different sizes (%d x %d and %d x %d pixels)",
+        a.width, a.height, b.width, b.height);
+    return out;
+  }
+  for (const std::string& problem : {CovarianceProblem(a, covariance_a, "A"),
+                                     CovarianceProblem(b, covariance_b, "B")}) {
+    if (!problem.empty()) {
+      out.error = problem;
+      return out;
+    }
+  }
+  PixelMap map = EmptyMap(a, GridStep(a, options));
+  const PairRays rays = RaysOfPair(a, b, map, max_angle_deg);
+  if (std::count(rays.valid.begin(), rays.valid.end(), true) < 3) {
+    out.error = "fewer than 3 pixels of the grid have a ray in both cameras";
+    return out;
+  }
+  out.b_from_a = FitRotation(b, rays);
+  out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDeg;
+  for (size_t k = 0; k < map.values.size(); ++k) {
+    Eigen::Vector2d projected;
+    if (rays.valid[k] &&
+        ProjectDirection(b, out.b_from_a * rays.a[k], &projected)) {
+      map.values[k] = (projected - rays.reference[k]).norm();
+      out.max_angle_deg = std::max(out.max_angle_deg, map.angle_deg[k]);
+    }
+  }
+  // The bands and gauges reach the limit asked for, else the widest pixel
+  // compared.
+  const double field_deg =
+      max_angle_deg > 0 ? max_angle_deg : out.max_angle_deg;
+  out.difference_px = map;
+  out.difference_bands =
+      SummarizeByAngle(out.difference_px, options.band_width_deg, field_deg);
+  if (covariance_a != nullptr || covariance_b != nullptr) {
+    out.expected_ok = true;
+    out.expected_px =
+        ExpectedDifference(a, covariance_a, b, covariance_b, map, field_deg);
+    out.expected_bands =
+        SummarizeByAngle(out.expected_px, options.band_width_deg, field_deg);
+  }
+  out.ok = true;
+  return out;
+}
 
 CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
                               const CalibrationResult& result,
@@ -678,7 +791,6 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
                               const EvidenceOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   CrossValidation out;
-  const Camera& camera = result.camera;
   CalibrationResult halves[2];
   if (!CalibrateHalves(views, result, calibration, &out, halves)) {
     out.seconds = SecondsSince(start);
@@ -690,30 +802,22 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
   out.rms_b_px = halves[1].rms_px;
   IntrinsicsChiSquare(halves[0], halves[1], &out.intrinsics_chi2,
                       &out.intrinsics_dof);
-
   // |project_B(R * unproject_A(pixel)) - pixel| after the rotation between
-  // the halves is taken out.
-  PixelMap map = EmptyMap(camera, GridStep(camera, options));
-  const HalvesRays rays = RaysOfHalves(out, map, camera, max_angle_deg);
-  out.b_from_a = FitRotationBetweenHalves(out, map, camera, rays);
-  out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDeg;
-  for (int j = 0; j < map.rows; ++j) {
-    for (int i = 0; i < map.cols; ++i) {
-      const int k = j * map.cols + i;
-      if (!rays.valid[k]) continue;
-      Eigen::Vector2d projected;
-      if (ProjectDirection(out.camera_b, out.b_from_a * rays.a[k],
-                           &projected)) {
-        map.values[k] = (projected - MapPixel(map, camera, i, j)).norm();
-      }
-    }
+  // the halves is taken out, against what their covariances predict.
+  const ProjectionDiff diff =
+      ProjectionDifference(out.camera_a, out.camera_b, max_angle_deg, options,
+                           &halves[0].covariance, &halves[1].covariance);
+  if (!diff.ok) {
+    out.error = "comparing the halves: " + diff.error;
+    out.seconds = SecondsSince(start);
+    return out;
   }
-  out.difference_px = map;
-  out.expected_px = ExpectedDifference(out, halves, map, max_angle_deg);
-  out.difference_bands = SummarizeByAngle(
-      out.difference_px, options.band_width_deg, max_angle_deg);
-  out.expected_bands =
-      SummarizeByAngle(out.expected_px, options.band_width_deg, max_angle_deg);
+  out.b_from_a = diff.b_from_a;
+  out.rotation_deg = diff.rotation_deg;
+  out.difference_px = diff.difference_px;
+  out.expected_px = diff.expected_px;
+  out.difference_bands = diff.difference_bands;
+  out.expected_bands = diff.expected_bands;
   out.ok = true;
   out.seconds = SecondsSince(start);
   return out;
@@ -744,6 +848,32 @@ Evidence ComputeEvidence(const std::vector<CalibrationView>& views,
   }
   evidence.seconds = SecondsSince(start);
   return evidence;
+}
+
+std::string ProjectionDifferenceText(const ProjectionDiff& diff,
+                                     const std::string& indent) {
+  if (!diff.ok) return indent + "projection difference: " + diff.error + "\n";
+  std::ostringstream text;
+  text << indent
+       << StringPrintf(
+              "rotation between the camera frames %.4f deg; compared up to "
+              "%.1f deg off the axis\n",
+              diff.rotation_deg, diff.max_angle_deg);
+  text << indent << "field angle      median      p95      max"
+       << (diff.expected_ok ? "   expected median      p95" : "") << "  (px)\n";
+  for (size_t b = 0; b < diff.difference_bands.size(); ++b) {
+    const AngleBand& d = diff.difference_bands[b];
+    if (d.count == 0) continue;
+    text << indent
+         << StringPrintf("%3.0f-%3.0f deg %9.3f %8.3f %8.3f", d.lo_deg,
+                         d.hi_deg, d.median, d.p95, d.max);
+    if (diff.expected_ok && b < diff.expected_bands.size()) {
+      const AngleBand& e = diff.expected_bands[b];
+      text << StringPrintf(" %17.3f %8.3f", e.median, e.p95);
+    }
+    text << "  n=" << d.count << "\n";
+  }
+  return text.str();
 }
 
 std::string EvidenceText(const Evidence& evidence) {

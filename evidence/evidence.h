@@ -84,6 +84,36 @@ struct AngleBand {
   int count = 0;
   double median = 0;
   double p95 = 0;
+  double max = 0;
+};
+
+// The far-field projection difference between two cameras of one image
+// size (ProjectionDifference): each grid pixel's ray under camera A, turned
+// by the rotation b_from_a that best aligns the two cameras' rays, projected
+// by camera B, against A's projection of the same ray,
+// |project_B(R * ray) - project_A(ray)| (mrcal's projection_diff). The
+// rotation is no disagreement about the lens: a camera frame is tied to its
+// calibration's board poses only, and turning it with all of them changes
+// no projection of the boards.
+struct ProjectionDiff {
+  bool ok = false;
+  std::string error;  // why not, when !ok
+  Eigen::Matrix3d b_from_a = Eigen::Matrix3d::Identity();
+  double rotation_deg = 0;  // the angle of b_from_a
+  // The widest field angle (A's ray) among the compared pixels, degrees.
+  double max_angle_deg = 0;
+  // The difference in pixels; NaN where not compared (a pixel without a ray
+  // in either camera, or beyond the field limit).
+  PixelMap difference_px;
+  // What the cameras' uncertainties alone would give, sqrt(tr(C_A(p)) +
+  // tr(C_B(p))) with each 2 x 2 projection covariance C(p) taken after its
+  // own rotation gauge over the compared field (RotationGauge), from the
+  // covariances given; `expected_ok` false (and the map empty) when none
+  // was given.
+  bool expected_ok = false;
+  PixelMap expected_px;
+  std::vector<AngleBand> difference_bands;
+  std::vector<AngleBand> expected_bands;  // empty when !expected_ok
 };
 
 struct CrossValidation {
@@ -100,7 +130,8 @@ struct CrossValidation {
   Eigen::Matrix3d b_from_a = Eigen::Matrix3d::Identity();
   double rotation_deg = 0;
   // |project_B(R * unproject_A(pixel)) - pixel| in pixels, within the
-  // observed field (field angle <= the widest inlier corner's).
+  // observed field (field angle <= the widest inlier corner's): the halves'
+  // ProjectionDifference.
   PixelMap difference_px;
   // What noise alone would give: the RMS length of the difference predicted
   // from the two halves' covariances, sqrt(tr(C_A(p)) + tr(C_B(p))), where
@@ -219,6 +250,23 @@ ProjectionUncertainty ComputeProjectionUncertainty(
     const CalibrationResult& result, double max_angle_deg,
     const EvidenceOptions& options);
 
+// The far-field projection difference of camera B against camera A (see
+// ProjectionDiff) on A's pixel grid (GridStep(a, options)), over the
+// pixels both cameras unproject whose ray under A is at most max_angle_deg
+// off the axis (0: no limit). The rotation starts from the better of the
+// identity and the least-squares alignment of the two cameras' rays at the
+// same pixels (Kabsch), and is refined by Gauss-Newton steps on the pixel
+// differences; a camera against itself gives the identity and exactly 0.
+// `covariance_a`, `covariance_b` (optional, n x n of the camera's model)
+// give the expected difference. Fails (with the reason) on cameras of
+// different image sizes, invalid options, or when fewer than 3 pixels can
+// be compared.
+ProjectionDiff ProjectionDifference(
+    const Camera& a, const Camera& b, double max_angle_deg,
+    const EvidenceOptions& options,
+    const Eigen::MatrixXd* covariance_a = nullptr,
+    const Eigen::MatrixXd* covariance_b = nullptr);
+
 // Calibrates the two halves of the used views of `result` (even and odd
 // positions among them) with `calibration` options, started from the full
 // solution, and compares them.
@@ -241,6 +289,13 @@ Evidence ComputeEvidence(const std::vector<CalibrationView>& views,
 std::vector<AngleBand> SummarizeByAngle(const PixelMap& map,
                                         double band_width_deg,
                                         double max_angle_deg);
+
+// Readable text of a projection difference: the rotation, then per
+// field-angle band the count, median, 95th percentile and maximum, with the
+// expected median and 95th percentile when known. `indent` starts every
+// line.
+std::string ProjectionDifferenceText(const ProjectionDiff& diff,
+                                     const std::string& indent = "");
 
 // Readable text of the evidence (tables of the bands, points and bins).
 std::string EvidenceText(const Evidence& evidence);

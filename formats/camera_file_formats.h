@@ -26,6 +26,9 @@ bool ParsePuzzlecal(const YAML::Node& map, const std::string& path,
                     FieldReader& r, Camera* camera);
 bool ParseViews(const YAML::Node& root, FieldReader& r,
                 std::vector<CameraFileView>* views);
+// What the file carries besides `camera` (its views included).
+bool ParseStats(const YAML::Node& root, const Camera& camera, FieldReader& r,
+                CameraFileStats* stats);
 
 // opencv and ros (camera_file_opencv_ros.cc)
 // OpenCV's FileStorage wants "%YAML:1.0" and its own matrix tag.

@@ -53,10 +53,19 @@ std::string FormatPuzzlecal(const Camera& camera,
     if (stats.param_stddev.size() == names.size()) {
       EmitNamedValues(out, "parameter_stddev", names, stats.param_stddev);
     }
+    const Eigen::Index n = static_cast<Eigen::Index>(names.size());
+    if (stats.covariance.rows() == n && stats.covariance.cols() == n) {
+      out << YAML::Key << "parameter_covariance" << YAML::Value;
+      EmitRows(out, stats.covariance);
+    }
     out << YAML::Key << "rms_px" << YAML::Value << stats.rms_px;
     out << YAML::Key << "views_used" << YAML::Value << stats.num_views_used;
     out << YAML::Key << "corners_used" << YAML::Value << stats.num_corners_used;
     out << YAML::Key << "outliers" << YAML::Value << stats.num_outliers;
+    if (stats.max_field_angle_deg > 0) {
+      out << YAML::Key << "max_field_angle_deg" << YAML::Value
+          << stats.max_field_angle_deg;
+    }
     if (!stats.verdict.empty()) {
       out << YAML::Key << "verdict" << YAML::Value << stats.verdict;
     }
@@ -124,6 +133,64 @@ bool ParseViews(const YAML::Node& root, FieldReader& r,
     views->push_back(view);
   }
   return true;
+}
+
+bool ParseStats(const YAML::Node& root, const Camera& camera, FieldReader& r,
+                CameraFileStats* stats) {
+  *stats = CameraFileStats();
+  if (!root["rms_px"]) return true;
+  stats->has_stats = true;
+  const std::vector<std::string> names = CameraModelParamNames(camera.model);
+  const int n = static_cast<int>(names.size());
+  YAML::Node stddev, covariance;
+  if (!r.Double(root, "", "rms_px", kRequired, &stats->rms_px) ||
+      !r.Int(root, "", "views_used", Presence::kOptional,
+             &stats->num_views_used) ||
+      !r.Int(root, "", "corners_used", Presence::kOptional,
+             &stats->num_corners_used) ||
+      !r.Int(root, "", "outliers", Presence::kOptional, &stats->num_outliers) ||
+      !r.Double(root, "", "max_field_angle_deg", Presence::kOptional,
+                &stats->max_field_angle_deg) ||
+      !r.String(root, "", "verdict", Presence::kOptional, &stats->verdict) ||
+      !r.Child(root, "", "parameter_stddev", Presence::kOptional, &stddev) ||
+      !r.List(root, "", "parameter_covariance", Presence::kOptional,
+              &covariance)) {
+    return false;
+  }
+  if (stddev) {
+    stats->param_stddev.assign(n, 0.0);
+    for (int k = 0; k < n; ++k) {
+      if (!r.Double(stddev, "parameter_stddev", names[k], kRequired,
+                    &stats->param_stddev[k])) {
+        return false;
+      }
+    }
+  }
+  if (covariance) {
+    const std::string field = "parameter_covariance";
+    if (static_cast<int>(covariance.size()) != n) {
+      return r.Fail(field, "expected " + std::to_string(n) + " rows for " +
+                               CameraModelName(camera.model) + ", got " +
+                               std::to_string(covariance.size()));
+    }
+    stats->covariance.resize(n, n);
+    for (int i = 0; i < n; ++i) {
+      std::vector<double> row;
+      if (!r.Numbers(covariance[i], FieldReader::Index(field, i), n, &row)) {
+        return false;
+      }
+      for (int j = 0; j < n; ++j) stats->covariance(i, j) = row[j];
+    }
+    const double asymmetry = (stats->covariance - stats->covariance.transpose())
+                                 .cwiseAbs()
+                                 .maxCoeff();
+    if (!(asymmetry <= 1e-9 * stats->covariance.cwiseAbs().maxCoeff()) ||
+        !(stats->covariance.diagonal().minCoeff() >= 0)) {
+      return r.Fail(field,
+                    "not a covariance (symmetric, with a diagonal >= 0)");
+    }
+  }
+  return ParseViews(root, r, &stats->views);
 }
 
 }  // namespace camera_file

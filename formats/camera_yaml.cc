@@ -318,6 +318,7 @@ CameraFileStats CameraFileStatsOfResult(
   CameraFileStats stats;
   stats.has_stats = true;
   stats.param_stddev = result.param_stddev;
+  if (result.covariance_ok) stats.covariance = result.covariance;
   stats.rms_px = result.rms_px;
   stats.num_views_used = result.num_views_used;
   stats.num_corners_used = result.num_corners_used;
@@ -347,6 +348,7 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
   CameraFileStats stats;
   stats.has_stats = true;
   stats.param_stddev = result.param_stddev;
+  if (result.covariance_ok) stats.covariance = result.covariance;
   stats.rms_px = result.rms_px;
   stats.num_views_used = result.num_views_used;
   stats.num_corners_used = result.num_corners_used;
@@ -359,7 +361,7 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
 
 bool ParseCameraFile(const std::string& text, const std::string& source,
                      Camera* camera, CameraFileFormat* format,
-                     std::string* error) {
+                     std::string* error, CameraFileStats* stats) {
   YAML::Node root;
   bool opencv_header = false;
   if (!ParseCameraText(text, source, &root, &opencv_header, error)) {
@@ -370,17 +372,28 @@ bool ParseCameraFile(const std::string& text, const std::string& source,
   }
   FieldReader reader(source, error);
   try {
-    return ParseCameraNode(root, "", opencv_header, &reader, camera, format);
+    Camera parsed;
+    CameraFileFormat found;
+    CameraFileStats read;
+    if (!ParseCameraNode(root, "", opencv_header, &reader, &parsed, &found) ||
+        (stats != nullptr && found == CameraFileFormat::kPuzzlecal &&
+         !camera_file::ParseStats(root, parsed, reader, &read))) {
+      return false;
+    }
+    *camera = parsed;
+    if (format != nullptr) *format = found;
+    if (stats != nullptr) *stats = read;
+    return true;
   } catch (const YAML::Exception& e) {
     return Fail(source + ": " + e.what(), error);
   }
 }
 
-bool ReadCameraFile(const std::string& path, Camera* camera,
-                    std::string* error) {
+bool ReadCameraFile(const std::string& path, Camera* camera, std::string* error,
+                    CameraFileStats* stats) {
   std::string text;
   if (!ReadTextFile(path, &text, error)) return false;
-  return ParseCameraFile(text, path, camera, nullptr, error);
+  return ParseCameraFile(text, path, camera, nullptr, error, stats);
 }
 
 bool ReadCameraFileViews(const std::string& path,

@@ -48,7 +48,11 @@ struct CameraFileView {
 struct CameraFileStats {
   bool has_stats = false;            // false: the fields below are not set
   std::vector<double> param_stddev;  // one per parameter, 0 for fixed ones
-  double rms_px = 0;                 // per coordinate, see CalibrationResult
+  // The intrinsics' covariance (n x n in the model's order, 0 for fixed
+  // ones), what the projection uncertainty of the camera is computed from;
+  // empty: unknown.
+  Eigen::MatrixXd covariance;
+  double rms_px = 0;  // per coordinate, see CalibrationResult
   int num_views_used = 0;
   int num_corners_used = 0;
   int num_outliers = 0;
@@ -57,8 +61,9 @@ struct CameraFileStats {
   std::string verdict;
   // Where the calibration's board corners were (see MeasureCalibrationRange):
   // the error figure of a format that leaves part of the camera out is
-  // given for points this near, up to this field angle. 0: unknown (then
-  // no figure, resp. the whole image).
+  // given for points this near, up to this field angle (the puzzlecal
+  // format keeps the field angle: where the calibration was observed, for
+  // comparisons). 0: unknown (then no figure, resp. the whole image).
   double closest_board_distance_m = 0;
   double max_field_angle_deg = 0;
 };
@@ -165,19 +170,24 @@ bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      const CameraFileNames& names = CameraFileNames());
 
 // Parses camera file text in any of the four formats; `source` names the
-// text in messages. `format` (optional) returns the format found.
+// text in messages. `format` (optional) returns the format found; `stats`
+// (optional) what the puzzlecal format carries besides the camera
+// (parameter_stddev, parameter_covariance, rms_px, views_used,
+// corners_used, outliers, max_field_angle_deg, verdict, views; has_stats
+// false when the text has no rms_px, as the other formats).
 bool ParseCameraFile(const std::string& text, const std::string& source,
                      Camera* camera, CameraFileFormat* format,
-                     std::string* error);
+                     std::string* error, CameraFileStats* stats = nullptr);
 // The same for a camera held by a YAML map at `path` of a larger file ("":
 // the file's root; a rig file's "cameras[1]"), its messages through
 // `reader`. `opencv_header`: the file began with OpenCV's "%YAML:1.0".
 bool ParseCameraNode(const YAML::Node& node, const std::string& path,
                      bool opencv_header, FieldReader* reader, Camera* camera,
                      CameraFileFormat* format);
-// Reads a camera file in any of the four formats.
-bool ReadCameraFile(const std::string& path, Camera* camera,
-                    std::string* error);
+// Reads a camera file in any of the four formats; `stats` (optional) as
+// ParseCameraFile's.
+bool ReadCameraFile(const std::string& path, Camera* camera, std::string* error,
+                    CameraFileStats* stats = nullptr);
 // Reads the `views` list of a puzzlecal-format camera file (empty when the
 // file has none).
 bool ReadCameraFileViews(const std::string& path,

@@ -12,6 +12,7 @@
 
 #include "formats/png_writer.h"
 #include "report/html.h"
+#include "report/image_chart.h"
 #include "report/overlay.h"
 #include "report/plot.h"
 #include "util/atomic_file.h"
@@ -150,57 +151,6 @@ std::string Seconds(double s) {
   return s >= 0 ? StringPrintf("%.2f", s) : std::string("not measured");
 }
 
-// ---------------------------------------------------------------------------
-// Image-shaped plots share one layout: the image rectangle scaled to the plot
-// width, title above, axes in image pixels, room on the right for a colour
-// bar and below for notes.
-
-struct ImageLayout {
-  cv::Size canvas;
-  cv::Rect area;
-  double scale = 1;  // canvas pixels per image pixel
-  int notes_y = 0;   // baseline of the first note line below the axes
-};
-
-ImageLayout MakeImageLayout(int plot_width, int width, int height,
-                            int note_lines) {
-  constexpr int kLeft = 80, kRight = 150, kTop = 80, kBottom = 70;
-  ImageLayout layout;
-  const int area_width = std::max(100, plot_width - kLeft - kRight);
-  layout.scale = static_cast<double>(area_width) / width;
-  const int area_height =
-      std::max(1, static_cast<int>(std::lround(height * layout.scale)));
-  layout.canvas = cv::Size(kLeft + area_width + kRight,
-                           kTop + area_height + kBottom + 22 * note_lines);
-  layout.area = cv::Rect(kLeft, kTop, area_width, area_height);
-  layout.notes_y = kTop + area_height + kBottom;
-  return layout;
-}
-
-// The plot area in image pixel coordinates (y down).
-void SetImageArea(const ImageLayout& layout, const ReportData& data,
-                  plot::Chart* chart) {
-  chart->SetArea(layout.area, -0.5, data.width - 0.5, -0.5, data.height - 0.5,
-                 /*y_down=*/true);
-}
-
-void DrawNote(const ImageLayout& layout, int line, const std::string& text,
-              plot::Chart* chart) {
-  chart->CanvasText(layout.area.x, layout.notes_y + 22 * line, text,
-                    plot::kTickHeight, Colour::kDarkGrey);
-}
-
-// Sample positions of a field computed every `step` pixels (the last one
-// on the image's last pixel), the outer ones moved to the image's edges so
-// the field fills the image rectangle.
-std::vector<double> SamplePositions(int count, int step, int size) {
-  std::vector<double> positions(std::max(1, count));
-  for (int i = 0; i < count; ++i) positions[i] = std::min(i * step, size - 1);
-  positions.front() = -0.5;
-  if (count > 1) positions.back() = size - 0.5;
-  return positions;
-}
-
 // The factor residual arrows are drawn with (options or automatic: the 95th
 // percentile inlier residual becomes 3 % of the image width), and that
 // percentile.
@@ -220,7 +170,7 @@ cv::Mat PlotResiduals(const ReportData& data, const ReportOptions& options) {
   const ImageLayout layout =
       MakeImageLayout(options.image_plot_width, data.width, data.height, 3);
   plot::Chart chart(layout.canvas.width, layout.canvas.height);
-  SetImageArea(layout, data, &chart);
+  SetImageArea(layout, data.width, data.height, &chart);
   chart.FilledRect(-0.5, -0.5, data.width - 0.5, data.height - 0.5,
                    Colour::kPaper);
   double p95 = 0;
@@ -307,7 +257,7 @@ cv::Mat PlotCoverage(const ReportData& data, const ReportOptions& options) {
   cv::minMaxLoc(counts, nullptr, &max_count);
   const int empty = rows * cols - cv::countNonZero(counts);
   plot::Chart chart(layout.canvas.width, layout.canvas.height);
-  SetImageArea(layout, data, &chart);
+  SetImageArea(layout, data.width, data.height, &chart);
   // Empty cells stay white.
   const double colour_max = std::max(2.0, max_count);
   chart.Cells(counts, -0.5, -0.5, cell, cell, 1, colour_max);
@@ -383,7 +333,7 @@ cv::Mat PlotDistortion(const ReportData& data, const ReportOptions& options) {
 
   plot::Chart chart(layout.canvas.width, layout.canvas.height,
                     /*antialias=*/false);
-  SetImageArea(layout, data, &chart);
+  SetImageArea(layout, data.width, data.height, &chart);
   chart.FilledRect(-0.5, -0.5, data.width - 0.5, data.height - 0.5,
                    Colour::kNoData);
   chart.Shades(magnitude, xs, ys, 0, colour_max);
@@ -758,74 +708,21 @@ cv::Mat PlotOverlay(const ReportData& data, int v, const std::string& rank,
 // ---------------------------------------------------------------------------
 // Evidence plots (evidence/evidence.h).
 
-// The map at image pixel (x, y): bilinear between the four samples around
-// it, or the nearest of them when one has no value.
-double SampleMap(const PixelMap& map, double x, double y) {
-  const int step = std::max(1, map.step_px);
-  const double gx = x / step, gy = y / step;
-  const int i0 = std::clamp(static_cast<int>(std::floor(gx)), 0, map.cols - 1);
-  const int j0 = std::clamp(static_cast<int>(std::floor(gy)), 0, map.rows - 1);
-  const int i1 = std::min(i0 + 1, map.cols - 1);
-  const int j1 = std::min(j0 + 1, map.rows - 1);
-  const double fx = std::clamp(gx - i0, 0.0, 1.0);
-  const double fy = std::clamp(gy - j0, 0.0, 1.0);
-  const double v00 = map.At(i0, j0), v10 = map.At(i1, j0);
-  const double v01 = map.At(i0, j1), v11 = map.At(i1, j1);
-  if (std::isfinite(v00) && std::isfinite(v10) && std::isfinite(v01) &&
-      std::isfinite(v11)) {
-    return (1 - fy) * ((1 - fx) * v00 + fx * v10) +
-           fy * ((1 - fx) * v01 + fx * v11);
-  }
-  return map.At(fx < 0.5 ? i0 : i1, fy < 0.5 ? j0 : j1);
-}
-
-// A PixelMap drawn over the image rectangle (interpolated between samples,
-// grey where the map has no value), with a colour bar from 0 to `colour_max`
-// (0: the map's largest value).
+// A PixelMap drawn over the image rectangle (image_chart.h), with a colour
+// bar from 0 to `colour_max` (0: the map's largest value).
 cv::Mat PlotPixelMap(const ReportData& data, const ReportOptions& options,
                      const PixelMap& map, double colour_max,
                      const std::string& title, const std::string& subtitle,
                      const std::string& bar_label,
                      const std::vector<std::string>& notes) {
-  const ImageLayout layout =
-      MakeImageLayout(options.image_plot_width, data.width, data.height,
-                      static_cast<int>(notes.size()));
-  double largest = 0;
-  for (double value : map.values) {
-    if (std::isfinite(value)) largest = std::max(largest, value);
-  }
-  if (!(colour_max > 0)) colour_max = largest > 0 ? largest : 1.0;
-  plot::Chart chart(layout.canvas.width, layout.canvas.height,
-                    /*antialias=*/false);
-  SetImageArea(layout, data, &chart);
-  chart.FilledRect(-0.5, -0.5, data.width - 0.5, data.height - 0.5,
-                   Colour::kNoData);
-  if (map.cols > 0 && map.rows > 0 &&
-      map.values.size() == static_cast<size_t>(map.cols) * map.rows) {
-    // Resampled every kStep px (the distortion map's default grid) so the bands
-    // follow the bilinear surface and a sample without a value only greys its
-    // own cell.
-    constexpr int kStep = 8;
-    const int nx = (data.width - 1 + kStep - 1) / kStep + 1;
-    const int ny = (data.height - 1 + kStep - 1) / kStep + 1;
-    cv::Mat values(ny, nx, CV_64F);
-    for (int j = 0; j < ny; ++j) {
-      for (int i = 0; i < nx; ++i) {
-        values.at<double>(j, i) =
-            SampleMap(map, std::min(i * kStep, data.width - 1),
-                      std::min(j * kStep, data.height - 1));
-      }
-    }
-    chart.Shades(values, SamplePositions(nx, kStep, data.width),
-                 SamplePositions(ny, kStep, data.height), 0, colour_max);
-  }
-  chart.Axes("x (px)", "y (px)", false);
-  chart.ColourBar(0, colour_max, bar_label);
-  chart.Title(title, subtitle);
-  for (size_t k = 0; k < notes.size(); ++k) {
-    DrawNote(layout, static_cast<int>(k), notes[k], &chart);
-  }
-  return chart.Finish();
+  PixelMapChart chart;
+  chart.title = title;
+  chart.subtitle = subtitle;
+  chart.bar_label = bar_label;
+  chart.notes = notes;
+  chart.colour_max = colour_max;
+  chart.plot_width = options.image_plot_width;
+  return DrawPixelMapChart(map, data.width, data.height, chart);
 }
 
 cv::Mat PlotCrossValidation(const ReportData& data,
