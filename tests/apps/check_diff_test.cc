@@ -106,48 +106,25 @@ Camera ReadCamera(const fs::path& path, CameraFileStats* stats) {
   return camera;
 }
 
+// The photo sets and camera files the cases use, made on first use in this
+// test process's folder (ctest runs every case as a process of its own, so
+// each makes only what it needs): the original photos and their calibration
+// (pinhole-radtan; kannala-brandt in the opencv format), new photos of the
+// same lens, and photos of the lens with the focal length changed, with
+// their calibration.
 class CheckDiffTest : public ::testing::Test {
  protected:
-  // Rendered and calibrated once for all cases: the original photos and
-  // their calibration (pinhole-radtan; kannala-brandt in the opencv
-  // format), new photos of the same lens, and photos of the lens with the
-  // focal length changed, with their calibration.
-  static void SetUpTestSuite() {
-    root_ = new fs::path(Scratch() / "sets");
-    const fs::path& root = *root_;
-    fs::create_directories(root);
-    const SceneSpec original = LensScene(1.0, 14, 11);
-    RenderInto(original, root / "original");
-    RenderInto(LensScene(1.0, 10, 23), root / "same");
-    RenderInto(LensScene(kFocalChange, 14, 23), root / "changed");
-    const Board& board = original.board;
-    testing_files::WriteFile(
-        root / "board.yaml",
-        "type: puzzleboard\ncols: " + std::to_string(board.cols) +
-            "\nrows: " + std::to_string(board.rows) + "\norigin: [" +
-            std::to_string(board.origin.x()) + ", " +
-            std::to_string(board.origin.y()) +
-            "]\ntile_size_m: " + std::to_string(board.tile_size_m) + "\n");
-    for (const auto& [set, out, extra] :
-         {std::tuple<const char*, const char*, const char*>{
-              "original", "original.yaml", ""},
-          {"changed", "changed.yaml", ""},
-          {"original", "original_kb_opencv.yaml",
-           " --model kannala-brandt --format opencv"}}) {
-      const ProgramRun run = RunPuzzlecal(
-          "calibrate --quiet --images " + Quote((root / set).string()) +
-          " --board " + Quote((root / "board.yaml").string()) + " --out " +
-          Quote((root / out).string()) + extra);
-      ASSERT_EQ(run.exit_code, 0) << run.all();
-    }
-    truth_ = new Camera(original.camera);
+  static const fs::path& Root() {
+    static const fs::path root = Scratch() / "sets";
+    return root;
   }
-  static void TearDownTestSuite() {
-    delete root_;
-    delete truth_;
-  }
+  static Camera Truth() { return LensScene(1.0, 14, 11).camera; }
+
+  // The quoted path of `name` in the sets folder, made if missing.
   static std::string Path(const std::string& name) {
-    return Quote((*root_ / name).string());
+    const fs::path path = Root() / name;
+    if (!fs::exists(path)) Make(name, path);
+    return Quote(path.string());
   }
   static std::string Check(const std::string& camera, const std::string& set,
                            const std::string& extra = "") {
@@ -155,12 +132,35 @@ class CheckDiffTest : public ::testing::Test {
            " --board " + Path("board.yaml") + extra;
   }
 
-  static fs::path* root_;
-  static Camera* truth_;
+ private:
+  static void Make(const std::string& name, const fs::path& path) {
+    fs::create_directories(Root());
+    if (name == "board.yaml") {
+      const Board& board = LensScene(1.0, 1, 1).board;
+      testing_files::WriteFile(
+          path, "type: puzzleboard\ncols: " + std::to_string(board.cols) +
+                    "\nrows: " + std::to_string(board.rows) + "\norigin: [" +
+                    std::to_string(board.origin.x()) + ", " +
+                    std::to_string(board.origin.y()) + "]\ntile_size_m: " +
+                    std::to_string(board.tile_size_m) + "\n");
+    } else if (name == "original") {
+      RenderInto(LensScene(1.0, 14, 11), path);
+    } else if (name == "same") {
+      RenderInto(LensScene(1.0, 10, 23), path);
+    } else if (name == "changed") {
+      RenderInto(LensScene(kFocalChange, 14, 23), path);
+    } else {
+      const std::string set = name == "changed.yaml" ? "changed" : "original";
+      const std::string extra = name == "original_kb_opencv.yaml"
+                                    ? " --model kannala-brandt --format opencv"
+                                    : "";
+      const ProgramRun run = RunPuzzlecal(
+          "calibrate --quiet --images " + Path(set) + " --board " +
+          Path("board.yaml") + " --out " + Quote(path.string()) + extra);
+      ASSERT_EQ(run.exit_code, 0) << run.all();
+    }
+  }
 };
-
-fs::path* CheckDiffTest::root_ = nullptr;
-Camera* CheckDiffTest::truth_ = nullptr;
 
 TEST_F(CheckDiffTest, CheckOnNewPhotosOfTheSameLensIsStillValid) {
   const ProgramRun run = RunPuzzlecal(Check("original.yaml", "same"));
@@ -190,11 +190,11 @@ TEST_F(CheckDiffTest, CheckWithTheFocalLengthChangedHasDriftedByTheTruth) {
   const std::map<int, BandRow> rows = ParseBands(run.out);
   ASSERT_FALSE(rows.empty());
   const double field = rows.rbegin()->second.hi;
-  Camera changed = *truth_;
+  Camera changed = Truth();
   changed.params[0] *= kFocalChange;
   changed.params[1] *= kFocalChange;
   const ProjectionDiff truth =
-      ProjectionDifference(*truth_, changed, field, EvidenceOptions());
+      ProjectionDifference(Truth(), changed, field, EvidenceOptions());
   ASSERT_TRUE(truth.ok) << truth.error;
   const int band = static_cast<int>(std::lround(lo / 10));
   ASSERT_LT(band, static_cast<int>(truth.difference_bands.size()));
@@ -237,13 +237,13 @@ TEST_F(CheckDiffTest, DiffOfTwoCalibrationsIsTheTruthsWithinTheirSigma) {
   EXPECT_NE(run.out.find("within the field both calibrations observed"),
             std::string::npos);
   CameraFileStats a, b;
-  ReadCamera(*root_ / "original.yaml", &a);
-  ReadCamera(*root_ / "changed.yaml", &b);
-  Camera changed = *truth_;
+  ReadCamera(Root() / "original.yaml", &a);
+  ReadCamera(Root() / "changed.yaml", &b);
+  Camera changed = Truth();
   changed.params[0] *= kFocalChange;
   changed.params[1] *= kFocalChange;
   const ProjectionDiff truth = ProjectionDifference(
-      *truth_, changed, std::min(a.max_field_angle_deg, b.max_field_angle_deg),
+      Truth(), changed, std::min(a.max_field_angle_deg, b.max_field_angle_deg),
       EvidenceOptions());
   ASSERT_TRUE(truth.ok) << truth.error;
   const std::map<int, BandRow> rows = ParseBands(run.out);
