@@ -1006,6 +1006,22 @@ double ContinuedTrustRegionRadius(double last_radius,
                   std::max(last_radius, options.initial_trust_region_radius));
 }
 
+CalibrationOptions PoseFitOptions(const CalibrationOptions& options,
+                                  const std::vector<double>& intrinsics) {
+  CalibrationOptions fit = options;
+  fit.initial_params = intrinsics;
+  fit.initial_cam_from_board.clear();
+  fit.fix_focal_length = true;
+  fit.fix_principal_point = true;
+  fit.fix_distortion = true;
+  fit.compute_covariance = false;
+  fit.min_views = 1;
+  fit.min_orientation_spread_deg = 0;
+  fit.min_coverage = 0;
+  fit.max_rms_px = std::numeric_limits<double>::max();
+  return fit;
+}
+
 bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
                int width, int height, const CalibrationOptions& options,
                CalibrationResult* result, std::string* error) {

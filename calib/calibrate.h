@@ -253,6 +253,13 @@ std::string CalibrationReport(const CalibrationResult& result);
 double ContinuedTrustRegionRadius(double last_radius,
                                   const CalibrationOptions& options);
 
+// The options of a pose fit: `options` with every intrinsic held at
+// `intrinsics` (only the poses move, each view posed from them), no
+// starting poses, no covariance, and none of the checks meant for a
+// calibration (view count, orientation spread, coverage, RMS limit).
+CalibrationOptions PoseFitOptions(const CalibrationOptions& options,
+                                  const std::vector<double>& intrinsics);
+
 // Calibrates `model` for images of width x height pixels. Returns false with
 // a reason (which says what to change) when the views are too few or
 // degenerate or the solve fails; `result` then holds what is known so far.

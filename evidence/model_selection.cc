@@ -69,17 +69,8 @@ bool HoldoutError(const std::vector<CalibrationView>& views,
   // meant for a calibration (views, spread, coverage, RMS) do not apply to
   // a pose fit; no corner is dropped, so a model that cannot follow the
   // lens pays for all of its corners.
-  CalibrationOptions options = calibration;
-  options.initial_params = camera.params;
-  options.fix_focal_length = true;
-  options.fix_principal_point = true;
-  options.fix_distortion = true;
+  CalibrationOptions options = PoseFitOptions(calibration, camera.params);
   options.outlier_k = 0;
-  options.min_views = 1;
-  options.min_orientation_spread_deg = 0;
-  options.min_coverage = 0;
-  options.max_rms_px = std::numeric_limits<double>::max();
-  options.compute_covariance = false;
   CalibrationResult result;
   if (!Calibrate(views, camera.model, camera.width, camera.height, options,
                  &result, error)) {

@@ -28,17 +28,7 @@ void FitHeld(const std::vector<CalibrationView>& views,
              const CalibrationOptions& calibration,
              const RecheckOptions& options, Recheck* out) {
   const Camera& camera = stored.camera;
-  CalibrationOptions held = calibration;
-  held.initial_params = camera.params;
-  held.initial_cam_from_board.clear();
-  held.fix_focal_length = true;
-  held.fix_principal_point = true;
-  held.fix_distortion = true;
-  held.compute_covariance = false;
-  held.min_views = 1;
-  held.min_orientation_spread_deg = 0;
-  held.min_coverage = 0;
-  held.max_rms_px = std::numeric_limits<double>::infinity();
+  const CalibrationOptions held = PoseFitOptions(calibration, camera.params);
   CalibrationResult result;
   out->held_ok = Calibrate(views, camera.model, camera.width, camera.height,
                            held, &result, &out->held_error);
