@@ -122,6 +122,7 @@ int RunCheck() {
   run_options.pipeline = options.pipeline;
   run_options.calibration = options.calibration;
   run_options.calibration.num_threads = threads;
+  run_options.recheck = options.check;
   run_options.recheck.evidence = options.evidence;
   cv::setNumThreads(1);  // the workers are the photos
   RecheckRun run;

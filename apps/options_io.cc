@@ -359,6 +359,18 @@ struct Fields<RigEvidenceOptions> {
 };
 
 template <>
+struct Fields<RecheckOptions> {
+  // Not here: evidence (the evidence section).
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("worse_view_factor", o.worse_view_factor);
+    v.Field("drift_sigmas", o.drift_sigmas);
+    v.Field("min_drift_px", o.min_drift_px);
+    v.Field("max_detectable_px", o.max_detectable_px);
+  }
+};
+
+template <>
 struct Fields<PipelineOptions> {
   // Section pipeline: what is left of PipelineOptions besides its groups
   // (those are sections of their own, see Fields<RunOptions>). Not here:
@@ -406,6 +418,7 @@ struct Fields<RunOptions> {
     v.Group("model_selection", o.model_selection);
     v.Group("rig", o.rig);
     v.Group("rig_evidence", o.rig_evidence);
+    v.Group("check", o.check);
   }
 };
 
@@ -557,6 +570,7 @@ bool CheckSections(const RunOptions& o, std::string* why) {
   if (!o.model_selection.Check(&inner)) return failed("model_selection");
   if (!o.rig.Check(&inner)) return failed("rig");
   if (!o.rig_evidence.Check(&inner)) return failed("rig_evidence");
+  if (!o.check.Check(&inner)) return failed("check");
   return true;
 }
 
@@ -603,9 +617,9 @@ class WriteVisitor {
 };
 
 constexpr char kHeader[] =
-    "# puzzlecal options (read with --options FILE by calibrate, detect and\n"
-    "# calibrate-rig). Every field with its value; delete the ones you keep\n"
-    "# at their defaults. Meaning and range of each field: detector\n"
+    "# puzzlecal options (read with --options FILE by calibrate, detect,\n"
+    "# calibrate-rig and check). Every field with its value; delete the ones\n"
+    "# you keep at their defaults. Meaning and range of each field: detector\n"
     "# detection/detector.h (DetectorOptions), grid grid/grid.h "
     "(GridOptions),\n"
     "# decode decode/decoder.h and decode/edge_bits.h (DecodeOptions,\n"
@@ -615,8 +629,9 @@ constexpr char kHeader[] =
     "# calib/initialization.h, evidence evidence/evidence.h, verdict\n"
     "# evidence/verdict.h, model_selection evidence/model_selection.h, rig\n"
     "# calib/rig_calibration.h (its camera options are the calibration\n"
-    "# section), rig_evidence evidence/rig_evidence.h. --threads and\n"
-    "# --format's fixed parameters are flags only.\n";
+    "# section), rig_evidence evidence/rig_evidence.h, check\n"
+    "# evidence/recheck.h. --threads and --format's fixed parameters are\n"
+    "# flags only.\n";
 
 }  // namespace
 

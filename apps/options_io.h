@@ -24,6 +24,7 @@
 #include "calib/rig_calibration.h"
 #include "evidence/evidence.h"
 #include "evidence/model_selection.h"
+#include "evidence/recheck.h"
 #include "evidence/rig_evidence.h"
 #include "evidence/verdict.h"
 #include "pipeline/pipeline.h"
@@ -47,6 +48,9 @@ struct RunOptions {
   // them).
   RigCalibrationOptions rig;
   RigEvidenceOptions rig_evidence;  // section rig_evidence
+  // Section check (`puzzlecal check`): RecheckOptions but its `evidence`,
+  // which is the evidence section.
+  RecheckOptions check;
 };
 
 // Reads the options file at `path` over `options` (fields it leaves out

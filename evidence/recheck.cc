@@ -149,8 +149,8 @@ void JudgeBands(const RecheckOptions& options, Recheck* out) {
   out->reason =
       std::isfinite(best_resolution)
           ? StringPrintf(
-                "the new views determine the projection only to %.2f px "
-                "(%.0f sigma) in their best field-angle band, %.2f px is "
+                "the new views determine the projection only to %.3f px "
+                "(%.0f sigma) in their best field-angle band, %.3g px is "
                 "needed: add views, with the board near the image borders "
                 "and tilted",
                 best_resolution, options.drift_sigmas,

@@ -171,6 +171,20 @@ TEST_F(CheckDiffTest, CheckOnNewPhotosOfTheSameLensIsStillValid) {
   EXPECT_NE(run.out.find("covariance in the file"), std::string::npos);
 }
 
+TEST_F(CheckDiffTest, CheckThatCannotSeeADriftSaysNotEnoughData) {
+  // The options file asks for a resolution of 0.001 px, which the ten new
+  // photos do not give.
+  const fs::path options = Scratch() / "fine.yaml";
+  fs::create_directories(Scratch());
+  testing_files::WriteFile(options, "check:\n  max_detectable_px: 0.001\n");
+  const ProgramRun run = RunPuzzlecal(
+      Check("original.yaml", "same", " --options " + Quote(options.string())));
+  EXPECT_EQ(run.exit_code, kExitNoResult) << run.all();
+  EXPECT_NE(run.out.find("verdict: not-enough-data — the new views "
+                         "determine the projection only to"),
+            std::string::npos);
+}
+
 TEST_F(CheckDiffTest, CheckWithTheFocalLengthChangedHasDriftedByTheTruth) {
   const fs::path out = Scratch() / "check_out";
   const ProgramRun run = RunPuzzlecal(
