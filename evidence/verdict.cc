@@ -63,6 +63,27 @@ std::string BinText(const ResidualBin& bin, const char* unit, bool metres) {
          unit + Printf(" (n=%.0f)", bin.count);
 }
 
+// The judged band (min_count samples or more, a positive prediction) where
+// the halves agree best: the smallest ratio of difference to prediction.
+// Null when no band is judged; `num_bands` (optional) counts them.
+const AngleBand* BestAgreeingBand(const CrossValidation& cv, int min_count,
+                                  double* ratio, int* num_bands = nullptr) {
+  const AngleBand* best = nullptr;
+  int bands = 0;
+  for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
+    const AngleBand& d = cv.difference_bands[b];
+    const AngleBand& e = cv.expected_bands[b];
+    if (d.count < min_count || !(e.median > 0)) continue;
+    ++bands;
+    if (best == nullptr || d.median / e.median < *ratio) {
+      best = &d;
+      *ratio = d.median / e.median;
+    }
+  }
+  if (num_bands != nullptr) *num_bands = bands;
+  return best;
+}
+
 // The factor by which the halves differ more than predicted in every judged
 // band (VerdictOptions::halves_min_bands): the smallest band ratio, at least
 // 1; 1 with fewer judged bands.
@@ -71,14 +92,7 @@ double HalvesScale(const CrossValidation& cv, int min_count,
   if (!cv.ok || options.halves_min_bands == 0) return 1.0;
   int bands = 0;
   double smallest = 0;
-  for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
-    const AngleBand& d = cv.difference_bands[b];
-    const AngleBand& e = cv.expected_bands[b];
-    if (d.count < min_count || !(e.median > 0)) continue;
-    const double ratio = d.median / e.median;
-    smallest = bands == 0 ? ratio : std::min(smallest, ratio);
-    ++bands;
-  }
+  BestAgreeingBand(cv, min_count, &smallest, &bands);
   if (bands < options.halves_min_bands) return 1.0;
   return std::max(1.0, smallest);
 }
@@ -92,17 +106,8 @@ void AddUniformHalvesFinding(const CrossValidation& cv, double halves_scale,
                              int min_count, const VerdictOptions& options,
                              std::vector<Finding>* findings) {
   if (!cv.ok || halves_scale <= options.halves_max_scale) return;
-  const AngleBand* best = nullptr;
   double best_ratio = 0;
-  for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
-    const AngleBand& d = cv.difference_bands[b];
-    const AngleBand& e = cv.expected_bands[b];
-    if (d.count < min_count || !(e.median > 0)) continue;
-    if (best == nullptr || d.median / e.median < best_ratio) {
-      best = &d;
-      best_ratio = d.median / e.median;
-    }
-  }
+  const AngleBand* best = BestAgreeingBand(cv, min_count, &best_ratio);
   if (best == nullptr || !(best->median > options.halves_uniform_floor_px)) {
     return;
   }
@@ -230,17 +235,12 @@ bool AddSystematicResidualFindings(const SystematicResiduals& residuals,
   return nearest_systematic || rms_grows;
 }
 
-// How one used view's corners fit: the RMS of its inliers, and its
-// rejected corners with the largest of their errors.
-struct ViewFit {
-  double inlier_rms_px = 0;
-  int corners = 0;
-  int rejected = 0;
-  double worst_rejected_px = 0;
-};
-
-ViewFit FitOfView(const CalibrationResult& result, size_t v) {
-  ViewFit fit;
+// How one used view's corners fit (standing kFits, to be judged): the RMS
+// of its inliers, and its rejected corners with the largest of their
+// errors.
+ViewJudgement FitOfView(const CalibrationResult& result, size_t v) {
+  ViewJudgement fit;
+  fit.standing = ViewStanding::kFits;
   double sum2 = 0;
   int inliers = 0;
   const std::vector<Eigen::Vector2d>& residuals = result.residuals[v];
@@ -306,13 +306,8 @@ int AddBadDetectionFindings(const CalibrationResult& result,
   std::vector<double> inlier_rms;
   for (size_t v = 0; v < result.view_used.size(); ++v) {
     if (!result.view_used[v] || v >= result.residuals.size()) continue;
-    const ViewFit fit = FitOfView(result, v);
-    judged[v].standing = ViewStanding::kFits;
-    judged[v].inlier_rms_px = fit.inlier_rms_px;
-    judged[v].corners = fit.corners;
-    judged[v].rejected = fit.rejected;
-    judged[v].worst_rejected_px = fit.worst_rejected_px;
-    inlier_rms.push_back(fit.inlier_rms_px);
+    judged[v] = FitOfView(result, v);
+    inlier_rms.push_back(judged[v].inlier_rms_px);
   }
   if (inlier_rms.empty()) return 0;
   std::vector<double> sorted = inlier_rms;

@@ -75,11 +75,11 @@ std::string Inline(
       }
       out += "<code>" + Escape(text.substr(i + 1, close - i - 1)) + "</code>";
       i = close + 1;
-    } else if (StartsWith(text.substr(i, 2), "**")) {
+    } else if (text.compare(i, 2, "**") == 0) {
       out += bold ? "</strong>" : "<strong>";
       bold = !bold;
       i += 2;
-    } else if (StartsWith(text.substr(i, 2), "![")) {
+    } else if (text.compare(i, 2, "![") == 0) {
       std::string alt, src;
       size_t end = 0;
       if (!ParseBracketLink(text, i + 1, &alt, &src, &end)) {

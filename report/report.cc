@@ -1274,10 +1274,13 @@ void MarkdownWorstViews(const ReportData& data, const CalibrationResult& result,
     return;
   }
   const Verdict* verdict = data.input->verdict;
+  const auto num_used = std::count_if(used.begin(), used.end(), [&](int v) {
+    return std::isfinite(data.view_rms[v]);
+  });
   md << StringPrintf(
       "The views the verdict names, then the highest inlier "
       "RMS of the %zu used views (overall %.3f px",
-      used.size(), result.rms_px);
+      static_cast<size_t>(num_used), result.rms_px);
   if (verdict != nullptr && verdict->view_rms_limit_px > 0) {
     md << StringPrintf(
         "; the median view's %.3f px, a view's inliers stand "
