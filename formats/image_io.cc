@@ -17,6 +17,7 @@
 
 #include "formats/opencv_decoder.h"
 #include "formats/png_filters.h"
+#include "formats/video_io.h"
 #include "util/failure.h"
 
 namespace puzzlecal {
@@ -289,8 +290,11 @@ bool ReadFile(const std::string& path, std::vector<unsigned char>* bytes) {
 
 }  // namespace
 
-bool ListImages(const std::string& path, ImageListing* listing,
-                std::string* error) {
+namespace {
+
+// ListImages, with videos listed apart when `with_videos`.
+bool ListMedia(const std::string& path, bool with_videos,
+               ImageListing* listing, std::string* error) {
   *listing = ImageListing();
   std::error_code ec;
   const fs::path root(path);
@@ -304,7 +308,8 @@ bool ListImages(const std::string& path, ImageListing* listing,
     return false;
   }
   if (fs::is_regular_file(status)) {
-    listing->images.push_back(path);
+    const bool video = with_videos && HasVideoExtension(path);
+    (video ? listing->videos : listing->images).push_back(path);
     return true;
   }
   if (!fs::is_directory(status)) {
@@ -326,6 +331,12 @@ bool ListImages(const std::string& path, ImageListing* listing,
     if (!it->is_regular_file(entry_ec)) continue;
     if (HasImageExtension(entry)) {
       listing->images.push_back(entry.string());
+    } else if (with_videos && HasVideoExtension(entry.string())) {
+      listing->videos.push_back(entry.string());
+    } else if (HasVideoExtension(entry.string())) {
+      listing->skipped.push_back(entry.string() +
+                                 ": a video (calibrate and calibrate-rig read "
+                                 "videos)");
     } else {
       listing->skipped.push_back(entry.string() +
                                  ": not an image file name (png, jpg, jpeg, "
@@ -333,14 +344,30 @@ bool ListImages(const std::string& path, ImageListing* listing,
     }
   }
   std::sort(listing->images.begin(), listing->images.end());
+  std::sort(listing->videos.begin(), listing->videos.end());
   std::sort(listing->skipped.begin(), listing->skipped.end());
-  if (listing->images.empty()) {
+  if (listing->images.empty() && listing->videos.empty()) {
     *error = path +
-             ": the folder holds no image files (png, jpg, jpeg, tif, "
-             "tiff, bmp)";
+             (with_videos ? ": the folder holds no image files (png, jpg, "
+                            "jpeg, tif, tiff, bmp) and no videos (mp4, avi, "
+                            "mkv, mov, ...)"
+                          : ": the folder holds no image files (png, jpg, "
+                            "jpeg, tif, tiff, bmp)");
     return false;
   }
   return true;
+}
+
+}  // namespace
+
+bool ListImages(const std::string& path, ImageListing* listing,
+                std::string* error) {
+  return ListMedia(path, /*with_videos=*/false, listing, error);
+}
+
+bool ListImagesAndVideos(const std::string& path, ImageListing* listing,
+                         std::string* error) {
+  return ListMedia(path, /*with_videos=*/true, listing, error);
 }
 
 bool ImageLoadOptions::Check(std::string* why) const {

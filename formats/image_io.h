@@ -13,6 +13,7 @@ namespace puzzlecal {
 // What ListImages found.
 struct ImageListing {
   std::vector<std::string> images;   // image files, sorted by name
+  std::vector<std::string> videos;   // ListImagesAndVideos: video files
   std::vector<std::string> skipped;  // other entries, with the reason
 };
 
@@ -21,6 +22,12 @@ struct ImageListing {
 // naming `path` when it does not exist, is not readable, or holds no image.
 bool ListImages(const std::string& path, ImageListing* listing,
                 std::string* error);
+
+// ListImages for the commands that read videos too: video files (by name:
+// formats/video_io.h HasVideoExtension) go to `listing->videos`, sorted by
+// name; `path` may name one video. False when the folder holds neither.
+bool ListImagesAndVideos(const std::string& path, ImageListing* listing,
+                         std::string* error);
 
 // Limits applied while loading.
 struct ImageLoadOptions {
