@@ -34,7 +34,9 @@
 #include "formats/camera_yaml.h"
 #include "formats/image_io.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/video_frames.h"
 #include "report/report.h"
+#include "util/atomic_file.h"
 #include "util/string_format.h"
 #include "util/timer.h"
 
@@ -53,7 +55,11 @@ constexpr char kUsage[] =
     "                    [--options FILE]  (`puzzlecal options` writes one)\n"
     "                    [--fix NAMES] [--initial camera.yaml]\n\n"
     "Calibrates a camera from every image in DIR (png, jpg, tif, bmp; 8 or 16 "
-    "bit; grey or colour)\nshowing the board of BOARD.yaml. --out is the "
+    "bit; grey or colour)\nshowing the board of BOARD.yaml, and from the "
+    "videos in it (mp4, avi, mkv, mov, ...;\nDIR may be one video): sharp "
+    "frames with new poses are chosen, at most video.max_frames\nper video; "
+    "a line per video says how many were kept and why the others were not "
+    "(the\nreport folder gets a table per video, video_frames_NAME.csv). --out is the "
     "camera file to write (a file path in an\nexisting folder; --format "
     "chooses what it holds). The camera file is written first and\n"
     "atomically; the report folder is replaced as a whole. A run that cannot "
@@ -126,11 +132,23 @@ void OnInterrupt(int) {
 // Writes the report aside, then puts it in place of `dir`
 // (apps/report_folder.h).
 bool WriteReportInPlace(const fs::path& dir, const ReportInput& input,
+                        const std::vector<VideoFrames>& videos,
                         std::string* error) {
   return WriteFolderInPlace(
       dir,
       [&](const std::string& folder, std::string* why) {
-        return WriteReport(folder, input, ReportOptions(), why);
+        if (!WriteReport(folder, input, ReportOptions(), why)) return false;
+        // Each video's frames: which were taken and why the others not.
+        for (const VideoFrames& video : videos) {
+          const std::string name =
+              "video_frames_" + fs::path(video.file).filename().string() +
+              ".csv";
+          if (!WriteFileAtomically((fs::path(folder) / name).string(),
+                                   video.Csv(), why)) {
+            return false;
+          }
+        }
+        return true;
       },
       error);
 }
@@ -268,7 +286,11 @@ struct CalibrateRequest {
 
 // What the run produced, image by image and as a whole.
 struct CalibrationRun {
-  std::vector<ImageResult> images;  // one record per image, in file order
+  // One record per image, in file order, then per kept video frame (a video
+  // that cannot be read: one unreadable record).
+  std::vector<ImageResult> images;
+  // Every video's frames and their outcomes (kept frames are in `images`).
+  std::vector<VideoFrames> videos;
   std::vector<CalibrationView> views;
   int width = 0, height = 0;
   ModelSelection selection;  // --model auto only
@@ -395,7 +417,7 @@ int ParseRequest(CalibrateRequest* request) {
     return kExitOutputError;
   }
   if (!LoadBoardFile(FLAGS_board, &request->board, &error) ||
-      !ListImages(FLAGS_images, &request->listing, &error)) {
+      !ListImagesAndVideos(FLAGS_images, &request->listing, &error)) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitBadInput;
   }
@@ -406,6 +428,32 @@ int ParseRequest(CalibrateRequest* request) {
     }
   }
   return kExitOk;
+}
+
+// The frames chosen from each video (pipeline/video_frames.h), one video
+// at a time: its kept frames join the images, a video that cannot be read
+// is one unreadable record. A line per video says what became of its
+// frames.
+void ReadVideos(const CalibrateRequest& request, CalibrationRun* run) {
+  for (const std::string& video : request.listing.videos) {
+    VideoFrames frames;
+    std::string error;
+    if (!ReadVideoFrames(video, request.board, request.options.pipeline,
+                         request.options.video, &frames, &error)) {
+      ImageResult unreadable;
+      unreadable.file = video;
+      unreadable.outcome = ImageOutcome::kUnreadable;
+      unreadable.reason = error;
+      run->images.push_back(std::move(unreadable));
+      continue;
+    }
+    if (request.verbosity != Verbosity::kQuiet) {
+      std::cout << frames.Summary() << "\n";
+    }
+    for (ImageResult& kept : frames.kept) run->images.push_back(std::move(kept));
+    frames.kept.clear();
+    run->videos.push_back(std::move(frames));
+  }
 }
 
 // Detection, grid and decode on all images, in parallel over images (each
@@ -419,6 +467,7 @@ int DetectAll(const CalibrateRequest& request, CalibrationRun* run) {
       request.listing.images, request.board, request.options.pipeline,
       request.threads,
       [&](size_t, const ImageResult& result) { progress.Done(result); });
+  ReadVideos(request, run);
   run->views = MakeCalibrationViews(request.board, &run->images, &run->width,
                                     &run->height);
   for (const ImageResult& image : run->images) {
@@ -442,7 +491,7 @@ int DetectAll(const CalibrateRequest& request, CalibrationRun* run) {
     std::cerr << image.reason << "\n";
   }
   std::cerr << "puzzlecal calibrate: none of the " << run->images.size()
-            << " image files in " << FLAGS_images
+            << " image and video files in " << FLAGS_images
             << " could be read; no calibration written.\n";
   return kExitBadInput;
 }
@@ -562,7 +611,7 @@ bool WriteReportOf(const CalibrateRequest& request, const CalibrationRun& run,
   }
   if (request.auto_model) input.model_selection = run.selection.Table();
   std::string error;
-  if (WriteReportInPlace(FLAGS_report, input, &error)) return true;
+  if (WriteReportInPlace(FLAGS_report, input, run.videos, &error)) return true;
   std::cerr << "puzzlecal calibrate: report not written: " << error
             << (run.calibrated
                     ? "\n(the camera file " + FLAGS_out + " was written)"

@@ -371,6 +371,19 @@ struct Fields<RecheckOptions> {
 };
 
 template <>
+struct Fields<VideoFrameOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("frame_step", o.frame_step);
+    v.Field("min_corners", o.min_corners);
+    v.Field("max_edge_width_px", o.max_edge_width_px);
+    v.Field("max_edges", o.max_edges);
+    v.Field("min_pose_change", o.min_pose_change);
+    v.Field("max_frames", o.max_frames);
+  }
+};
+
+template <>
 struct Fields<PipelineOptions> {
   // Section pipeline: what is left of PipelineOptions besides its groups
   // (those are sections of their own, see Fields<RunOptions>). Not here:
@@ -419,6 +432,7 @@ struct Fields<RunOptions> {
     v.Group("rig", o.rig);
     v.Group("rig_evidence", o.rig_evidence);
     v.Group("check", o.check);
+    v.Group("video", o.video);
   }
 };
 
@@ -571,6 +585,7 @@ bool CheckSections(const RunOptions& o, std::string* why) {
   if (!o.rig.Check(&inner)) return failed("rig");
   if (!o.rig_evidence.Check(&inner)) return failed("rig_evidence");
   if (!o.check.Check(&inner)) return failed("check");
+  if (!o.video.Check(&inner)) return failed("video");
   return true;
 }
 
@@ -630,8 +645,8 @@ constexpr char kHeader[] =
     "# evidence/verdict.h, model_selection evidence/model_selection.h, rig\n"
     "# calib/rig_calibration.h (its camera options are the calibration\n"
     "# section), rig_evidence evidence/rig_evidence.h, check\n"
-    "# evidence/recheck.h. --threads and --format's fixed parameters are\n"
-    "# flags only.\n";
+    "# evidence/recheck.h, video pipeline/video_frames.h. --threads and\n"
+    "# --format's fixed parameters are flags only.\n";
 
 }  // namespace
 

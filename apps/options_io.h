@@ -28,6 +28,7 @@
 #include "evidence/rig_evidence.h"
 #include "evidence/verdict.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/video_frames.h"
 
 namespace puzzlecal {
 
@@ -51,6 +52,9 @@ struct RunOptions {
   // Section check (`puzzlecal check`): RecheckOptions but its `evidence`,
   // which is the evidence section.
   RecheckOptions check;
+  // Section video: choosing calibration frames from videos
+  // (VideoFrameOptions).
+  VideoFrameOptions video;
 };
 
 // Reads the options file at `path` over `options` (fields it leaves out
