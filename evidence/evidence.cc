@@ -217,21 +217,27 @@ int GridStep(const Camera& camera, const EvidenceOptions& options) {
   return std::max(1, step);
 }
 
+bool ProjectionJacobian(const Camera& camera, const Eigen::Vector2d& pixel,
+                        const Eigen::MatrixXd* gauge,
+                        Eigen::MatrixXd* jacobian) {
+  const int n = CameraModelNumParams(camera.model);
+  if (static_cast<int>(camera.params.size()) != n) return false;
+  Eigen::Matrix<double, 2, 3> g;
+  if (!PixelJacobians(camera, pixel, jacobian, &g)) return false;
+  if (gauge != nullptr && gauge->rows() == 3 && gauge->cols() == n) {
+    *jacobian -= g * *gauge;
+  }
+  return true;
+}
+
 bool ProjectionCovariance(const Camera& camera,
                           const Eigen::MatrixXd& covariance,
                           const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov,
                           const Eigen::MatrixXd* gauge) {
   const int n = CameraModelNumParams(camera.model);
-  if (static_cast<int>(camera.params.size()) != n || covariance.rows() != n ||
-      covariance.cols() != n) {
-    return false;
-  }
+  if (covariance.rows() != n || covariance.cols() != n) return false;
   Eigen::MatrixXd jacobian;
-  Eigen::Matrix<double, 2, 3> g;
-  if (!PixelJacobians(camera, pixel, &jacobian, &g)) return false;
-  if (gauge != nullptr && gauge->rows() == 3 && gauge->cols() == n) {
-    jacobian -= g * *gauge;
-  }
+  if (!ProjectionJacobian(camera, pixel, gauge, &jacobian)) return false;
   *cov = jacobian * covariance * jacobian.transpose();
   return cov->allFinite();
 }

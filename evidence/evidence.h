@@ -239,6 +239,14 @@ bool ProjectionCovariance(const Camera& camera,
                           const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov,
                           const Eigen::MatrixXd* gauge = nullptr);
 
+// The 2 x n Jacobian that ProjectionCovariance propagates the covariance
+// with: d pixel / d intrinsics of the far point seen at `pixel`, minus the
+// part the rotation `gauge` undoes (when given). False when the pixel has no
+// ray.
+bool ProjectionJacobian(const Camera& camera, const Eigen::Vector2d& pixel,
+                        const Eigen::MatrixXd* gauge,
+                        Eigen::MatrixXd* jacobian);
+
 // M = (sum G^T G)^-1 sum G^T J over the grid pixels of `camera` whose ray is
 // at most max_angle_deg off the axis (see ProjectionUncertainty): the
 // rotation that best undoes a parameter change. Empty when not formed.

@@ -9,7 +9,7 @@ namespace puzzlecal {
 namespace sim {
 
 Camera MakeCamera(CameraModelId model, int width, int height,
-                         std::vector<double> params) {
+                  std::vector<double> params) {
   Camera camera;
   camera.model = model;
   camera.width = width;
@@ -135,6 +135,36 @@ SyntheticData MakeSyntheticData(const SyntheticScene& scene) {
     data.is_outlier.push_back(std::move(outlier));
   }
   return data;
+}
+
+CalibrationView ProjectBoardView(const Camera& camera, const Board& board,
+                                 const Eigen::Isometry3d& cam_from_board,
+                                 double noise_px, std::mt19937* rng,
+                                 const std::string& name,
+                                 std::vector<Eigen::Vector2d>* exact) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  CalibrationView view;
+  view.name = name;
+  if (exact != nullptr) exact->clear();
+  const Eigen::Vector3d normal_cam = cam_from_board.linear().col(2);
+  for (const Eigen::Vector2i& id : board.AllIds()) {
+    const Eigen::Vector3d point = board.Point(id);
+    const Eigen::Vector3d cam = cam_from_board * point;
+    Eigen::Vector2d pixel;
+    // Beyond the radius where the distortion folds over, a lens shows
+    // nothing the model could place.
+    const bool seen = cam.dot(normal_cam) > 0 &&
+                      FieldRadius(camera, cam) < MaxMonotonicRadius(camera) &&
+                      camera.Project(cam, &pixel) && pixel.x() >= 0 &&
+                      pixel.y() >= 0 && pixel.x() <= camera.width - 1 &&
+                      pixel.y() <= camera.height - 1;
+    const Eigen::Vector2d noise(normal(*rng), normal(*rng));
+    if (!seen) continue;
+    view.board_points.push_back(point);
+    view.image_points.push_back(pixel + noise_px * noise);
+    if (exact != nullptr) exact->push_back(pixel);
+  }
+  return view;
 }
 
 }  // namespace sim

@@ -10,10 +10,13 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <random>
+#include <string>
 #include <vector>
 
 #include "camera/calibration_view.h"
 #include "camera/camera_models.h"
+#include "target/board.h"
 
 namespace puzzlecal {
 namespace sim {
@@ -68,6 +71,17 @@ Camera TruthFisheye190();
 // The scene's views: random poses (deterministic for scene.seed), the
 // visible corners projected through scene.camera, noise and outliers added.
 SyntheticData MakeSyntheticData(const SyntheticScene& scene);
+
+// The view of every corner of `board` seen from `cam_from_board` that lies
+// in front of the board's printed side, inside the image and within the
+// radius where the camera's distortion is monotonic, with
+// Gaussian noise of noise_px per coordinate drawn from `rng` (two draws per
+// corner, row-major). Sets `exact` (optional) to the noise-free pixels.
+CalibrationView ProjectBoardView(const Camera& camera, const Board& board,
+                                 const Eigen::Isometry3d& cam_from_board,
+                                 double noise_px, std::mt19937* rng,
+                                 const std::string& name,
+                                 std::vector<Eigen::Vector2d>* exact = nullptr);
 
 }  // namespace sim
 }  // namespace puzzlecal

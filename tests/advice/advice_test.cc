@@ -1,0 +1,234 @@
+// Capture advice against truth: synthetic correspondences of the sample lens
+// (and a 180-degree fisheye) from a deficient start, the advised poses
+// added and the camera recalibrated, compared with poses drawn at random
+// from the same candidates.
+
+#include "advice/advice.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "advice/view_information.h"
+#include "calib/calibrate.h"
+#include "sim/scenes.h"
+#include "sim/synthetic_views.h"
+#include "util/statistics.h"
+
+namespace puzzlecal {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kNoisePx = 0.05;
+
+// A deficient start: `count` views with the board's centre near the image
+// centre, nearly facing the camera (tilts of 6 to 10 degrees), at about
+// the distance where the board spans 60 % of the image width.
+std::vector<Eigen::Isometry3d> CentredFrontalPoses(const Camera& camera,
+                                                   const Board& board,
+                                                   int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double width_m = (board.cols - 1) * board.tile_size_m;
+  const double distance = width_m * camera.params[0] / (0.6 * camera.width);
+  const Eigen::Vector3d centre =
+      0.5 * (board.Point(board.origin) +
+             board.Point(board.origin +
+                         Eigen::Vector2i(board.cols - 1, board.rows - 1)));
+  std::vector<Eigen::Isometry3d> poses;
+  for (int k = 0; k < count; ++k) {
+    const double tilt = (6 + 4 * uniform(rng)) * kDeg;
+    const double direction = 2 * M_PI * (k + uniform(rng)) / count;
+    const Eigen::Vector3d axis(-std::sin(direction), std::cos(direction), 0);
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = Eigen::AngleAxisd(tilt, axis).toRotationMatrix();
+    const Eigen::Vector3d shift(0.05 * (uniform(rng) - 0.5),
+                                0.05 * (uniform(rng) - 0.5), 1.0);
+    pose.translation() = distance * shift.normalized() - pose.linear() * centre;
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
+std::vector<CalibrationView> ViewsAt(
+    const Camera& camera, const Board& board,
+    const std::vector<Eigen::Isometry3d>& poses, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<CalibrationView> views;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    views.push_back(sim::ProjectBoardView(camera, board, poses[k], kNoisePx,
+                                          &rng, "view_" + std::to_string(k)));
+  }
+  return views;
+}
+
+bool CalibrateViews(const std::vector<CalibrationView>& views,
+                    const Camera& truth, CalibrationResult* result) {
+  CalibrationOptions options;
+  std::string error;
+  const bool ok = Calibrate(views, truth.model, truth.width, truth.height,
+                            options, result, &error);
+  EXPECT_TRUE(ok) << error;
+  return ok && result->covariance_ok;
+}
+
+std::vector<bool> FreeOf(const CalibrationResult& result) {
+  std::vector<bool> free(result.param_fixed.size());
+  for (size_t k = 0; k < free.size(); ++k) free[k] = !result.param_fixed[k];
+  return free;
+}
+
+Eigen::MatrixXd FreeCovariance(const CalibrationResult& result) {
+  std::vector<int> index;
+  for (size_t k = 0; k < result.param_fixed.size(); ++k) {
+    if (!result.param_fixed[k]) index.push_back(static_cast<int>(k));
+  }
+  Eigen::MatrixXd out(index.size(), index.size());
+  for (size_t r = 0; r < index.size(); ++r) {
+    for (size_t c = 0; c < index.size(); ++c) {
+      out(r, c) = result.covariance(index[r], index[c]);
+    }
+  }
+  return out;
+}
+
+// The worst predicted uncertainty over the judged field of a calibration.
+double WorstSigma(const CalibrationResult& result,
+                  const AdviceOptions& options) {
+  return PredictFieldUncertainty(result.camera, FreeOf(result),
+                                 FreeCovariance(result), options)
+      .worst_px;
+}
+
+TEST(ViewInformation, SumOverTheViewsIsTheCalibrationsInformation) {
+  const SceneSpec scene = SampleScene();
+  sim::SyntheticScene synthetic;
+  synthetic.camera = scene.camera;
+  synthetic.num_views = 12;
+  synthetic.noise_px = kNoisePx;
+  const sim::SyntheticData data = sim::MakeSyntheticData(synthetic);
+  CalibrationResult result;
+  ASSERT_TRUE(CalibrateViews(data.views, scene.camera, &result));
+  const Eigen::MatrixXd information = TakenInformation(data.views, result);
+  // The calibration's covariance is its residual variance times the
+  // inverse of this information: the ratio is one number everywhere.
+  const Eigen::MatrixXd ratio_matrix =
+      FreeCovariance(result) * information;  // variance * identity
+  const double variance = ratio_matrix.trace() / ratio_matrix.rows();
+  EXPECT_GT(variance, 0.5 * kNoisePx * kNoisePx);
+  EXPECT_LT(variance, 2.0 * kNoisePx * kNoisePx);
+  const Eigen::MatrixXd identity =
+      Eigen::MatrixXd::Identity(ratio_matrix.rows(), ratio_matrix.cols());
+  EXPECT_LT((ratio_matrix / variance - identity).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+TEST(ViewInformation, FewerThanThreeProjectingPointsTellNothing) {
+  const Camera camera = SampleScene().camera;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(0, 0, 1);
+  Eigen::MatrixXd information;
+  EXPECT_FALSE(ViewInformation(camera, {{0, 0, 0}, {0.1, 0, 0}}, pose, 1.0,
+                               &information));
+  EXPECT_TRUE(ViewInformation(camera, {{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}},
+                              pose, 1.0, &information));
+}
+
+struct Comparison {
+  double start_worst = 0;
+  double advised_worst = 0;
+  double random_median_worst = 0;
+  std::vector<double> predicted;     // after each advised view
+  std::vector<double> recalibrated;  // the same, recalibrated
+};
+
+Comparison CompareAdvisedWithRandom(const Camera& truth, const Board& board) {
+  Comparison out;
+  const std::vector<Eigen::Isometry3d> start_poses =
+      CentredFrontalPoses(truth, board, 6, 3);
+  const std::vector<CalibrationView> start =
+      ViewsAt(truth, board, start_poses, 7);
+  CalibrationResult result;
+  if (!CalibrateViews(start, truth, &result)) return out;
+  AdviceOptions options;
+  const Advice advice = AdviseViews(start, result, board, options);
+  EXPECT_TRUE(advice.ok) << advice.error;
+  if (!advice.ok) return out;
+  EXPECT_EQ(advice.views.size(), 4u);
+  // The comparisons judge one field, the advice's.
+  options.field_deg = advice.field_deg;
+  out.start_worst = WorstSigma(result, options);
+  std::vector<Eigen::Isometry3d> poses = start_poses;
+  for (size_t k = 0; k < advice.views.size(); ++k) {
+    poses.push_back(advice.views[k].cam_from_board);
+    CalibrationResult again;
+    if (!CalibrateViews(ViewsAt(truth, board, poses, 11), truth, &again)) {
+      return out;
+    }
+    out.predicted.push_back(advice.views[k].after.worst_px);
+    out.recalibrated.push_back(WorstSigma(again, options));
+  }
+  out.advised_worst = out.recalibrated.back();
+  std::vector<double> random_worst;
+  std::mt19937 rng(17);
+  for (int draw = 0; draw < 10; ++draw) {
+    std::vector<Eigen::Isometry3d> random = start_poses;
+    std::uniform_int_distribution<size_t> pick(
+        0, advice.candidate_poses.size() - 1);
+    for (int k = 0; k < 4; ++k)
+      random.push_back(advice.candidate_poses[pick(rng)]);
+    CalibrationResult again;
+    if (!CalibrateViews(ViewsAt(truth, board, random, 11), truth, &again)) {
+      continue;
+    }
+    random_worst.push_back(WorstSigma(again, options));
+  }
+  out.random_median_worst = Median(random_worst);
+  return out;
+}
+
+// The prediction after each advised view against the recalibration with
+// it: within 20 % (measured: 0.87-0.97 of the recalibrated worst on the
+// sample lens, 1.03-1.13 on the fisheye).
+void ExpectPredictionsFollow(const Comparison& c) {
+  ASSERT_EQ(c.predicted.size(), 4u);
+  for (size_t k = 0; k < c.predicted.size(); ++k) {
+    EXPECT_LT(c.predicted[k], 1.2 * c.recalibrated[k]) << "view " << k + 1;
+    EXPECT_GT(c.predicted[k], c.recalibrated[k] / 1.2) << "view " << k + 1;
+  }
+}
+
+TEST(Advice, AdvisedViewsBeatRandomOnesForTheSampleLens) {
+  const SceneSpec scene = SampleScene();
+  const Comparison c = CompareAdvisedWithRandom(scene.camera, scene.board);
+  // Measured: 1.61 px at the start, 0.0093 px advised, 0.027 px random.
+  EXPECT_LT(c.advised_worst, c.start_worst / 20);
+  EXPECT_LT(2 * c.advised_worst, c.random_median_worst);
+  ExpectPredictionsFollow(c);
+}
+
+TEST(Advice, AdvisedViewsBeatRandomOnesForAFisheye) {
+  const Camera truth = FisheyeLensCamera(640, 480, 180.0);
+  const Board board = SampleScene().board;
+  const Comparison c = CompareAdvisedWithRandom(truth, board);
+  // Measured: 3.9 px at the start, 0.0071 px advised, 0.0103 px random.
+  EXPECT_LT(c.advised_worst, c.start_worst / 20);
+  EXPECT_LT(c.advised_worst, c.random_median_worst);
+  ExpectPredictionsFollow(c);
+}
+
+TEST(Advice, DescribesPosesInWords) {
+  const Camera camera = SampleScene().camera;
+  EXPECT_EQ(DescribePose(camera, {50, 40}, 0.62, 40, 180),
+            "board about 0.62 m away, its centre in the top-left corner of the "
+            "image, tilted about 40 degrees with its left edge towards the "
+            "camera");
+  EXPECT_EQ(DescribePose(camera, {400, 300}, 1.0, 0, 0),
+            "board about 1 m away, its centre in the centre of the image, "
+            "facing the camera squarely");
+}
+
+}  // namespace
+}  // namespace puzzlecal
