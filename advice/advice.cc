@@ -439,6 +439,42 @@ double ObservedFieldDeg(const std::vector<CalibrationView>& views,
   return widest;
 }
 
+// The widest field radius (FieldRadius) of the image: its corners' rays,
+// or the fold's radius when a corner has none.
+double ImageEdgeRadius(const Camera& camera) {
+  double widest = 0;
+  const double max_radius = MaxMonotonicRadius(camera);
+  for (const Eigen::Vector2d& corner :
+       {Eigen::Vector2d(0, 0), Eigen::Vector2d(camera.width - 1, 0),
+        Eigen::Vector2d(0, camera.height - 1),
+        Eigen::Vector2d(camera.width - 1, camera.height - 1)}) {
+    Eigen::Vector3d ray;
+    widest = std::max(widest, camera.Unproject(corner, &ray).converged
+                                  ? FieldRadius(camera, ray)
+                                  : max_radius);
+  }
+  return std::min(widest, max_radius);
+}
+
+// Where a point of the board's outline is drawn: its projection inside
+// the image's field; beyond it (pinhole cameras only: no distortion was
+// observed there, and extrapolating a polynomial bends the outline into
+// waves) the edge's projection continued along the radial line.
+bool OutlinePixel(const Camera& camera, const Eigen::Vector3d& point_cam,
+                  double edge_radius, Eigen::Vector2d* pixel) {
+  const double radius = FieldRadius(camera, point_cam);
+  if (radius <= edge_radius) return camera.Project(point_cam, pixel);
+  if (!CameraModelIsPinhole(camera.model) || point_cam.z() <= 0) return false;
+  const double shrink = edge_radius / radius;
+  const Eigen::Vector3d at_edge(shrink * point_cam.x(), shrink * point_cam.y(),
+                                point_cam.z());
+  Eigen::Vector2d edge;
+  if (!camera.Project(at_edge, &edge)) return false;
+  const Eigen::Vector2d centre(camera.params[2], camera.params[3]);
+  *pixel = centre + (edge - centre) / shrink;
+  return true;
+}
+
 std::vector<Eigen::Vector2d> Outline(const Camera& camera, const Board& board,
                                      const Eigen::Isometry3d& pose) {
   // The printed area: the outer inner corners grown by the board's border.
@@ -451,6 +487,7 @@ std::vector<Eigen::Vector2d> Outline(const Camera& camera, const Board& board,
       Eigen::Vector3d(border, border, 0);
   const Eigen::Vector3d corners[4] = {
       lo, {hi.x(), lo.y(), 0}, hi, {lo.x(), hi.y(), 0}};
+  const double edge_radius = ImageEdgeRadius(camera);
   std::vector<Eigen::Vector2d> out;
   constexpr int kStepsPerSide = 24;
   for (int side = 0; side < 4; ++side) {
@@ -459,7 +496,9 @@ std::vector<Eigen::Vector2d> Outline(const Camera& camera, const Board& board,
       const Eigen::Vector3d p =
           (1 - t) * corners[side] + t * corners[(side + 1) % 4];
       Eigen::Vector2d pixel;
-      if (camera.Project(pose * p, &pixel)) out.push_back(pixel);
+      if (OutlinePixel(camera, pose * p, edge_radius, &pixel)) {
+        out.push_back(pixel);
+      }
     }
   }
   return out;
@@ -610,8 +649,12 @@ std::string DescribePose(const Camera& camera, const Eigen::Vector2d& centre_px,
     place = std::string("in the ") + kRows[row] + "-" + kCols[col] +
             " corner of the image";
   }
-  std::string words = StringPrintf("board about %.2g m away, its centre %s",
-                                   distance_m, place.c_str());
+  // Centimetres for a board held close, where "0.073 m" reads badly.
+  const std::string distance = distance_m < 0.3
+                                   ? StringPrintf("%.0f cm", 100 * distance_m)
+                                   : StringPrintf("%.2g m", distance_m);
+  std::string words = StringPrintf("board about %s away, its centre %s",
+                                   distance.c_str(), place.c_str());
   if (tilt_deg < 5) return words + ", facing the camera squarely";
   // The edge nearer the camera, by the direction in the image (y down).
   const char* const kEdges[8] = {

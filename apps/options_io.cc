@@ -384,6 +384,35 @@ struct Fields<VideoFrameOptions> {
 };
 
 template <>
+struct Fields<AdviceOptions> {
+  // Not here: count (--count), field_deg (--field-deg), num_threads
+  // (--threads), target_uncertainty_px and target_min_views (the verdict
+  // section's max_uncertainty_px and min_views).
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("field_samples", o.field_samples);
+    v.Field("position_cols", o.position_cols);
+    v.Field("position_rows", o.position_rows);
+    v.Field("distance_factors", o.distance_factors);
+    v.Field("tilts_deg", o.tilts_deg);
+    v.Field("tilt_directions", o.tilt_directions);
+    v.Field("min_view_angle_deg", o.min_view_angle_deg);
+    v.Field("min_visible_fraction", o.min_visible_fraction);
+    v.Field("image_margin_px", o.image_margin_px);
+    v.Field("min_tile_px", o.min_tile_px);
+    v.Field("max_corners_per_view", o.max_corners_per_view);
+    v.Field("min_separation_fraction", o.min_separation_fraction);
+    v.Field("min_separation_deg", o.min_separation_deg);
+    v.Field("min_distance_ratio", o.min_distance_ratio);
+    v.Field("max_estimate_views", o.max_estimate_views);
+    v.Field("noise_sigma_px", o.noise_sigma_px);
+    v.Field("prior_focal_fraction", o.prior_focal_fraction);
+    v.Field("prior_centre_fraction", o.prior_centre_fraction);
+    v.Field("prior_distortion", o.prior_distortion);
+  }
+};
+
+template <>
 struct Fields<PipelineOptions> {
   // Section pipeline: what is left of PipelineOptions besides its groups
   // (those are sections of their own, see Fields<RunOptions>). Not here:
@@ -433,6 +462,7 @@ struct Fields<RunOptions> {
     v.Group("rig_evidence", o.rig_evidence);
     v.Group("check", o.check);
     v.Group("video", o.video);
+    v.Group("advice", o.advice);
   }
 };
 
@@ -586,6 +616,7 @@ bool CheckSections(const RunOptions& o, std::string* why) {
   if (!o.rig_evidence.Check(&inner)) return failed("rig_evidence");
   if (!o.check.Check(&inner)) return failed("check");
   if (!o.video.Check(&inner)) return failed("video");
+  if (!o.advice.Check(&inner)) return failed("advice");
   return true;
 }
 
@@ -633,8 +664,9 @@ class WriteVisitor {
 
 constexpr char kHeader[] =
     "# puzzlecal options (read with --options FILE by calibrate, detect,\n"
-    "# calibrate-rig and check). Every field with its value; delete the ones\n"
-    "# you keep at their defaults. Meaning and range of each field: detector\n"
+    "# calibrate-rig, check and advise). Every field with its value; delete\n"
+    "# the ones you keep at their defaults. Meaning and range of each field:\n"
+    "# detector\n"
     "# detection/detector.h (DetectorOptions), grid grid/grid.h "
     "(GridOptions),\n"
     "# decode decode/decoder.h and decode/edge_bits.h (DecodeOptions,\n"
@@ -645,8 +677,9 @@ constexpr char kHeader[] =
     "# evidence/verdict.h, model_selection evidence/model_selection.h, rig\n"
     "# calib/rig_calibration.h (its camera options are the calibration\n"
     "# section), rig_evidence evidence/rig_evidence.h, check\n"
-    "# evidence/recheck.h, video pipeline/video_frames.h. --threads and\n"
-    "# --format's fixed parameters are flags only.\n";
+    "# evidence/recheck.h, video pipeline/video_frames.h, advice\n"
+    "# advice/advice.h. --threads and --format's fixed parameters are flags\n"
+    "# only.\n";
 
 }  // namespace
 

@@ -20,6 +20,7 @@
 
 #include <string>
 
+#include "advice/advice.h"
 #include "calib/calibrate.h"
 #include "calib/rig_calibration.h"
 #include "evidence/evidence.h"
@@ -55,6 +56,11 @@ struct RunOptions {
   // Section video: choosing calibration frames from videos
   // (VideoFrameOptions).
   VideoFrameOptions video;
+  // Section advice (`puzzlecal advise`, and calibrate's report when the
+  // verdict is not good): AdviceOptions but count, field_deg, num_threads
+  // (flags) and the target (the verdict section's max_uncertainty_px and
+  // min_views).
+  AdviceOptions advice;
 };
 
 // Reads the options file at `path` over `options` (fields it leaves out

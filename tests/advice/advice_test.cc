@@ -225,6 +225,10 @@ TEST(Advice, DescribesPosesInWords) {
             "board about 0.62 m away, its centre in the top-left corner of the "
             "image, tilted about 40 degrees with its left edge towards the "
             "camera");
+  EXPECT_EQ(DescribePose(camera, {790, 300}, 0.073, 60, 315),
+            "board about 7 cm away, its centre at the right edge of the "
+            "image, tilted about 60 degrees with its top-right corner towards "
+            "the camera");
   EXPECT_EQ(DescribePose(camera, {400, 300}, 1.0, 0, 0),
             "board about 1 m away, its centre in the centre of the image, "
             "facing the camera squarely");
