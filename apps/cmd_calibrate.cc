@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "advice/advice.h"
 #include "apps/common_flags.h"
 #include "apps/fixed_params.h"
 #include "apps/options_io.h"
@@ -299,6 +300,9 @@ struct CalibrationRun {
   std::string calibration_error;
   Evidence evidence;
   Verdict verdict;
+  // Which photos to take next, when the verdict is not good and a report
+  // is written (advice.ok false otherwise).
+  Advice advice;
   double seconds_load = 0, seconds_detect = 0, seconds_grid_decode = 0;
   double seconds_calibrate = 0;
 };
@@ -563,6 +567,13 @@ int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
       request.auto_model ? &run->selection : nullptr);
   run->evidence = std::move(judgement.evidence);
   run->verdict = std::move(judgement.verdict);
+  if (run->verdict.kind != VerdictKind::kGood && !FLAGS_report.empty()) {
+    AdviceOptions advice = request.options.advice;
+    advice.num_threads = request.threads;
+    advice.target_uncertainty_px = request.options.verdict.max_uncertainty_px;
+    advice.target_min_views = request.options.verdict.min_views;
+    run->advice = AdviseViews(run->views, run->result, request.board, advice);
+  }
   return kExitOk;
 }
 
@@ -610,6 +621,7 @@ bool WriteReportOf(const CalibrateRequest& request, const CalibrationRun& run,
     input.verdict = &run.verdict;
   }
   if (request.auto_model) input.model_selection = run.selection.Table();
+  if (run.advice.ok) input.advice = &run.advice;
   std::string error;
   if (WriteReportInPlace(FLAGS_report, input, run.videos, &error)) return true;
   std::cerr << "puzzlecal calibrate: report not written: " << error
@@ -647,6 +659,10 @@ void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
   std::cout << run.verdict.Line() << "\n";
   for (const std::string& note : run.verdict.notes) {
     std::cout << "note: " << note << "\n";
+  }
+  if (run.advice.ok && request.verbosity != Verbosity::kQuiet) {
+    std::cout << "next photo (" << FLAGS_report << "/next_1.png): "
+              << run.advice.views[0].words << "\n";
   }
   std::cout << "wrote " << FLAGS_out
             << (FLAGS_report.empty() ? "" : " and the report " + FLAGS_report)

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "formats/png_writer.h"
+#include "report/advice_report.h"
 #include "report/html.h"
 #include "report/image_chart.h"
 #include "report/overlay.h"
@@ -1453,6 +1454,7 @@ std::string ReportMarkdown(const ReportInput& input,
   if (input.evidence != nullptr) {
     md << EvidenceMarkdown(*input.evidence, input.verdict, 2);
   }
+  if (input.advice != nullptr) md << AdviceMarkdown(*input.advice, 2);
   MarkdownWorstViews(data, result, options, md);
   MarkdownImages(input, data, md);
   MarkdownTime(input, md);
@@ -1613,6 +1615,16 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
       if (!warning.empty()) summary->warnings.push_back(warning);
       if (!write_png(name + ".png", overlay)) return false;
     }
+  }
+  if (input.advice != nullptr && input.advice->ok && size_ok) {
+    std::vector<std::string> advice_files;
+    if (!WriteAdviceFiles(dir, *input.advice,
+                          SeenCorners(*input.views, result),
+                          options.image_plot_width, &advice_files, error)) {
+      return false;
+    }
+    summary->files.insert(summary->files.end(), advice_files.begin(),
+                          advice_files.end());
   }
   const std::string markdown = ReportMarkdown(input, options, png_files);
   if (!WriteFileAtomically((folder / "summary.md").string(), markdown, error)) {

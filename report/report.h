@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "advice/advice.h"
 #include "calib/calibrate.h"
 #include "camera/calibration_view.h"
 #include "evidence/evidence.h"
@@ -109,6 +110,10 @@ struct ReportInput {
   const Verdict* verdict = nullptr;
   // The comparison table of `--model auto` ("" when not run).
   std::string model_selection;
+  // Capture advice (advice/advice.h; calibrate gives it when the verdict
+  // is not good): a section after the evidence, the pictures
+  // next_1.png, ... and advice.yaml. Null: none.
+  const Advice* advice = nullptr;
 };
 
 // What WriteReport did.
