@@ -52,14 +52,12 @@ struct FieldSamples {
 };
 
 // The widest field angle on the circle about the principal point that the
-// image holds entirely (`width_only`: that reaches the nearer of the left
-// and right edges, the image's height ignored).
-double CircleFieldDeg(const Camera& camera, bool width_only) {
+// image holds entirely.
+double InscribedFieldDeg(const Camera& camera) {
   const double cx = camera.params[2];
   const double cy = camera.params[3];
-  double radius = std::min(cx, camera.width - 1 - cx);
-  if (!width_only)
-    radius = std::min(radius, std::min(cy, camera.height - 1 - cy));
+  const double radius = std::min(std::min(cx, camera.width - 1 - cx),
+                                 std::min(cy, camera.height - 1 - cy));
   double widest = 0;
   for (int k = 0; k < 16; ++k) {
     const double phi = 2 * M_PI * k / 16;
@@ -84,51 +82,70 @@ double CircleFieldDeg(const Camera& camera, bool width_only) {
 // point that the image holds entirely.
 double LensFieldDeg(const Camera& camera, double observed_deg) {
   if (CameraModelIsPinhole(camera.model)) return 89.0;
-  return std::max(observed_deg, CircleFieldDeg(camera, false));
+  return std::max(observed_deg, InscribedFieldDeg(camera));
 }
 
-// The judged field of `camera`: options.field_deg when given; otherwise
-// the circle about the principal point that reaches the image's nearer
-// left or right edge for a pinhole camera (the image corners beyond it
-// are left out: there the uncertainty is a tail of the highest-order
-// coefficients, which a linear prediction cannot follow), and the lens
-// field for a fisheye.
-double JudgedFieldDeg(const Camera& camera, double observed_deg,
+// The radius in pixels about the principal point of the judged field:
+// options.field_radius_px when given; otherwise the circle that reaches the
+// nearer of the image's left and right edges for a pinhole camera (the
+// image corners beyond it are left out), and for a fisheye the wider of
+// the circle the image holds entirely and `observed_px` (the farthest
+// corner seen). In pixels, not in field angles: a start whose distortion
+// is poorly known puts the image's edge at a wrong field angle, and a
+// field of angles would then judge rays the lens does not show.
+double JudgedRadiusPx(const Camera& camera, double observed_px,
                       const AdviceOptions& options) {
-  if (options.field_deg > 0) return options.field_deg;
-  if (CameraModelIsPinhole(camera.model)) return CircleFieldDeg(camera, true);
-  return LensFieldDeg(camera, observed_deg);
+  if (options.field_radius_px > 0) return options.field_radius_px;
+  const double cx = camera.params[2];
+  const double cy = camera.params[3];
+  const double width_radius = std::min(cx, camera.width - 1 - cx);
+  if (CameraModelIsPinhole(camera.model)) return width_radius;
+  const double inscribed =
+      std::min(width_radius, std::min(cy, camera.height - 1 - cy));
+  return std::max(inscribed, observed_px);
 }
 
 FieldSamples MakeFieldSamples(const Camera& camera,
-                              const std::vector<int>& free, double field_deg,
+                              const std::vector<int>& free, double radius_px,
                               const AdviceOptions& options) {
   FieldSamples out;
-  out.field_deg = field_deg;
+  const double max_deg = options.field_deg > 0 ? options.field_deg : 180.0;
+  const double fold_radius =
+      options.max_fold_fraction * MaxMonotonicRadius(camera);
+  const Eigen::Vector2d centre(camera.params[2], camera.params[3]);
   const double area = static_cast<double>(camera.width) * camera.height;
   const int step = std::max(
       1, static_cast<int>(std::floor(std::sqrt(area / options.field_samples))));
-  const Eigen::MatrixXd gauge = RotationGauge(camera, step, field_deg);
+  std::vector<Eigen::Vector2d> pixels;
   for (int y = step / 2; y < camera.height; y += step) {
     for (int x = step / 2; x < camera.width; x += step) {
       const Eigen::Vector2d pixel(x, y);
+      if ((pixel - centre).norm() > radius_px) continue;
       Eigen::Vector3d ray;
       if (!camera.Unproject(pixel, &ray).converged) continue;
       const double angle = FieldAngleDeg(ray);
-      if (angle > field_deg) continue;
-      Eigen::MatrixXd full;
-      if (!ProjectionJacobian(camera, pixel, gauge.size() ? &gauge : nullptr,
-                              &full)) {
-        continue;
-      }
-      Eigen::MatrixXd jacobian(2, free.size());
-      for (size_t k = 0; k < free.size(); ++k) {
-        jacobian.col(k) = full.col(free[k]);
-      }
-      out.jacobian.push_back(jacobian);
+      if (angle > max_deg || FieldRadius(camera, ray) > fold_radius) continue;
+      pixels.push_back(pixel);
       out.angle_deg.push_back(angle);
+      out.field_deg = std::max(out.field_deg, angle);
     }
   }
+  const Eigen::MatrixXd gauge = RotationGauge(camera, step, out.field_deg);
+  std::vector<double> angles;
+  for (size_t s = 0; s < pixels.size(); ++s) {
+    Eigen::MatrixXd full;
+    if (!ProjectionJacobian(camera, pixels[s], gauge.size() ? &gauge : nullptr,
+                            &full)) {
+      continue;
+    }
+    Eigen::MatrixXd jacobian(2, free.size());
+    for (size_t k = 0; k < free.size(); ++k) {
+      jacobian.col(k) = full.col(free[k]);
+    }
+    out.jacobian.push_back(jacobian);
+    angles.push_back(out.angle_deg[s]);
+  }
+  out.angle_deg = angles;
   return out;
 }
 
@@ -425,18 +442,24 @@ double MedianDistance(const std::vector<CalibrationView>& views,
   return distances.empty() ? 0.0 : Median(distances);
 }
 
-double ObservedFieldDeg(const std::vector<CalibrationView>& views,
-                        const CalibrationResult& result) {
-  double widest = 0;
+// The widest field angle of the inlier corners of the used views and their
+// farthest pixel from the principal point.
+void ObservedField(const std::vector<CalibrationView>& views,
+                   const CalibrationResult& result, double* widest_deg,
+                   double* farthest_px) {
+  const Eigen::Vector2d centre(result.camera.params[2],
+                               result.camera.params[3]);
   for (size_t v = 0; v < views.size() && v < result.view_used.size(); ++v) {
     if (!result.view_used[v]) continue;
     for (size_t i = 0; i < views[v].board_points.size(); ++i) {
       if (!result.inlier[v][i]) continue;
-      widest = std::max(widest, FieldAngleDeg(result.cam_from_board[v] *
-                                              views[v].board_points[i]));
+      *widest_deg = std::max(
+          *widest_deg,
+          FieldAngleDeg(result.cam_from_board[v] * views[v].board_points[i]));
+      *farthest_px =
+          std::max(*farthest_px, (views[v].image_points[i] - centre).norm());
     }
   }
-  return widest;
 }
 
 // The widest field radius (FieldRadius) of the image: its corners' rays,
@@ -547,6 +570,10 @@ bool AdviceOptions::Check(std::string* why) const {
   if (!(field_deg >= 0 && field_deg < 180)) {
     return Fail("field_deg must lie in [0, 180)", why);
   }
+  if (!(field_radius_px >= 0)) return Fail("field_radius_px must be >= 0", why);
+  if (!(max_fold_fraction > 0 && max_fold_fraction <= 1)) {
+    return Fail("max_fold_fraction must lie in (0, 1]", why);
+  }
   if (field_samples < 16) return Fail("field_samples must be >= 16", why);
   if (position_cols < 1 || position_rows < 1) {
     return Fail("position_cols and position_rows must be >= 1", why);
@@ -624,9 +651,10 @@ FieldUncertainty PredictFieldUncertainty(const Camera& camera,
                                          const std::vector<bool>& free,
                                          const Eigen::MatrixXd& free_covariance,
                                          const AdviceOptions& options) {
-  const double field = JudgedFieldDeg(camera, 0.0, options);
-  return Evaluate(MakeFieldSamples(camera, FreeIndices(free), field, options),
-                  free_covariance);
+  return Evaluate(
+      MakeFieldSamples(camera, FreeIndices(free),
+                       JudgedRadiusPx(camera, 0.0, options), options),
+      free_covariance);
 }
 
 std::string DescribePose(const Camera& camera, const Eigen::Vector2d& centre_px,
@@ -693,10 +721,12 @@ Advice AdviseViews(const std::vector<CalibrationView>& views,
   const double noise = NoiseSigma(result, free_index.size(), options);
   advice.noise_sigma_px = noise;
   advice.target_uncertainty_px = options.target_uncertainty_px;
-  const double observed_deg = ObservedFieldDeg(views, result);
-  advice.field_deg = JudgedFieldDeg(camera, observed_deg, options);
+  double observed_deg = 0, observed_px = 0;
+  ObservedField(views, result, &observed_deg, &observed_px);
+  advice.field_radius_px = JudgedRadiusPx(camera, observed_px, options);
   const FieldSamples samples =
-      MakeFieldSamples(camera, free_index, advice.field_deg, options);
+      MakeFieldSamples(camera, free_index, advice.field_radius_px, options);
+  advice.field_deg = samples.field_deg;
   if (samples.jacobian.empty()) {
     advice.error = "no pixel of the judged field has a ray";
     return advice;
@@ -786,9 +816,10 @@ std::string Advice::Text() const {
   std::ostringstream out;
   if (!ok) return "no advice: " + error + "\n";
   out << StringPrintf(
-      "projection uncertainty now (%d views, field up to %.0f deg): worst "
-      "%.3f px, median %.3f px, worst band median %.3f px\n",
-      views_taken, field_deg, now.worst_px, now.median_px,
+      "projection uncertainty now (%d views; field: within %.0f px of the "
+      "principal point, rays up to %.0f deg): worst %.3f px, median %.3f px, "
+      "worst band median %.3f px\n",
+      views_taken, field_radius_px, field_deg, now.worst_px, now.median_px,
       now.worst_band_median_px);
   for (size_t k = 0; k < views.size(); ++k) {
     const AdvisedView& v = views[k];

@@ -33,18 +33,30 @@ namespace puzzlecal {
 struct AdviceOptions {
   // Board poses to advise. Default 4. >= 1.
   int count = 4;
-  // The field over which the uncertainty is judged: image pixels whose ray
-  // is at most this many degrees off the optical axis. 0 (the default): for
-  // a pinhole camera the circle about the principal point that reaches the
-  // nearer of the image's left and right edges (the image corners beyond
-  // it are left out: their uncertainty is a tail of the highest-order
-  // distortion coefficients, which a linear prediction does not follow:
-  // on the sample lens, 0.02 px predicted against 0.36 px recalibrated at
-  // the very corners, where within the circle the two agree); for a
-  // fisheye the circle about the principal point that the image holds
-  // entirely, or the observed field when wider. Not only the observed
-  // field: the advice is there to extend it.
+  // The field over which the uncertainty is judged: the pixels within
+  // field_radius_px of the principal point whose ray is at most field_deg
+  // off the optical axis. field_radius_px 0 (the default): for a pinhole
+  // camera the circle that reaches the nearer of the image's left and right
+  // edges (the image corners beyond it are left out: their uncertainty is
+  // a tail of the highest-order distortion coefficients that a linear
+  // prediction does not follow: on the sample lens, 0.02 px predicted
+  // against 0.36 px recalibrated at the very corners, where within the
+  // circle the two agree); for a fisheye the circle the image holds
+  // entirely, or the farthest corner seen when farther. In pixels, not
+  // angles: a start whose distortion is poorly known puts the image's edge
+  // at a wrong angle. field_deg 0 (the default): no limit. Not only the
+  // observed field: the advice is there to extend it.
+  double field_radius_px = 0.0;
   double field_deg = 0.0;
+  // Pixels whose ray's field radius (FieldRadius) lies beyond this
+  // fraction of the radius where the distortion folds over
+  // (MaxMonotonicRadius) are not judged: near the fold a pixel's ray is
+  // uncertain in itself (every estimate puts the fold elsewhere), and the
+  // worst uncertainty there would be a property of the fold, not of the
+  // views. The sample lens (barrel distortion k1 = -0.2) folds inside its
+  // image; lenses whose fold lies beyond the image are not affected.
+  // Default 0.9. (0, 1].
+  double max_fold_fraction = 0.9;
   // Uncertainty samples: a grid over the image with about this many
   // points. Default 600. >= 16.
   int field_samples = 600;
@@ -150,7 +162,10 @@ struct Advice {
   std::string error;  // why not, when !ok
   Camera camera;      // the intrinsics the prediction linearises at
   double noise_sigma_px = 0;
-  double field_deg = 0;  // the judged field (the widest ray when 0 asked)
+  // The judged field: its radius about the principal point and its widest
+  // ray.
+  double field_radius_px = 0;
+  double field_deg = 0;
   double reference_distance_m = 0;  // median distance of the views taken
   int views_taken = 0;
   FieldUncertainty now;  // with the views taken

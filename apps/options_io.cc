@@ -390,6 +390,8 @@ struct Fields<AdviceOptions> {
   // section's max_uncertainty_px and min_views).
   template <typename V, typename O>
   static void Visit(V& v, O& o) {
+    v.Field("field_radius_px", o.field_radius_px);
+    v.Field("max_fold_fraction", o.max_fold_fraction);
     v.Field("field_samples", o.field_samples);
     v.Field("position_cols", o.position_cols);
     v.Field("position_rows", o.position_rows);

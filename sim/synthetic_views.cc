@@ -137,6 +137,33 @@ SyntheticData MakeSyntheticData(const SyntheticScene& scene) {
   return data;
 }
 
+std::vector<Eigen::Isometry3d> CentredFrontalPoses(const Camera& camera,
+                                                   const Board& board,
+                                                   int count, unsigned seed) {
+  constexpr double kDegree = M_PI / 180.0;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double width_m = (board.cols - 1) * board.tile_size_m;
+  const double distance = width_m * camera.params[0] / (0.6 * camera.width);
+  const Eigen::Vector3d centre =
+      0.5 * (board.Point(board.origin) +
+             board.Point(board.origin +
+                         Eigen::Vector2i(board.cols - 1, board.rows - 1)));
+  std::vector<Eigen::Isometry3d> poses;
+  for (int k = 0; k < count; ++k) {
+    const double tilt = (6 + 4 * uniform(rng)) * kDegree;
+    const double direction = 2 * M_PI * (k + uniform(rng)) / count;
+    const Eigen::Vector3d axis(-std::sin(direction), std::cos(direction), 0);
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = Eigen::AngleAxisd(tilt, axis).toRotationMatrix();
+    const Eigen::Vector3d shift(0.05 * (uniform(rng) - 0.5),
+                                0.05 * (uniform(rng) - 0.5), 1.0);
+    pose.translation() = distance * shift.normalized() - pose.linear() * centre;
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
 CalibrationView ProjectBoardView(const Camera& camera, const Board& board,
                                  const Eigen::Isometry3d& cam_from_board,
                                  double noise_px, std::mt19937* rng,

@@ -72,6 +72,15 @@ Camera TruthFisheye190();
 // visible corners projected through scene.camera, noise and outliers added.
 SyntheticData MakeSyntheticData(const SyntheticScene& scene);
 
+// A deficient start for capture advice: `count` poses with the board's
+// centre near the image centre (within 2.5 % of the distance), nearly
+// facing the camera (tilts of 6 to 10 degrees, their directions spread
+// around), at the distance where the board spans 60 % of the image width
+// (pinhole-like: from fx). Deterministic for `seed`.
+std::vector<Eigen::Isometry3d> CentredFrontalPoses(const Camera& camera,
+                                                   const Board& board,
+                                                   int count, unsigned seed);
+
 // The view of every corner of `board` seen from `cam_from_board` that lies
 // in front of the board's printed side, inside the image and within the
 // radius where the camera's distortion is monotonic, with
