@@ -165,9 +165,15 @@ TEST(VideoFrames, TheEdgeWidthSeparatesEightPixelStreaksFromSharpFrames) {
       const double width =
           BoardEdgeWidth(image, result.decode.observation, 60);
       ASSERT_GT(width, 0);
-      if (length == 0) EXPECT_LT(width, 3.2);
-      if (length == 4) EXPECT_LT(width, limit) << "angle " << angle;
-      if (length == 8) EXPECT_GT(width, limit) << "angle " << angle;
+      if (length == 0) {
+        EXPECT_LT(width, 3.2);
+      }
+      if (length == 4) {
+        EXPECT_LT(width, limit) << "angle " << angle;
+      }
+      if (length == 8) {
+        EXPECT_GT(width, limit) << "angle " << angle;
+      }
     }
   }
 }
