@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cmath>
 #include <csignal>
@@ -34,17 +35,37 @@
 #include "formats/board_file.h"
 #include "formats/camera_yaml.h"
 #include "formats/image_io.h"
+#include "formats/png_writer.h"
+#include "pipeline/folder_watch.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/video_frames.h"
+#include "report/advice_report.h"
 #include "report/report.h"
 #include "util/atomic_file.h"
+#include "util/statistics.h"
 #include "util/string_format.h"
 #include "util/timer.h"
+
+DEFINE_string(watch, "",
+              "calibrate: a folder to watch instead of --images: after each "
+              "photo that arrives, one line (used or why not, views, "
+              "uncertainty, verdict, the next advised photo); ends when the "
+              "verdict is good, on Ctrl-C or after --watch-idle seconds "
+              "without a photo, and writes what calibrate writes.");
+DEFINE_double(watch_idle, 0,
+              "calibrate --watch: stop after this many seconds without a new "
+              "photo (0: wait for Ctrl-C or a good verdict).");
 
 namespace puzzlecal {
 namespace {
 
 namespace fs = std::filesystem;
+
+// How often --watch looks into its folder.
+constexpr int kWatchPollMs = 200;
+// A photo whose board corners sit, in the median, within this fraction of
+// the image diagonal of an earlier photo's same corners repeats its pose.
+constexpr double kDuplicateFraction = 0.01;
 
 constexpr char kUsage[] =
     "puzzlecal calibrate --images DIR --board BOARD.yaml --out camera.yaml\n"
@@ -54,13 +75,16 @@ constexpr char kUsage[] =
     "                    [--rostopic TOPIC] [--camera-name NAME] "
     "[--quiet | --verbose]\n"
     "                    [--options FILE]  (`puzzlecal options` writes one)\n"
-    "                    [--fix NAMES] [--initial camera.yaml]\n\n"
+    "                    [--fix NAMES] [--initial camera.yaml]\n"
+    "puzzlecal calibrate --watch DIR --board BOARD.yaml --out camera.yaml "
+    "[--watch-idle S] [...]\n\n"
     "Calibrates a camera from every image in DIR (png, jpg, tif, bmp; 8 or 16 "
     "bit; grey or colour)\nshowing the board of BOARD.yaml, and from the "
     "videos in it (mp4, avi, mkv, mov, ...;\nDIR may be one video): sharp "
     "frames with new poses are chosen, at most video.max_frames\nper video; "
     "a line per video says how many were kept and why the others were not "
-    "(the\nreport folder gets a table per video, video_frames_NAME.csv). --out is the "
+    "(the\nreport folder gets a table per video, video_frames_NAME.csv). --out "
+    "is the "
     "camera file to write (a file path in an\nexisting folder; --format "
     "chooses what it holds). The camera file is written first and\n"
     "atomically; the report folder is replaced as a whole. A run that cannot "
@@ -68,7 +92,15 @@ constexpr char kUsage[] =
     "file.\n\n--fix holds parameters at their start (k3,p1,p2 as OpenCV's "
     "CALIB_FIX_K3 and\nCALIB_ZERO_TANGENT_DIST; focal, principal-point, "
     "distortion, all); --initial starts\nfrom a camera file (its model), so "
-    "--initial cam.yaml --fix all fits only the poses.\n\nExit codes: 0 done, "
+    "--initial cam.yaml --fix all fits only the poses.\n\n--watch DIR waits "
+    "for "
+    "photos to arrive in DIR (a phone or a capture script writing\ninto it) "
+    "and after each prints one line: used or why not (no board, too few "
+    "corners,\na pose nearly repeating an earlier photo), views so far, "
+    "coverage, the projection\nuncertainty, the verdict and the next advised "
+    "photo (its picture refreshed beside\n--out as next_1.png). It ends when "
+    "the verdict is good, on Ctrl-C or after\n--watch-idle seconds without a "
+    "photo, and writes the camera file and report then.\n\nExit codes: 0 done, "
     "2 bad command line, 3 bad input, 4 no "
     "trustworthy result,\n5 an output cannot be written (checked before the "
     "work starts), 130 interrupted.";
@@ -141,9 +173,9 @@ bool WriteReportInPlace(const fs::path& dir, const ReportInput& input,
         if (!WriteReport(folder, input, ReportOptions(), why)) return false;
         // Each video's frames: which were taken and why the others not.
         for (const VideoFrames& video : videos) {
-          const std::string name =
-              "video_frames_" + fs::path(video.file).filename().string() +
-              ".csv";
+          const std::string name = "video_frames_" +
+                                   fs::path(video.file).filename().string() +
+                                   ".csv";
           if (!WriteFileAtomically((fs::path(folder) / name).string(),
                                    video.Csv(), why)) {
             return false;
@@ -283,6 +315,9 @@ struct CalibrateRequest {
   Board board;
   ImageListing listing;
   Verbosity verbosity = Verbosity::kNormal;
+  // --watch: photos arrive one by one (the model table is not printed at
+  // every step).
+  bool watching = false;
 };
 
 // What the run produced, image by image and as a whole.
@@ -366,9 +401,16 @@ int AddUserFixed(CalibrateRequest* request) {
 // Flags, formats, outputs, the board file and the image folder. Returns
 // kExitOk or the exit code, having said why.
 int ParseRequest(CalibrateRequest* request) {
-  if (FLAGS_images.empty() || FLAGS_board.empty() || FLAGS_out.empty()) {
-    std::cerr << "puzzlecal calibrate: --images, --board and --out are "
-                 "required. Run `puzzlecal calibrate --help`.\n";
+  request->watching = !FLAGS_watch.empty();
+  if ((FLAGS_images.empty() == FLAGS_watch.empty()) || FLAGS_board.empty() ||
+      FLAGS_out.empty()) {
+    std::cerr << "puzzlecal calibrate: --images (or --watch), --board and "
+                 "--out are required, --images and --watch not both. Run "
+                 "`puzzlecal calibrate --help`.\n";
+    return kExitUsage;
+  }
+  if (!(FLAGS_watch_idle >= 0)) {
+    std::cerr << "puzzlecal calibrate: --watch-idle must be >= 0.\n";
     return kExitUsage;
   }
   request->auto_model = FLAGS_model == "auto";
@@ -421,8 +463,17 @@ int ParseRequest(CalibrateRequest* request) {
     return kExitOutputError;
   }
   if (!LoadBoardFile(FLAGS_board, &request->board, &error) ||
-      !ListImagesAndVideos(FLAGS_images, &request->listing, &error)) {
+      (!request->watching &&
+       !ListImagesAndVideos(FLAGS_images, &request->listing, &error))) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
+    return kExitBadInput;
+  }
+  std::error_code ec;
+  if (request->watching && (fs::create_directories(FLAGS_watch, ec),
+                            !fs::is_directory(FLAGS_watch))) {
+    std::cerr << "puzzlecal calibrate: --watch " << FLAGS_watch
+              << ": not a folder and cannot be made one"
+              << (ec ? ": " + ec.message() : "") << "\n";
     return kExitBadInput;
   }
   request->verbosity = ConsoleVerbosity();
@@ -454,7 +505,8 @@ void ReadVideos(const CalibrateRequest& request, CalibrationRun* run) {
     if (request.verbosity != Verbosity::kQuiet) {
       std::cout << frames.Summary() << "\n";
     }
-    for (ImageResult& kept : frames.kept) run->images.push_back(std::move(kept));
+    for (ImageResult& kept : frames.kept)
+      run->images.push_back(std::move(kept));
     frames.kept.clear();
     run->videos.push_back(std::move(frames));
   }
@@ -508,11 +560,15 @@ int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
   if (!SelectModel(run->views, run->width, run->height,
                    request->calibration_options,
                    request->options.model_selection, &run->selection, &error)) {
+    if (request->watching) {
+      run->calibration_error = error;
+      return kExitNoResult;
+    }
     std::cerr << run->selection.Table() << "puzzlecal calibrate: " << error
               << "\n";
     return kExitNoResult;
   }
-  std::cout << run->selection.Table();
+  if (!request->watching) std::cout << run->selection.Table();
   request->model = run->selection.candidates[run->selection.chosen].model;
   if (!CameraFormatFixedParams(request->format, request->model,
                                &request->calibration_options.fixed_params,
@@ -567,7 +623,8 @@ int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
       request.auto_model ? &run->selection : nullptr);
   run->evidence = std::move(judgement.evidence);
   run->verdict = std::move(judgement.verdict);
-  if (run->verdict.kind != VerdictKind::kGood && !FLAGS_report.empty()) {
+  if (run->verdict.kind != VerdictKind::kGood &&
+      (!FLAGS_report.empty() || request.watching)) {
     AdviceOptions advice = request.options.advice;
     advice.num_threads = request.threads;
     advice.target_uncertainty_px = request.options.verdict.max_uncertainty_px;
@@ -661,25 +718,19 @@ void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
     std::cout << "note: " << note << "\n";
   }
   if (run.advice.ok && request.verbosity != Verbosity::kQuiet) {
-    std::cout << "next photo (" << FLAGS_report << "/next_1.png): "
-              << run.advice.views[0].words << "\n";
+    std::cout << "next photo (" << FLAGS_report
+              << "/next_1.png): " << run.advice.views[0].words << "\n";
   }
   std::cout << "wrote " << FLAGS_out
             << (FLAGS_report.empty() ? "" : " and the report " + FLAGS_report)
             << "\n";
 }
 
-int RunCalibrate() {
-  std::signal(SIGINT, OnInterrupt);
-  const Timer run_timer;
-  CalibrateRequest request;
-  CalibrationRun run;
-  if (const int code = ParseRequest(&request); code != kExitOk) return code;
-  if (const int code = DetectAll(request, &run); code != kExitOk) return code;
-  request.calibration_options.num_threads = request.threads;  // same result
-  if (const int code = CalibrateAndJudge(&request, &run); code != kExitOk) {
-    return code;
-  }
+// The outputs of a run whose views are calibrated and judged: the image
+// problems, the camera file, the report and the closing lines. Returns the
+// exit code.
+int FinishRun(const CalibrateRequest& request, const CalibrationRun& run,
+              const Timer& run_timer) {
   const std::vector<ReportImage> report_images =
       MakeReportImages(run.images, run.calibrated ? &run.result : nullptr);
   PrintImageProblems(report_images);
@@ -702,12 +753,190 @@ int RunCalibrate() {
   return kExitOk;
 }
 
+// ---- --watch ----
+
+// Set by Ctrl-C while watching: the watch ends and writes what it has (a
+// second Ctrl-C interrupts as usual).
+volatile std::sig_atomic_t g_stop_watch = 0;
+
+void OnWatchInterrupt(int) {
+  g_stop_watch = 1;
+  std::signal(SIGINT, OnInterrupt);
+}
+
+// The earlier photo whose board corners `image` nearly repeats (most of
+// its ids seen at nearly the same pixels: a second photo of one pose adds
+// little), or "".
+std::string DuplicateOf(const std::vector<ImageResult>& earlier,
+                        const ImageResult& image) {
+  const BoardObservation& seen = image.decode.observation;
+  const double limit =
+      kDuplicateFraction * std::hypot(image.width, image.height);
+  for (const ImageResult& other : earlier) {
+    if (other.outcome != ImageOutcome::kUsable) continue;
+    std::map<std::pair<int, int>, Eigen::Vector2d> at;
+    for (size_t i = 0; i < other.decode.observation.id.size(); ++i) {
+      const Eigen::Vector2i& id = other.decode.observation.id[i];
+      at[{id.x(), id.y()}] = other.decode.observation.xy[i];
+    }
+    std::vector<double> moved;
+    for (size_t i = 0; i < seen.id.size(); ++i) {
+      const auto found = at.find({seen.id[i].x(), seen.id[i].y()});
+      if (found != at.end())
+        moved.push_back((found->second - seen.xy[i]).norm());
+    }
+    const size_t fewer = std::min(seen.id.size(), at.size());
+    if (fewer > 0 && moved.size() >= 0.9 * fewer && Median(moved) < limit) {
+      return fs::path(other.file).filename().string();
+    }
+  }
+  return "";
+}
+
+// The verdict's uncertainty figure: the largest band median of the
+// projection uncertainty within the observed field (0 when none).
+double WorstBandMedian(const Evidence& evidence, int min_count) {
+  double worst = 0;
+  for (const AngleBand& band : evidence.uncertainty.bands) {
+    if (band.count >= min_count) worst = std::max(worst, band.median);
+  }
+  return worst;
+}
+
+// Calibrates and judges the photos so far (once there are enough views) and
+// says where the calibration stands, after the photo's own words.
+std::string WatchStanding(CalibrateRequest* request, CalibrationRun* run) {
+  run->views = MakeCalibrationViews(request->board, &run->images, &run->width,
+                                    &run->height);
+  const int needed = request->calibration_options.min_views;
+  if (static_cast<int>(run->views.size()) < needed) {
+    run->calibrated = false;
+    return StringPrintf("%zu views, calibrating from %d", run->views.size(),
+                        needed);
+  }
+  run->calibration_error.clear();
+  run->advice = Advice();
+  run->verdict = Verdict();
+  if (CalibrateAndJudge(request, run) != kExitOk || !run->calibrated) {
+    run->calibrated = false;
+    return StringPrintf("%zu views, not calibrated yet: %s", run->views.size(),
+                        run->calibration_error.c_str());
+  }
+  std::string line = StringPrintf(
+      "%d of %zu views used, coverage %.0f %%, uncertainty %.3f px (limit "
+      "%.2f), verdict %s",
+      run->result.num_views_used, run->views.size(), 100 * run->result.coverage,
+      WorstBandMedian(run->evidence, request->options.evidence.min_bin_count),
+      request->options.verdict.max_uncertainty_px,
+      VerdictKindName(run->verdict.kind));
+  if (run->advice.ok) line += " — next: " + run->advice.views[0].words;
+  return line;
+}
+
+// The line for one photo that arrived: whether it is used, then the
+// standing. A photo that gives no view, or repeats an earlier pose, is
+// left out (the standing is unchanged then).
+std::string WatchStep(const std::string& file, CalibrateRequest* request,
+                      CalibrationRun* run) {
+  ImageResult image =
+      ProcessImageFile(file, request->board, request->options.pipeline);
+  const std::string name = fs::path(file).filename().string();
+  if (image.outcome != ImageOutcome::kUsable) {
+    std::string reason = image.reason;
+    if (reason.rfind(image.file + ": ", 0) == 0) {
+      reason.erase(0, image.file.size() + 2);
+    }
+    run->images.push_back(std::move(image));
+    return name + ": not used — " +
+           ImageOutcomeName(run->images.back().outcome) +
+           (reason.empty() ? "" : " (" + reason + ")");
+  }
+  const std::string duplicate = DuplicateOf(run->images, image);
+  if (!duplicate.empty()) {
+    return name + ": not used — nearly the same pose as " + duplicate +
+           " (move or tilt the board)";
+  }
+  const size_t corners = image.decode.observation.id.size();
+  run->images.push_back(std::move(image));
+  return name + StringPrintf(": used (%zu corners) — ", corners) +
+         WatchStanding(request, run);
+}
+
+// The advised photo's picture beside --out (next_1.png), refreshed.
+void RefreshNextPicture(const CalibrationRun& run) {
+  if (!run.advice.ok) return;
+  const fs::path path = fs::path(FLAGS_out).parent_path() / "next_1.png";
+  std::string error;
+  if (!WritePngFile(path.string(),
+                    DrawAdvicePicture(run.advice, 0,
+                                      SeenCorners(run.views, run.result), 1200),
+                    &error)) {
+    std::cerr << "puzzlecal calibrate: " << error << "\n";
+  }
+}
+
+// Photos as they arrive in --watch, each processed and said in one line,
+// until the verdict is good, Ctrl-C or --watch-idle; then the outputs.
+int RunWatch(CalibrateRequest* request, const Timer& run_timer) {
+  std::signal(SIGINT, OnWatchInterrupt);
+  request->calibration_options.num_threads = request->threads;
+  CalibrationRun run;
+  FolderWatch watch(FLAGS_watch);
+  std::cout << "watching " << FLAGS_watch
+            << " for photos (Ctrl-C ends and writes the result)" << std::endl;
+  Timer idle;
+  int photos = 0;
+  bool good = false;
+  while (!g_stop_watch && !good &&
+         !(FLAGS_watch_idle > 0 && idle.Seconds() > FLAGS_watch_idle)) {
+    std::vector<std::string> files;
+    std::string error;
+    if (!watch.Poll(&files, &error)) {
+      std::cerr << "puzzlecal calibrate: " << error << "\n";
+      return kExitBadInput;
+    }
+    for (const std::string& file : files) {
+      if (good || g_stop_watch) break;
+      const std::string line = WatchStep(file, request, &run);
+      RefreshNextPicture(run);  // before the line that names the advice
+      std::cout << "[" << ++photos << "] " << line << std::endl;
+      good = run.calibrated && run.verdict.kind == VerdictKind::kGood;
+      idle.Restart();
+    }
+    if (files.empty()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(kWatchPollMs));
+    }
+  }
+  std::signal(SIGINT, OnInterrupt);
+  std::cout << (good           ? "the verdict is good: done"
+                : g_stop_watch ? "stopped"
+                               : "no new photo: done")
+            << std::endl;
+  return FinishRun(*request, run, run_timer);
+}
+
+int RunCalibrate() {
+  std::signal(SIGINT, OnInterrupt);
+  const Timer run_timer;
+  CalibrateRequest request;
+  CalibrationRun run;
+  if (const int code = ParseRequest(&request); code != kExitOk) return code;
+  if (request.watching) return RunWatch(&request, run_timer);
+  if (const int code = DetectAll(request, &run); code != kExitOk) return code;
+  request.calibration_options.num_threads = request.threads;  // same result
+  if (const int code = CalibrateAndJudge(&request, &run); code != kExitOk) {
+    return code;
+  }
+  return FinishRun(request, run, run_timer);
+}
+
 PUZZLECAL_REGISTER_SUBCOMMAND(calibrate, "calibrate",
                               "calibrate a camera from a folder of photos",
                               kUsage,
                               {"images", "board", "model", "out", "format",
                                "report", "threads", "rostopic", "camera_name",
-                               "options", "fix", "initial"},
+                               "options", "fix", "initial", "watch",
+                               "watch_idle"},
                               &RunCalibrate);
 
 }  // namespace

@@ -31,12 +31,6 @@ std::string Lower(std::string s) {
   return s;
 }
 
-bool HasImageExtension(const fs::path& path) {
-  const std::string ext = Lower(path.extension().string());
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" ||
-         ext == ".tiff" || ext == ".bmp";
-}
-
 // What the file header tells before decoding: the image size (0 when the
 // format is not parsed here) and, for PNG and JPEG, whether the file is
 // complete. Decoders of truncated PNG/JPEG files often return a partly grey
@@ -218,6 +212,12 @@ bool GreyPngData(const std::vector<unsigned char>& b, int* width, int* height,
 
 }  // namespace
 
+bool HasImageExtension(const std::filesystem::path& path) {
+  const std::string ext = Lower(path.extension().string());
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" ||
+         ext == ".tiff" || ext == ".bmp";
+}
+
 // What an ImageLoader keeps between files.
 struct ImageLoader::Buffers {
   std::vector<unsigned char> bytes;  // the file
@@ -293,8 +293,8 @@ bool ReadFile(const std::string& path, std::vector<unsigned char>* bytes) {
 namespace {
 
 // ListImages, with videos listed apart when `with_videos`.
-bool ListMedia(const std::string& path, bool with_videos,
-               ImageListing* listing, std::string* error) {
+bool ListMedia(const std::string& path, bool with_videos, ImageListing* listing,
+               std::string* error) {
   *listing = ImageListing();
   std::error_code ec;
   const fs::path root(path);
@@ -347,12 +347,12 @@ bool ListMedia(const std::string& path, bool with_videos,
   std::sort(listing->videos.begin(), listing->videos.end());
   std::sort(listing->skipped.begin(), listing->skipped.end());
   if (listing->images.empty() && listing->videos.empty()) {
-    *error = path +
-             (with_videos ? ": the folder holds no image files (png, jpg, "
-                            "jpeg, tif, tiff, bmp) and no videos (mp4, avi, "
-                            "mkv, mov, ...)"
-                          : ": the folder holds no image files (png, jpg, "
-                            "jpeg, tif, tiff, bmp)");
+    *error =
+        path + (with_videos ? ": the folder holds no image files (png, jpg, "
+                              "jpeg, tif, tiff, bmp) and no videos (mp4, avi, "
+                              "mkv, mov, ...)"
+                            : ": the folder holds no image files (png, jpg, "
+                              "jpeg, tif, tiff, bmp)");
     return false;
   }
   return true;

@@ -3,12 +3,17 @@
 
 // Finding and loading the photos of a calibration run.
 
+#include <filesystem>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 namespace puzzlecal {
+
+// True for the file names ListImages lists as images (png, jpg/jpeg,
+// tif/tiff, bmp; any case).
+bool HasImageExtension(const std::filesystem::path& path);
 
 // What ListImages found.
 struct ImageListing {
