@@ -8,11 +8,13 @@
 #include <filesystem>
 #include <thread>
 
+#include "advice/advice.h"
 #include "apps/options_io.h"
 #include "evidence/judgement.h"
 #include "formats/camera_yaml.h"
 #include "pipeline/pipeline.h"
 #include "python/src/bindings.h"
+#include "report/advice_report.h"
 
 namespace puzzlecal::python {
 namespace {
@@ -24,6 +26,64 @@ struct PyCalibration {
   std::vector<std::string> view_files;
   JudgedCalibration judged;
 };
+
+// A CV_8UC3 image as an H x W x 3 uint8 array (BGR, as OpenCV keeps it;
+// a copy).
+py::array_t<uint8_t> BgrArray(const cv::Mat& image) {
+  py::array_t<uint8_t> out({image.rows, image.cols, 3});
+  for (int r = 0; r < image.rows; ++r) {
+    std::copy(image.ptr<uint8_t>(r), image.ptr<uint8_t>(r) + 3 * image.cols,
+              out.mutable_data(r, 0, 0));
+  }
+  return out;
+}
+
+py::dict UncertaintyDict(const FieldUncertainty& u) {
+  py::dict d;
+  d["worst_px"] = u.worst_px;
+  d["median_px"] = u.median_px;
+  d["worst_band_median_px"] = u.worst_band_median_px;
+  return d;
+}
+
+// The advice as a dict (the fields of advice.yaml, the outlines and the
+// pictures as arrays).
+py::dict AdviceDict(const Advice& advice, const PyCalibration& c) {
+  py::dict d;
+  d["field_radius_px"] = advice.field_radius_px;
+  d["field_deg"] = advice.field_deg;
+  d["noise_sigma_px"] = advice.noise_sigma_px;
+  d["views_taken"] = advice.views_taken;
+  d["uncertainty_now"] = UncertaintyDict(advice.now);
+  d["target_uncertainty_px"] = advice.target_uncertainty_px;
+  d["photos_to_target"] = advice.photos_to_target >= 0
+                              ? py::object(py::int_(advice.photos_to_target))
+                              : py::object(py::none());
+  d["candidates"] = advice.candidate_poses.size();
+  const std::vector<Eigen::Vector2d> seen =
+      SeenCorners(c.views, c.judged.result);
+  py::list views;
+  for (size_t k = 0; k < advice.views.size(); ++k) {
+    const AdvisedView& v = advice.views[k];
+    py::dict view;
+    view["words"] = v.words;
+    view["R"] = MatrixArray(v.cam_from_board.linear());
+    view["t"] = MatrixArray(v.cam_from_board.translation()).reshape({3});
+    view["centre_px"] = MatrixArray(v.centre_px).reshape({2});
+    view["distance_m"] = v.distance_m;
+    view["tilt_deg"] = v.tilt_deg;
+    view["tilt_direction_deg"] = v.tilt_direction_deg;
+    view["visible_corners"] = v.visible_corners;
+    view["outline_px"] = PointsArray(v.outline_px);
+    view["expected_after"] = UncertaintyDict(v.after);
+    view["picture"] = BgrArray(
+        DrawAdvicePicture(advice, static_cast<int>(k), seen, 1200));
+    views.append(view);
+  }
+  d["views"] = views;
+  d["text"] = advice.Text();
+  return d;
+}
 
 }  // namespace
 
@@ -322,6 +382,38 @@ void BindCalibration(py::module_& m) {
           "program prints it; None otherwise")
       .def("summary",
            [](const PyCalibration& c) { return c.judged.result.FullReport(); })
+      .def(
+          "advise",
+          [](const PyCalibration& c, int count, double field_deg,
+             const RunOptions& options, int threads) {
+            AdviceOptions advice_options = options.advice;
+            advice_options.count = count;
+            advice_options.field_deg = field_deg;
+            advice_options.num_threads = Threads(threads);
+            advice_options.target_uncertainty_px =
+                options.verdict.max_uncertainty_px;
+            advice_options.target_min_views = options.verdict.min_views;
+            std::string why;
+            if (!advice_options.Check(&why)) Raise("advise: " + why);
+            Advice advice;
+            {
+              py::gil_scoped_release release;
+              advice = AdviseViews(c.views, c.judged.result, c.board,
+                                   advice_options);
+            }
+            if (!advice.ok) Raise("advise: " + advice.error);
+            return AdviceDict(advice, c);
+          },
+          py::arg("count") = 4, py::arg("field_deg") = 0.0,
+          py::arg("options") = RunOptions(), py::arg("threads") = 0,
+          "Which photos to take next, as `puzzlecal advise` says: the `count` "
+          "board poses that lower the projection uncertainty the most, "
+          "chosen one by one. Returns a dict: uncertainty_now, "
+          "photos_to_target (None when not within reach), and views, each "
+          "with words, R and t (cam_from_board), centre_px, distance_m, "
+          "tilt_deg, tilt_direction_deg, outline_px (the board's border in "
+          "the image), expected_after and picture (an image as next_K.png "
+          "shows it). field_deg limits the judged field (0: the default).")
       .def(
           "save",
           [](const PyCalibration& c, const std::string& path,
