@@ -9,34 +9,34 @@
 namespace puzzlecal {
 namespace {
 
-template <typename Model>
-bool ModelViewInformation(const Camera& camera,
-                          const std::vector<Eigen::Vector3d>& board_points,
-                          const Eigen::Isometry3d& cam_from_board,
-                          double weight, Eigen::MatrixXd* information) {
-  constexpr int kN = Model::kNumParams;
-  double pose[kPoseBlockSize];
+// The solvers' pose block (angle-axis, translation) of a pose.
+void PoseBlock(const Eigen::Isometry3d& cam_from_board, double* pose) {
   const Eigen::Matrix3d rotation = cam_from_board.linear();
   ceres::RotationMatrixToAngleAxis(
       ceres::ColumnMajorAdapter3x3(rotation.data()), pose);
   for (int k = 0; k < 3; ++k) pose[3 + k] = cam_from_board.translation()(k);
+}
 
-  Eigen::Matrix<double, kN, kN> a = Eigen::Matrix<double, kN, kN>::Zero();
-  Eigen::Matrix<double, kN, kPoseBlockSize> b =
-      Eigen::Matrix<double, kN, kPoseBlockSize>::Zero();
+}  // namespace
+
+bool ViewInformation(const Camera& camera,
+                     const std::vector<Eigen::Vector3d>& board_points,
+                     const Eigen::Isometry3d& cam_from_board, double weight,
+                     Eigen::MatrixXd* information) {
+  const int n = CameraModelNumParams(camera.model);
+  if (static_cast<int>(camera.params.size()) != n) return false;
+  double pose[kPoseBlockSize];
+  PoseBlock(cam_from_board, pose);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(n, kPoseBlockSize);
   Eigen::Matrix<double, kPoseBlockSize, kPoseBlockSize> c =
       Eigen::Matrix<double, kPoseBlockSize, kPoseBlockSize>::Zero();
-  Eigen::Matrix<double, 2, kN, Eigen::RowMajor> j_intrinsics;
+  Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> j_intrinsics(2, n);
   Eigen::Matrix<double, 2, kPoseBlockSize, Eigen::RowMajor> j_pose;
-  const double* parameters[2] = {camera.params.data(), pose};
-  double* jacobians[2] = {j_intrinsics.data(), j_pose.data()};
   int used = 0;
   for (const Eigen::Vector3d& point : board_points) {
-    Eigen::Vector2d pixel;
-    if (!camera.Project(cam_from_board * point, &pixel)) continue;
-    const ReprojectionCost<Model> cost(point, pixel);
-    double residual[2];
-    if (!cost.Evaluate(parameters, residual, jacobians) ||
+    if (!ReprojectionJacobians(camera.model, camera.params.data(), pose, point,
+                               j_intrinsics.data(), j_pose.data()) ||
         !j_intrinsics.allFinite() || !j_pose.allFinite()) {
       continue;
     }
@@ -51,25 +51,8 @@ bool ModelViewInformation(const Camera& camera,
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
     return false;
   }
-  const Eigen::Matrix<double, kN, kN> schur = a - b * ldlt.solve(b.transpose());
-  *information = weight * schur;
+  *information = weight * (a - b * ldlt.solve(b.transpose()));
   return information->allFinite();
-}
-
-}  // namespace
-
-bool ViewInformation(const Camera& camera,
-                     const std::vector<Eigen::Vector3d>& board_points,
-                     const Eigen::Isometry3d& cam_from_board, double weight,
-                     Eigen::MatrixXd* information) {
-  if (static_cast<int>(camera.params.size()) !=
-      CameraModelNumParams(camera.model)) {
-    return false;
-  }
-  return DispatchCameraModel(camera.model, [&](auto model) {
-    return ModelViewInformation<decltype(model)>(
-        camera, board_points, cam_from_board, weight, information);
-  });
 }
 
 }  // namespace puzzlecal

@@ -158,6 +158,17 @@ extern template class ReprojectionCost<PinholeRationalModel>;
 extern template class ReprojectionCost<KannalaBrandtModel>;
 extern template class ReprojectionCost<KannalaBrandtNoncentralModel>;
 
+// The Jacobians of the reprojection error of `board_point` under `model`
+// with `intrinsics` and the pose block `pose` (angle-axis, translation):
+// d residual / d intrinsics (2 x n, row-major, n the model's parameter
+// count) and d residual / d pose (2 x 6, row-major), as the solvers compute
+// them, for code that needs them without a solve (the capture advice). False
+// when the point does not project.
+bool ReprojectionJacobians(CameraModelId model, const double* intrinsics,
+                           const double* pose,
+                           const Eigen::Vector3d& board_point,
+                           double* d_intrinsics, double* d_pose);
+
 }  // namespace puzzlecal
 
 #endif  // PUZZLECAL_CALIB_REPROJECTION_ERROR_H_
