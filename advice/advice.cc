@@ -666,9 +666,23 @@ std::string DescribePose(const Camera& camera, const Eigen::Vector2d& centre_px,
       static_cast<int>(3 * (centre_px.x() + 0.5) / camera.width), 0, 2);
   const int row = std::clamp(
       static_cast<int>(3 * (centre_px.y() + 0.5) / camera.height), 0, 2);
+  // Within the middle third, a shift of more than a twelfth of the image
+  // is said ("a little above the centre"): two advised poses can differ
+  // by that alone.
+  const double right = centre_px.x() / camera.width - 0.5;
+  const double down = centre_px.y() / camera.height - 0.5;
+  std::string shift;
+  if (row == 1 && std::abs(down) > 1.0 / 12) {
+    shift = down < 0 ? "above" : "below";
+  }
+  if (col == 1 && std::abs(right) > 1.0 / 12) {
+    shift += std::string(shift.empty() ? "" : " and ") +
+             (right < 0 ? "left of" : "right of");
+  }
   std::string place;
   if (row == 1 && col == 1) {
-    place = "in the centre of the image";
+    place = shift.empty() ? "in the centre of the image"
+                          : "a little " + shift + " the centre of the image";
   } else if (row == 1) {
     place = std::string("at the ") + kCols[col] + " edge of the image";
   } else if (col == 1) {

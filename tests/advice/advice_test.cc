@@ -214,6 +214,10 @@ TEST(Advice, DescribesPosesInWords) {
             "board about 7 cm away, its centre at the right edge of the "
             "image, tilted about 60 degrees with its top-right corner towards "
             "the camera");
+  EXPECT_EQ(DescribePose(camera, {400, 210}, 0.2, 60, 315),
+            "board about 20 cm away, its centre a little above the centre of "
+            "the image, tilted about 60 degrees with its top-right corner "
+            "towards the camera");
   EXPECT_EQ(DescribePose(camera, {400, 300}, 1.0, 0, 0),
             "board about 1 m away, its centre in the centre of the image, "
             "facing the camera squarely");
