@@ -52,6 +52,10 @@ DEFINE_string(watch, "",
               "uncertainty, verdict, the next advised photo); ends when the "
               "verdict is good, on Ctrl-C or after --watch-idle seconds "
               "without a photo, and writes what calibrate writes.");
+DEFINE_bool(same_focal, false,
+            "calibrate: one focal length, fy = fx (square pixels; OpenCV's "
+            "CALIB_FIX_ASPECT_RATIO with an aspect of 1); the options "
+            "file's calibration.same_focal_length.");
 DEFINE_double(watch_idle, 0,
               "calibrate --watch: stop after this many seconds without a new "
               "photo (0: wait for Ctrl-C or a good verdict).");
@@ -75,7 +79,7 @@ constexpr char kUsage[] =
     "                    [--rostopic TOPIC] [--camera-name NAME] "
     "[--quiet | --verbose]\n"
     "                    [--options FILE]  (`puzzlecal options` writes one)\n"
-    "                    [--fix NAMES] [--initial camera.yaml]\n"
+    "                    [--fix NAMES] [--initial camera.yaml] [--same-focal]\n"
     "puzzlecal calibrate --watch DIR --board BOARD.yaml --out camera.yaml "
     "[--watch-idle S] [...]\n\n"
     "Calibrates a camera from every image in DIR (png, jpg, tif, bmp; 8 or 16 "
@@ -427,6 +431,7 @@ int ParseRequest(CalibrateRequest* request) {
     return kExitBadInput;
   }
   request->calibration_options = request->options.calibration;
+  if (FLAGS_same_focal) request->calibration_options.same_focal_length = true;
   request->user_fixed = request->calibration_options.fixed_params;
   request->calibration_options.fixed_params.clear();
   if (const int code = ParseInitialCamera(request); code != kExitOk) {
@@ -935,8 +940,8 @@ PUZZLECAL_REGISTER_SUBCOMMAND(calibrate, "calibrate",
                               kUsage,
                               {"images", "board", "model", "out", "format",
                                "report", "threads", "rostopic", "camera_name",
-                               "options", "fix", "initial", "watch",
-                               "watch_idle"},
+                               "options", "fix", "initial", "same_focal",
+                               "watch", "watch_idle"},
                               &RunCalibrate);
 
 }  // namespace

@@ -205,6 +205,7 @@ struct Fields<CalibrationOptions> {
     v.Field("fix_focal_length", o.fix_focal_length);
     v.Field("fix_principal_point", o.fix_principal_point);
     v.Field("fix_distortion", o.fix_distortion);
+    v.Field("same_focal_length", o.same_focal_length);
     v.Field("initial_params", o.initial_params);
     v.Field("loss", o.loss);
     v.Field("loss_scale_px", o.loss_scale_px);

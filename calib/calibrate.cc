@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 
+#include "calib/intrinsics_manifold.h"
 #include "calib/marginal_covariance.h"
 #include "calib/parallel_reprojection.h"
 #include "calib/reprojection_error.h"
@@ -333,6 +334,14 @@ std::vector<bool> FixedParams(const CalibrationState& s) {
   return fixed;
 }
 
+// The parameters without a tangent coordinate of their own: the fixed
+// ones, and fy when it is tied to fx (same_focal_length).
+std::vector<bool> CovarianceFixed(const CalibrationState& s) {
+  std::vector<bool> fixed = s.fixed;
+  if (s.options.same_focal_length && fixed.size() > 1) fixed[1] = true;
+  return fixed;
+}
+
 // The correspondences that project through the initial camera start as
 // inliers; a view with too few of them drops out.
 bool SelectInitialInliers(CalibrationState* s) {
@@ -422,7 +431,15 @@ int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
   for (int k = 0; k < Model::kNumParams; ++k) {
     if (fixed[k]) fixed_indices.push_back(k);
   }
-  if (static_cast<int>(fixed_indices.size()) == Model::kNumParams) {
+  if (s->options.same_focal_length) {
+    auto manifold =
+        std::make_unique<TiedFocalManifold>(Model::kNumParams, fixed);
+    if (manifold->TangentSize() == 0) {
+      s->problem->SetParameterBlockConstant(s->params.data());
+    } else {
+      s->problem->SetManifold(s->params.data(), manifold.release());
+    }
+  } else if (static_cast<int>(fixed_indices.size()) == Model::kNumParams) {
     s->problem->SetParameterBlockConstant(s->params.data());
   } else if (!fixed_indices.empty()) {
     s->problem->SetManifold(
@@ -667,7 +684,7 @@ void FillResult(CalibrationState* s) {
   r->rms_px = corners > 0 ? std::sqrt(s->sum2 / (2.0 * corners)) : 0.0;
   r->rms_point_px = corners > 0 ? std::sqrt(s->sum2 / corners) : 0.0;
   s->free_params = kPoseBlockSize * r->num_views_used;
-  for (bool held : s->fixed) s->free_params += held ? 0 : 1;
+  for (bool held : CovarianceFixed(*s)) s->free_params += held ? 0 : 1;
 }
 
 // ---------------------------------------------------------------------------
@@ -716,8 +733,14 @@ void ComputeCovariance(CalibrationState* s) {
     for (size_t v = 0; v < s->poses.size(); ++v) {
       if (s->view_used[v]) poses.push_back(s->poses[v].data());
     }
-    ok = MarginalCovariance(s->problem.get(), s->params.data(), poses, s->fixed,
+    ok = MarginalCovariance(s->problem.get(), s->params.data(), poses,
+                            CovarianceFixed(*s),
                             s->options.covariance_min_eigenvalue_ratio, &block);
+    if (ok && s->options.same_focal_length) {
+      // fy is fx: its rows are fx's.
+      block.row(1) = block.row(0);
+      block.col(1) = block.col(0);
+    }
   } else {
     ok = CeresCovariance<Model>(s, &block);
   }
@@ -784,6 +807,12 @@ template <typename Model>
 bool CalibrateModel(CalibrationState* s) {
   if (!CheckViews(s) || !Initialise(s)) return false;
   s->fixed = FixedParams(*s);
+  if (s->options.same_focal_length) {
+    // fy follows fx from here on (TiedFocalManifold keeps their offset).
+    const double focal =
+        s->fixed[0] ? s->params[0] : 0.5 * (s->params[0] + s->params[1]);
+    s->params[0] = s->params[1] = focal;
+  }
   if (!SelectInitialInliers(s) || !SolveFromInitialisation<Model>(s)) {
     return false;
   }
@@ -1014,6 +1043,7 @@ CalibrationOptions PoseFitOptions(const CalibrationOptions& options,
   fit.fix_focal_length = true;
   fit.fix_principal_point = true;
   fit.fix_distortion = true;
+  fit.same_focal_length = false;  // the intrinsics are as given
   fit.compute_covariance = false;
   fit.min_views = 1;
   fit.min_orientation_spread_deg = 0;

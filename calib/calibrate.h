@@ -34,6 +34,11 @@ struct CalibrationOptions {
   // Hold every distortion coefficient at its initial value (0 unless
   // initial_params says otherwise). Default false.
   bool fix_distortion = false;
+  // One focal length: fy tied to fx (square pixels; OpenCV's
+  // CALIB_FIX_ASPECT_RATIO with an aspect of 1). Both start at their mean
+  // (at fx when fx is held); their standard deviations and covariance rows
+  // are then the same. Default false.
+  bool same_focal_length = false;
   // Individual parameters held at their initial values, by name ("k3",
   // "p1", ...; see CameraModelParamNames). Default empty.
   std::vector<std::string> fixed_params;

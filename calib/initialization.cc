@@ -742,9 +742,9 @@ std::vector<StartCandidate> StartingCandidates(
   const double f_search = SearchFocalLength(model, width, height, search_views,
                                             options, &candidates[0].cost);
   candidates[0].camera = CandidateCamera(model, width, height, f_search);
-  candidates[0].method = "focal-length search (f = " +
-                         std::to_string(f_search) +
-                         " px, centred principal point)";
+  candidates[0].method =
+      "focal-length search (f = " + std::to_string(f_search) +
+      " px, centred principal point)";
   const double cx0 = 0.5 * (width - 1), cy0 = 0.5 * (height - 1);
   const double scale = 0.5 * std::max(width, height);
   const std::vector<Eigen::Matrix3d> homographies =
@@ -767,8 +767,7 @@ std::vector<StartCandidate> StartingCandidates(
   double f;
   if (ZhangCentred(homographies, &f)) {
     const Camera centred = CandidateCamera(model, width, height, f * scale);
-    candidates.push_back({centred,
-                          "Zhang closed form, centred principal point",
+    candidates.push_back({centred, "Zhang closed form, centred principal point",
                           ViewFitCost(centred, search_views, options)});
   }
   return candidates;
@@ -839,12 +838,12 @@ void RefineStart(const std::vector<CalibrationView>& views,
 // can prefer a false basin on a narrow lens (steep views of a 70 deg lens
 // gave f = 139 px for 457), so each candidate is refined with k1, k2 free
 // and the best fit to the search views wins.
-void StartFromCandidates(const std::vector<CalibrationView>& views,
-                         const std::vector<bool>& use_view,
-                         CameraModelId model, int width, int height,
-                         const std::vector<const CalibrationView*>& search_views,
-                         const InitializationOptions& options, Camera* camera,
-                         InitializationResult* result) {
+void StartFromCandidates(
+    const std::vector<CalibrationView>& views,
+    const std::vector<bool>& use_view, CameraModelId model, int width,
+    int height, const std::vector<const CalibrationView*>& search_views,
+    const InitializationOptions& options, Camera* camera,
+    InitializationResult* result) {
   std::vector<StartCandidate> candidates =
       StartingCandidates(model, width, height, search_views, options);
   const bool refine = options.start_refine_iterations > 0;

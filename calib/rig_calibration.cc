@@ -1088,6 +1088,13 @@ bool RigCalibrationOptions::Check(std::string* why) const {
   if (!(max_start_rotation_deviation_deg > 0)) {
     return Fail("max_start_rotation_deviation_deg must be > 0", why);
   }
+  if (camera.same_focal_length) {
+    // The joint solve and its covariance hold parameters by subset only.
+    return Fail(
+        "same_focal_length is for single cameras; the rig calibration does "
+        "not tie fy to fx",
+        why);
+  }
   return camera.Check(why);
 }
 

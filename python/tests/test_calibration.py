@@ -171,3 +171,14 @@ def test_fixed_parameters_and_a_known_start(board, radtan):
         puzzlecal.calibrate(
             str(SAMPLE), board, model="pinhole-radtan", threads=2,
             options=puzzlecal.options(calibration={"fixed_params": ["k9"]}))
+
+
+def test_same_focal_length_by_keyword(board):
+    """One focal length through the options, as --same-focal does."""
+    result = puzzlecal.calibrate(
+        str(SAMPLE), board, model="pinhole-radtan", threads=2,
+        options=puzzlecal.options(calibration={"same_focal_length": True}))
+    params = result.params_by_name
+    assert params["fx"] == params["fy"]
+    sigma = result.stddev_by_name
+    assert sigma["fx"] == sigma["fy"] > 0

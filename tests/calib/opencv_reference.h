@@ -16,17 +16,18 @@ namespace puzzlecal {
 namespace testing {
 
 struct OpenCvCalibration {
-  bool ok = false;           // OpenCV returned without an exception
-  std::string error;         // the exception text when !ok
-  double rms_point_px = 0;   // OpenCV's returned RMS (per corner)
+  bool ok = false;             // OpenCV returned without an exception
+  std::string error;           // the exception text when !ok
+  double rms_point_px = 0;     // OpenCV's returned RMS (per corner)
   std::vector<double> params;  // in puzzlecal's parameter order
 };
 
 // cv::calibrateCamera (5 coefficients, or 8 with CALIB_RATIONAL_MODEL) or
-// cv::fisheye::calibrate, by model.
+// cv::fisheye::calibrate, by model. `flags` are added to calibrateCamera's
+// (CALIB_FIX_ASPECT_RATIO keeps fx / fy at 1).
 inline OpenCvCalibration CalibrateWithOpenCv(
     const std::vector<CalibrationView>& views, CameraModelId model, int width,
-    int height) {
+    int height, int flags = 0) {
   OpenCvCalibration out;
   try {
     if (model == CameraModelId::kKannalaBrandt) {
@@ -46,8 +47,8 @@ inline OpenCvCalibration CalibrateWithOpenCv(
       out.rms_point_px = cv::fisheye::calibrate(
           object, image, cv::Size(width, height), k, d, rvecs, tvecs,
           cv::fisheye::CALIB_RECOMPUTE_EXTRINSIC | cv::fisheye::CALIB_FIX_SKEW,
-          cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
-                           100, 1e-12));
+          cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100,
+                           1e-12));
       out.params = {k(0, 0), k(1, 1), k(0, 2), k(1, 2), d[0], d[1], d[2], d[3]};
     } else {
       // calibrateCamera works in single precision.
@@ -62,13 +63,13 @@ inline OpenCvCalibration CalibrateWithOpenCv(
         }
       }
       const bool rational = model == CameraModelId::kPinholeRational;
-      cv::Mat k, d;
+      cv::Mat k = cv::Mat::eye(3, 3, CV_64F), d;
       std::vector<cv::Mat> rvecs, tvecs;
       out.rms_point_px = cv::calibrateCamera(
           object, image, cv::Size(width, height), k, d, rvecs, tvecs,
-          rational ? cv::CALIB_RATIONAL_MODEL : 0,
-          cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
-                           100, 1e-12));
+          (rational ? cv::CALIB_RATIONAL_MODEL : 0) | flags,
+          cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100,
+                           1e-12));
       out.params = {k.at<double>(0, 0), k.at<double>(1, 1), k.at<double>(0, 2),
                     k.at<double>(1, 2)};
       const int num = rational ? 8 : 5;
