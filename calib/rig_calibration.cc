@@ -1088,13 +1088,6 @@ bool RigCalibrationOptions::Check(std::string* why) const {
   if (!(max_start_rotation_deviation_deg > 0)) {
     return Fail("max_start_rotation_deviation_deg must be > 0", why);
   }
-  if (camera.same_focal_length) {
-    // The joint solve and its covariance hold parameters by subset only.
-    return Fail(
-        "same_focal_length is for single cameras; the rig calibration does "
-        "not tie fy to fx",
-        why);
-  }
   return camera.Check(why);
 }
 
@@ -1114,6 +1107,13 @@ bool CalibrateRig(const std::vector<RigCameraInput>& input_cameras,
   std::string why;
   if (!options.Check(&why))
     return Fail("rig calibration options: " + why, error);
+  if (options.camera.same_focal_length) {
+    // The joint solve and its covariance hold parameters by subset only.
+    return Fail(
+        "same_focal_length (--same-focal) is for single cameras; the rig "
+        "calibration does not tie fy to fx",
+        error);
+  }
   if (!CheckRigInput(cameras, error)) return false;
   const size_t num_cameras = cameras.size();
   const size_t num_frames = cameras[0].frames.size();

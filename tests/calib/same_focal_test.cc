@@ -71,8 +71,11 @@ TEST(SameFocalLength, ARigRefusesIt) {
   RigCalibrationOptions options;
   options.camera.same_focal_length = true;
   std::string why;
-  EXPECT_FALSE(options.Check(&why));
-  EXPECT_NE(why.find("same_focal_length"), std::string::npos);
+  EXPECT_TRUE(options.Check(&why)) << why;  // an options file may hold it
+  RigCalibrationResult result;
+  std::string error;
+  EXPECT_FALSE(CalibrateRig({}, options, &result, &error));
+  EXPECT_NE(error.find("same_focal_length"), std::string::npos) << error;
 }
 
 }  // namespace
