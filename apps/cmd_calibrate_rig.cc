@@ -28,7 +28,10 @@
 #include "formats/rig_yaml.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/rig_run.h"
+#include "pipeline/rig_video.h"
+#include "pipeline/video_frames.h"
 #include "report/rig_report.h"
+#include "util/atomic_file.h"
 #include "util/timer.h"
 
 DEFINE_bool(match_by_order, false,
@@ -52,7 +55,19 @@ constexpr char kUsage[] =
     "file name in different subfolders is the\nsame instant; a camera "
     "without that file did not see the board then (--match_by_order\n"
     "pairs the n-th image of every folder instead, for folders named "
-    "left01.jpg, right01.jpg, ...).\nOne --model for all "
+    "left01.jpg, right01.jpg, ...).\nA camera folder may instead hold "
+    "exactly one video (mp4, avi, mkv, mov, ...), then every camera's\n"
+    "must: each video's sharp frames showing the board are paired with the "
+    "first camera's frame\nnearest in time stamp, within "
+    "rig_video.max_time_difference_ms (default a quarter of its\nframe "
+    "period). The time stamps are taken to count from a common start: start "
+    "the cameras\ntogether (or cut the videos to a common start). Near "
+    "duplicate frames are dropped and at most\nvideo.max_frames kept, spread "
+    "over the poses; a line per video and one for the rig say\nwhat became "
+    "of the frames (the report folder gets video_frames_CAMERA.csv per "
+    "camera), and\nframes are named cam0.mp4#frame0123. A folder with "
+    "several videos, or photos and videos\nmixed, is refused.\nOne --model "
+    "for all "
     "cameras, or one per camera in folder order; auto chooses a camera's\n"
     "model by held-out error, as calibrate --model auto does. Writes the rig "
     "file "
@@ -250,17 +265,84 @@ int ParseRigRequest(RigRequest* request) {
   return kExitOk;
 }
 
+// The names of a listing's files, for messages ("a.mp4, b.mp4").
+std::string FileNames(const std::vector<std::string>& files) {
+  std::string names;
+  for (size_t i = 0; i < files.size() && i < 4; ++i) {
+    names += (i > 0 ? ", " : "") + fs::path(files[i]).filename().string();
+  }
+  return names + (files.size() > 4 ? ", ..." : "");
+}
+
+// Photos in every camera folder, or exactly one video in every one
+// (`videos` receives them then, one per camera; empty for photos).
+// Returns kExitOk or kExitBadInput, having named the folder and said why.
+int CheckCameraInputs(const RigRequest& request,
+                      const std::vector<ImageListing>& listings,
+                      std::vector<std::string>* videos) {
+  constexpr char kRule[] =
+      "a camera folder holds photos or exactly one video, and a rig is "
+      "calibrated from photos in every camera folder or from one video in "
+      "every camera folder";
+  int first_video = -1, first_photos = -1;
+  for (size_t c = 0; c < listings.size(); ++c) {
+    const std::string camera = "camera '" +
+                               request.folders[c].filename().string() +
+                               "' (" + request.folders[c].string() + ")";
+    const ImageListing& listing = listings[c];
+    if (listing.videos.size() > 1) {
+      std::cerr << kName << ": " << camera << " holds "
+                << listing.videos.size() << " videos ("
+                << FileNames(listing.videos) << "); " << kRule << ".\n";
+      return kExitBadInput;
+    }
+    if (!listing.videos.empty() && !listing.images.empty()) {
+      std::cerr << kName << ": " << camera << " holds both photos ("
+                << FileNames(listing.images) << ") and a video ("
+                << FileNames(listing.videos) << "); " << kRule << ".\n";
+      return kExitBadInput;
+    }
+    int& first = listing.videos.empty() ? first_photos : first_video;
+    if (first < 0) first = static_cast<int>(c);
+  }
+  if (first_video >= 0 && first_photos >= 0) {
+    const size_t v = first_video, p = first_photos;
+    std::cerr << kName << ": camera '"
+              << request.folders[v].filename().string() << "' ("
+              << request.folders[v].string() << ") holds a video ("
+              << FileNames(listings[v].videos) << "), camera '"
+              << request.folders[p].filename().string() << "' ("
+              << request.folders[p].string() << ") photos; " << kRule
+              << ".\n";
+    return kExitBadInput;
+  }
+  videos->clear();
+  if (first_video < 0) return kExitOk;
+  if (FLAGS_match_by_order) {
+    std::cerr << kName << ": --match_by_order pairs photos; the frames of "
+              << "the camera videos in " << FLAGS_images
+              << " are paired by time stamp.\n";
+    return kExitUsage;
+  }
+  for (const ImageListing& listing : listings) {
+    videos->push_back(listing.videos[0]);
+  }
+  return kExitOk;
+}
+
 // Every camera's images and the frame of each (pipeline/rig_run.h: by file
-// name, or by order with --match_by_order).
+// name, or by order with --match_by_order), or every camera's video
+// (`videos`, frames paired later by time).
 int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
-               RigFrames* frames) {
+               RigFrames* frames, std::vector<std::string>* videos) {
   const size_t num_cameras = request.folders.size();
   listings->resize(num_cameras);
   std::vector<std::string> names;
   for (size_t c = 0; c < num_cameras; ++c) {
     names.push_back(request.folders[c].filename().string());
     std::string error;
-    if (!ListImages(request.folders[c].string(), &(*listings)[c], &error)) {
+    if (!ListImagesAndVideos(request.folders[c].string(), &(*listings)[c],
+                             &error)) {
       std::cerr << kName << ": camera '" << names.back() << "': " << error
                 << "\n";
       return kExitBadInput;
@@ -268,6 +350,10 @@ int ListFrames(const RigRequest& request, std::vector<ImageListing>* listings,
     for (const std::string& skipped : (*listings)[c].skipped) {
       LOG(INFO) << "skipped " << skipped;
     }
+  }
+  if (const int code = CheckCameraInputs(request, *listings, videos);
+      code != kExitOk || !videos->empty()) {
+    return code;
   }
   std::string error;
   if (!MatchRigFrames(names, *listings, FLAGS_match_by_order, frames, &error)) {
@@ -337,6 +423,9 @@ int AddKnownCamera(const RigRequest& request, RigCameraInput* input) {
   return kExitOk;
 }
 
+int FinishCamera(const RigRequest& request, size_t c, int usable,
+                 const std::string& what, RigCameraInput* input);
+
 // Detection, grid and decode of one camera's images into its rig input:
 // one (possibly empty) view per frame; `frame_files` receives the image
 // file of each frame ("" where the camera has none).
@@ -361,6 +450,13 @@ int DetectCamera(const RigRequest& request, size_t c,
     std::cerr << "camera '" << input->name << "': " << usable << " of "
               << images.size() << " images usable\n";
   }
+  return FinishCamera(request, c, usable, "image", input);
+}
+
+// Camera c's model (--model auto) and known parameters once its views are
+// made; `usable` views, none: bad input naming the folder.
+int FinishCamera(const RigRequest& request, size_t c, int usable,
+                 const std::string& what, RigCameraInput* input) {
   if (usable > 0) {
     if (request.auto_model[c]) {
       if (const int code = ChooseModel(request, input); code != kExitOk) {
@@ -370,9 +466,53 @@ int DetectCamera(const RigRequest& request, size_t c,
     return AddKnownCamera(request, input);
   }
   std::cerr << kName << ": camera '" << input->name << "' ("
-            << request.folders[c].string()
-            << "): no image shows the board; no calibration written.\n";
+            << request.folders[c].string() << "): no " << what
+            << " shows the board; no calibration written.\n";
   return kExitBadInput;
+}
+
+// Every camera's video (pipeline/rig_video.h): frames examined, paired by
+// time stamp with the first camera's and chosen; a line per video and one
+// for the rig say what became of them. `videos_out` keeps each video's
+// frame records for the report.
+int DetectVideoCameras(const RigRequest& request,
+                       const std::vector<std::string>& videos,
+                       std::vector<RigCameraInput>* inputs,
+                       std::vector<std::vector<std::string>>* frame_files,
+                       std::vector<VideoFrames>* videos_out) {
+  RigVideoFrames frames;
+  std::string error;
+  if (!ReadRigVideos(videos, request.board, request.options.pipeline,
+                     request.options.video, request.options.rig_video,
+                     request.threads, &frames, &error)) {
+    std::cerr << kName << ": " << error << "\n";
+    return kExitBadInput;
+  }
+  if (!FLAGS_quiet) {
+    for (size_t c = 0; c < videos.size(); ++c) {
+      std::cout << "camera '" << request.folders[c].filename().string()
+                << "': " << frames.videos[c].Summary() << "\n";
+    }
+    std::cout << frames.Summary() << "\n";
+  }
+  for (size_t c = 0; c < videos.size(); ++c) {
+    RigCameraInput& input = (*inputs)[c];
+    input.name = request.folders[c].filename().string();
+    input.model = request.models[c];
+    input.fixed_params = request.format_fixed[c];
+    const int usable = MakeRigVideoCameraViews(request.board, c, &frames,
+                                               &input, &(*frame_files)[c]);
+    if (const int code =
+            FinishCamera(request, c, usable, "chosen video frame", &input);
+        code != kExitOk) {
+      if (usable == 0 && frames.unpaired_frames > 0) {
+        std::cerr << kName << ": " << frames.Summary() << "\n";
+      }
+      return code;
+    }
+  }
+  *videos_out = std::move(frames.videos);
+  return kExitOk;
 }
 
 // The frames' notes (relabelled views of a symmetric board, views left
@@ -444,6 +584,8 @@ void PrintRigOutcome(const RigCalibrationResult& result,
 bool WriteReport(const RigCalibrationResult& result, bool calibrated,
                  const std::string& calibration_error, const JudgedRig& judged,
                  const std::vector<std::vector<std::string>>& frame_files,
+                 const std::vector<VideoFrames>& videos,
+                 const std::vector<std::string>& camera_names,
                  double seconds_images, double seconds_total, int threads,
                  std::string* error) {
   RigReportInput report;
@@ -466,7 +608,20 @@ bool WriteReport(const RigCalibrationResult& result, bool calibrated,
   return WriteFolderInPlace(
       fs::path(FLAGS_report),
       [&](const std::string& folder, std::string* why) {
-        return WriteRigReport(folder, report, RigReportOptions(), why);
+        if (!WriteRigReport(folder, report, RigReportOptions(), why)) {
+          return false;
+        }
+        // Each camera video's frames: which were taken and why the others
+        // not, and the reference frame each was paired with.
+        for (size_t c = 0; c < videos.size(); ++c) {
+          const std::string name =
+              "video_frames_" + camera_names[c] + ".csv";
+          if (!WriteFileAtomically((fs::path(folder) / name).string(),
+                                   videos[c].Csv(true), why)) {
+            return false;
+          }
+        }
+        return true;
       },
       error);
 }
@@ -480,7 +635,8 @@ int RunCalibrateRig() {
   }
   std::vector<ImageListing> listings;
   RigFrames frames;
-  if (const int code = ListFrames(request, &listings, &frames);
+  std::vector<std::string> videos;
+  if (const int code = ListFrames(request, &listings, &frames, &videos);
       code != kExitOk) {
     return code;
   }
@@ -489,7 +645,19 @@ int RunCalibrateRig() {
   const size_t num_cameras = request.folders.size();
   std::vector<RigCameraInput> inputs(num_cameras);
   std::vector<std::vector<std::string>> frame_files(num_cameras);
-  for (size_t c = 0; c < num_cameras; ++c) {
+  std::vector<VideoFrames> video_frames;
+  std::vector<std::string> camera_names;
+  for (const fs::path& folder : request.folders) {
+    camera_names.push_back(folder.filename().string());
+  }
+  if (!videos.empty()) {
+    if (const int code = DetectVideoCameras(request, videos, &inputs,
+                                            &frame_files, &video_frames);
+        code != kExitOk) {
+      return code;
+    }
+  }
+  for (size_t c = 0; c < num_cameras && videos.empty(); ++c) {
     if (const int code =
             DetectCamera(request, c, listings[c], frames.frame_of_file[c],
                          frames.num_frames, &inputs[c], &frame_files[c]);
@@ -513,8 +681,8 @@ int RunCalibrateRig() {
   if (!calibrated) {
     if (!FLAGS_report.empty() &&
         !WriteReport(result, calibrated, calibration_error, judged, frame_files,
-                     seconds_images, run_timer.Seconds(), request.threads,
-                     &error)) {
+                     video_frames, camera_names, seconds_images,
+                     run_timer.Seconds(), request.threads, &error)) {
       std::cerr << kName << ": report not written: " << error << "\n";
     }
     std::cerr << kName << ": no calibration written. " << calibration_error
@@ -531,8 +699,8 @@ int RunCalibrateRig() {
   g_rig_written = 1;
   if (!FLAGS_report.empty()) {
     if (!WriteReport(result, calibrated, calibration_error, judged, frame_files,
-                     seconds_images, run_timer.Seconds(), request.threads,
-                     &error)) {
+                     video_frames, camera_names, seconds_images,
+                     run_timer.Seconds(), request.threads, &error)) {
       for (const std::string& path : written) {
         std::cout << "wrote " << path << "\n";
       }

@@ -385,6 +385,14 @@ struct Fields<VideoFrameOptions> {
 };
 
 template <>
+struct Fields<RigVideoOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("max_time_difference_ms", o.max_time_difference_ms);
+  }
+};
+
+template <>
 struct Fields<AdviceOptions> {
   // Not here: count (--count), field_deg (--field-deg), num_threads
   // (--threads), target_uncertainty_px and target_min_views (the verdict
@@ -465,6 +473,7 @@ struct Fields<RunOptions> {
     v.Group("rig_evidence", o.rig_evidence);
     v.Group("check", o.check);
     v.Group("video", o.video);
+    v.Group("rig_video", o.rig_video);
     v.Group("advice", o.advice);
   }
 };
@@ -619,6 +628,7 @@ bool CheckSections(const RunOptions& o, std::string* why) {
   if (!o.rig_evidence.Check(&inner)) return failed("rig_evidence");
   if (!o.check.Check(&inner)) return failed("check");
   if (!o.video.Check(&inner)) return failed("video");
+  if (!o.rig_video.Check(&inner)) return failed("rig_video");
   if (!o.advice.Check(&inner)) return failed("advice");
   return true;
 }
@@ -679,7 +689,8 @@ constexpr char kHeader[] =
     "# evidence/verdict.h, model_selection evidence/model_selection.h, rig\n"
     "# calib/rig_calibration.h (its camera options are the calibration\n"
     "# section), rig_evidence evidence/rig_evidence.h, check\n"
-    "# evidence/recheck.h, video pipeline/video_frames.h, advice\n"
+    "# evidence/recheck.h, video pipeline/video_frames.h, rig_video\n"
+    "# pipeline/rig_video.h, advice\n"
     "# advice/advice.h. --threads and --format's fixed parameters are flags\n"
     "# only.\n";
 

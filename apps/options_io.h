@@ -29,6 +29,7 @@
 #include "evidence/rig_evidence.h"
 #include "evidence/verdict.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/rig_video.h"
 #include "pipeline/video_frames.h"
 
 namespace puzzlecal {
@@ -56,6 +57,9 @@ struct RunOptions {
   // Section video: choosing calibration frames from videos
   // (VideoFrameOptions).
   VideoFrameOptions video;
+  // Section rig_video (calibrate-rig from one video per camera): pairing
+  // the cameras' frames by time stamp (RigVideoOptions).
+  RigVideoOptions rig_video;
   // Section advice (`puzzlecal advise`, and calibrate's report when the
   // verdict is not good): AdviceOptions but count, field_deg, num_threads
   // (flags) and the target (the verdict section's max_uncertainty_px and

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "calib/initialization.h"
+#include "formats/image_io.h"
 #include "formats/video_io.h"
 #include "util/enum_names.h"
 #include "util/failure.h"
@@ -25,6 +26,7 @@ constexpr EnumName<VideoFrameOutcome> kOutcomeNames[] = {
     {VideoFrameOutcome::kBlurred, "blurred"},
     {VideoFrameOutcome::kNearDuplicate, "near duplicate"},
     {VideoFrameOutcome::kNotNeeded, "not needed"},
+    {VideoFrameOutcome::kNoPartner, "no partner"},
 };
 
 // Bilinear grey level at (x, y); false outside the image.
@@ -212,6 +214,42 @@ std::string VideoFrameName(const std::string& video, int index) {
   return StringPrintf("%s#frame%04d", video.c_str(), index);
 }
 
+bool ParseVideoFrameName(const std::string& name, std::string* video,
+                         int* index) {
+  const size_t hash = name.rfind("#frame");
+  if (hash == std::string::npos || hash == 0) return false;
+  const std::string digits = name.substr(hash + 6);
+  if (digits.empty() || digits.size() > 9 ||
+      !std::all_of(digits.begin(), digits.end(),
+                   [](char ch) { return ch >= '0' && ch <= '9'; })) {
+    return false;
+  }
+  *video = name.substr(0, hash);
+  *index = std::stoi(digits);
+  return true;
+}
+
+bool LoadFrameImage(const std::string& file, cv::Mat* grey,
+                    std::string* error) {
+  std::string video;
+  int index = 0;
+  if (!ParseVideoFrameName(file, &video, &index) ||
+      !HasVideoExtension(video)) {
+    return LoadGreyImage(file, ImageLoadOptions(), grey, error);
+  }
+  VideoReader reader;
+  if (!reader.Open(video, error)) return false;
+  double time_ms = 0;
+  for (int i = 0; i <= index; ++i) {
+    if (!reader.Read(grey, &time_ms)) {
+      return Fail(file + ": the video ends (or cannot be decoded) before "
+                         "frame " + std::to_string(index),
+                  error);
+    }
+  }
+  return true;
+}
+
 int VideoFrames::Count(VideoFrameOutcome outcome) const {
   return static_cast<int>(
       std::count_if(frames.begin(), frames.end(),
@@ -231,14 +269,19 @@ std::string VideoFrames::Summary() const {
       << Count(VideoFrameOutcome::kNearDuplicate) << " near duplicates, "
       << Count(VideoFrameOutcome::kNotNeeded) << " not needed, "
       << Count(VideoFrameOutcome::kKept) << " kept";
+  if (const int no_partner = Count(VideoFrameOutcome::kNoPartner);
+      no_partner > 0) {
+    out << ", " << no_partner << " without a partner in time";
+  }
   if (!note.empty()) out << "; " << note;
   return out.str();
 }
 
-std::string VideoFrames::Csv() const {
+std::string VideoFrames::Csv(bool with_partners) const {
   std::ostringstream out;
   out << "frame,time_ms,outcome,corners,edge_width_px,pose_change_px,"
-         "similar_frame,reason\n";
+         "similar_frame,reason"
+      << (with_partners ? ",reference_frame,time_difference_ms\n" : "\n");
   for (const VideoFrameRecord& r : frames) {
     std::string reason = r.reason;
     std::replace(reason.begin(), reason.end(), '"', '\'');
@@ -249,7 +292,16 @@ std::string VideoFrames::Csv() const {
         << (r.pose_change_px < 0 ? ""
                                  : StringPrintf("%.1f", r.pose_change_px))
         << "," << (r.similar_frame < 0 ? "" : std::to_string(r.similar_frame))
-        << ",\"" << reason << "\"\n";
+        << ",\"" << reason << "\"";
+    if (with_partners) {
+      out << ","
+          << (r.reference_frame < 0 ? "" : std::to_string(r.reference_frame))
+          << ","
+          << (r.reference_frame < 0
+                  ? ""
+                  : StringPrintf("%.3f", r.time_difference_ms));
+    }
+    out << "\n";
   }
   return out.str();
 }

@@ -68,10 +68,13 @@ enum class VideoFrameOutcome {
   kBlurred,        // edges wider than max_edge_width_px
   kNearDuplicate,  // a kept frame shows nearly the same pose
   kNotNeeded,      // beyond max_frames: kept frames show more different poses
+  // calibrate-rig: no frame of the reference camera's video within the
+  // time tolerance (or a nearer frame of this video took it)
+  kNoPartner,
 };
 
 // "kept", "no board", "few corners", "blurred", "near duplicate",
-// "not needed".
+// "not needed", "no partner".
 const char* VideoFrameOutcomeName(VideoFrameOutcome outcome);
 
 struct VideoFrameRecord {
@@ -85,6 +88,11 @@ struct VideoFrameRecord {
   double pose_change_px = -1;
   int similar_frame = -1;  // that kept frame's index
   std::string reason;      // kNoBoard: the pipeline's reason
+  // calibrate-rig (pipeline/rig_video.h): the reference camera's frame this
+  // frame was paired with by time stamp (-1: none), and this frame's time
+  // minus that frame's (ms).
+  int reference_frame = -1;
+  double time_difference_ms = 0;
 };
 
 // The board-to-image homography's image of the board's outline: a frame's
@@ -117,16 +125,29 @@ struct VideoFrames {
 
   int Count(VideoFrameOutcome outcome) const;
   // "clip.mp4: 900 frames, 87 with the board, 23 blurred, 41 near
-  // duplicates, 30 kept" (and the note).
+  // duplicates, 30 kept" (the frames without a partner in time when there
+  // are any, and the note).
   std::string Summary() const;
   // One line per examined frame: frame,time_ms,outcome,corners,
-  // edge_width_px,pose_change_px,similar_frame,reason.
-  std::string Csv() const;
+  // edge_width_px,pose_change_px,similar_frame,reason; `with_partners`
+  // (calibrate-rig) adds reference_frame,time_difference_ms.
+  std::string Csv(bool with_partners = false) const;
 };
 
 // The name of frame `index` of `video`: "VIDEO#frame0123" (at least four
 // digits), what messages, tables and camera files call it.
 std::string VideoFrameName(const std::string& video, int index);
+
+// The video and frame index of a VideoFrameName; false for other names.
+bool ParseVideoFrameName(const std::string& name, std::string* video,
+                         int* index);
+
+// The 8-bit grey pixels of `file`: a photo (formats/image_io.h
+// LoadGreyImage with default options) or a video frame named by
+// VideoFrameName (the video decoded up to that frame). False with a message
+// naming the file and the reason.
+bool LoadFrameImage(const std::string& file, cv::Mat* grey,
+                    std::string* error);
 
 // Sharpness of a frame where its board is: the edge width (see
 // VideoFrameOptions::max_edge_width_px) across the tile edges between

@@ -10,6 +10,7 @@
 
 #include "formats/image_io.h"
 #include "formats/png_writer.h"
+#include "pipeline/video_frames.h"
 #include "report/html.h"
 #include "report/overlay.h"
 #include "report/plot.h"
@@ -364,10 +365,9 @@ bool WriteRectifiedPair(const std::string& dir, const RigReportInput& input,
                         const RigReportOptions& options, std::string* error) {
   const RigCalibrationResult& result = *input.result;
   cv::Mat first, second;
-  if (!LoadGreyImage(input.files[0][pair_frame], ImageLoadOptions(), &first,
-                     error) ||
-      !LoadGreyImage(input.files[1][pair_frame], ImageLoadOptions(), &second,
-                     error)) {
+  // Photos, or frames of the cameras' videos ("cam0.mp4#frame0012").
+  if (!LoadFrameImage(input.files[0][pair_frame], &first, error) ||
+      !LoadFrameImage(input.files[1][pair_frame], &second, error)) {
     return false;
   }
   const cv::Mat pair =

@@ -13,6 +13,7 @@
 
 #include "camera/camera_models.h"
 #include "sim/render.h"
+#include "sim/rig_scenes.h"
 #include "sim/scenes.h"
 #include "target/board.h"
 
@@ -74,6 +75,53 @@ bool RenderClip(const ClipSpec& spec, const std::string& path, int num_threads,
 // by 8-16 px streaks.
 ClipSpec SampleClip(double seconds = 30.0, double fps = 30.0, int width = 640,
                     int height = 480);
+
+// A rig's clips: the same board motion (a ClipSpec's path, blur, rate and
+// length) seen by every camera of a rig, one video per camera, so a rig
+// run from videos can be checked against the rig, the cameras and each
+// frame's pose. A camera may be offset in time (an unsynchronised rig): its
+// frame i shows the board where it is at i / fps + time_offset_ms, while
+// its video's time stamps count i / fps from 0 as every camera's do.
+struct RigClipSpec {
+  // The board, its path (poses in the rig frame, the first camera's:
+  // cam_from_board of camera 0), render options, fps, length and blur; its
+  // `camera` is not used (each camera below has its own). Camera c's frame
+  // i uses seed render.seed + 100000 * c + i; a shake blurs every camera's
+  // frame of that instant with the same streak.
+  ClipSpec clip;
+  // The cameras, [0] the rig frame (its cam_from_rig the identity); >= 1.
+  // field_of_view_deg is each camera's RenderOptions::field_of_view_deg.
+  std::vector<RigSceneCamera> cameras;
+  // Per camera, its clip's offset in time (ms; positive: the camera shows
+  // later instants of the motion). Empty (the default): all 0. Poses
+  // beyond the path's ends stay at its ends.
+  std::vector<double> time_offset_ms;
+
+  bool Check(std::string* why = nullptr) const;
+};
+
+// Per camera, the truth of every frame of its clip (camera c's
+// cam_from_board).
+std::vector<std::vector<ClipFrameTruth>> RigClipTruth(const RigClipSpec& spec);
+
+// Renders camera c's clip into `paths[c]` (as RenderClip: frames rendered
+// on `num_threads` threads, the files do not depend on the thread count).
+// Fills `truth` (optional, per camera). False with a reason naming the
+// field, the camera or the file.
+bool RenderRigClip(const RigClipSpec& spec,
+                   const std::vector<std::string>& paths, int num_threads,
+                   std::vector<std::vector<ClipFrameTruth>>* truth,
+                   std::string* error);
+
+// A stereo rig filming SampleClip's motion (the board 0.35-0.8 m in front
+// of the first camera): "cam0" the sample lens, "cam1" a 84-degree pinhole
+// with less distortion and its principal point 2 % of the width off the
+// centre, 12 cm to the right of cam0 (and 4 mm down, 2 mm back), turned 4
+// degrees towards it and 0.7 degrees down. `cam1_offset_ms` offsets cam1's
+// clip in time (0: synchronised).
+RigClipSpec StereoClip(double seconds = 4.0, double fps = 10.0,
+                       int width = 640, int height = 480,
+                       double cam1_offset_ms = 0.0);
 
 }  // namespace puzzlecal
 
