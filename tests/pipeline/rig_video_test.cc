@@ -142,7 +142,9 @@ TEST(ChooseRigFrames, TheCapPrefersFramesSeenByMoreCamerasAndSpreads) {
   for (size_t k = 0; k < frames.size(); ++k) {
     const bool kept = k == 0 || k == 4 || k == 9;
     EXPECT_EQ(choice.not_needed[k], !kept) << k;
-    if (!kept) EXPECT_GE(choice.closest[k], 0) << k;
+    if (!kept) {
+      EXPECT_GE(choice.closest[k], 0) << k;
+    }
   }
   EXPECT_EQ(choice.closest[1], 0);
   EXPECT_EQ(choice.closest[8], 9);
