@@ -32,6 +32,7 @@
 #include "pipeline/video_frames.h"
 #include "report/rig_report.h"
 #include "util/atomic_file.h"
+#include "util/string_format.h"
 #include "util/timer.h"
 
 DEFINE_bool(match_by_order, false,
@@ -502,12 +503,24 @@ int DetectVideoCameras(const RigRequest& request,
     input.fixed_params = request.format_fixed[c];
     const int usable = MakeRigVideoCameraViews(request.board, c, &frames,
                                                &input, &(*frame_files)[c]);
+    if (usable == 0 &&
+        frames.videos[c].Count(VideoFrameOutcome::kNoPartner) > 0) {
+      std::cerr << kName << ": camera '" << input.name << "' ("
+                << request.folders[c].string()
+                << "): none of its frames showing the board has a frame of "
+                << fs::path(videos[0]).filename().string() << " within "
+                << StringPrintf("%.1f", frames.tolerance_ms) << " ms ("
+                << frames.Summary()
+                << "). The time stamps are taken to count from a common "
+                   "start: start the cameras together (or cut the videos to "
+                   "a common start), or widen "
+                   "rig_video.max_time_difference_ms; no calibration "
+                   "written.\n";
+      return kExitBadInput;
+    }
     if (const int code =
             FinishCamera(request, c, usable, "chosen video frame", &input);
         code != kExitOk) {
-      if (usable == 0 && frames.unpaired_frames > 0) {
-        std::cerr << kName << ": " << frames.Summary() << "\n";
-      }
       return code;
     }
   }
