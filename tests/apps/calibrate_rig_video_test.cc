@@ -130,7 +130,15 @@ TEST(CalibrateRigVideo, ASynchronisedStereoClipPairRecoversTheRig) {
   EXPECT_LT(errors.baseline_relative, 0.005);
   EXPECT_LT(errors.fx_relative[0], 0.002);
   EXPECT_LT(errors.fx_relative[1], 0.002);
-  EXPECT_NE(run.out.find("rig: verdict: good"), std::string::npos) << run.out;
+  // The frames are of one instant: the rig's consistency names no frame
+  // and no camera (its verdict is good or a camera's own; cam1's detector
+  // finds two sharp frames of a steep view at 0.2-0.3 px, which its own
+  // verdict names as bad detections).
+  const std::string verdict = Line(run.out, "rig: verdict: ");
+  ASSERT_NE(verdict, "") << run.out;
+  EXPECT_EQ(verdict.find("moved-frames"), std::string::npos) << verdict;
+  EXPECT_EQ(verdict.find("inconsistent"), std::string::npos) << verdict;
+  EXPECT_NE(Line(run.out, "cam0: verdict: good"), "") << run.out;
 
   // The rig file names the frames by video and frame; the kept frames are
   // at most video.max_frames (40) and spread over the clip.
@@ -190,13 +198,21 @@ TEST(CalibrateRigVideo, ACameraSeveralFramesLateIsNotCalledGood) {
   if (run.exit_code == kExitOk) {
     const std::string verdict = Line(run.out, "rig: verdict: ");
     ASSERT_NE(verdict, "") << run.out;
-    EXPECT_EQ(verdict.find("rig: verdict: good"), std::string::npos)
+    // The frames paired are 300 ms apart in the motion: the rig's
+    // consistency says so (inconsistent or moved frames), and rightly: the
+    // rig it found is far from the truth.
+    EXPECT_TRUE(verdict.find("rig: verdict: inconsistent") == 0 ||
+                verdict.find("rig: verdict: moved-frames") == 0)
         << verdict;
     std::vector<RigFileCamera> cameras;
     std::string error;
     ASSERT_TRUE(ReadRigFile((root / "rig.yaml").string(), &cameras, &error))
         << error;
-    Compare(spec, cameras);
+    const RigErrors errors = Compare(spec, cameras);
+    EXPECT_GT(errors.rotation_deg, 1.0);
+    // The rig file carries the verdict too.
+    const YAML::Node rig = YAML::LoadFile((root / "rig.yaml").string());
+    EXPECT_NE(rig["verdict"]["kind"].as<std::string>(), "good");
   } else {
     EXPECT_EQ(run.exit_code, kExitNoResult) << run.all();
   }
