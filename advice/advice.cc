@@ -8,6 +8,7 @@
 
 #include "advice/view_information.h"
 #include "evidence/evidence.h"
+#include "util/angles.h"
 #include "util/failure.h"
 #include "util/parallel_for.h"
 #include "util/statistics.h"
@@ -17,12 +18,11 @@
 namespace puzzlecal {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kBandWidthDeg = 10.0;
 constexpr int kMinBandSamples = 5;
 
 double FieldAngleDeg(const Eigen::Vector3d& ray) {
-  return std::atan2(ray.head<2>().norm(), ray.z()) / kDeg;
+  return std::atan2(ray.head<2>().norm(), ray.z()) / kDegree;
 }
 
 std::vector<int> FreeIndices(const std::vector<bool>& free) {
@@ -239,12 +239,12 @@ Eigen::Matrix3d TiltedRotation(const Eigen::Vector3d& ray, double tilt_deg,
       Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), ray)
           .toRotationMatrix();
   const Eigen::Vector3d toward =
-      face * Eigen::Vector3d(std::cos(tilt_direction_deg * kDeg),
-                             std::sin(tilt_direction_deg * kDeg), 0.0);
+      face * Eigen::Vector3d(std::cos(tilt_direction_deg * kDegree),
+                             std::sin(tilt_direction_deg * kDegree), 0.0);
   // The normal leans towards `toward`: the board's points on that side come
   // nearer (see DescribePose).
   const Eigen::Vector3d axis = ray.cross(toward).normalized();
-  return Eigen::AngleAxisd(tilt_deg * kDeg, axis).toRotationMatrix() * face;
+  return Eigen::AngleAxisd(tilt_deg * kDegree, axis).toRotationMatrix() * face;
 }
 
 // Where a corner can be seen: within the lens's field and, for lenses
@@ -307,7 +307,7 @@ bool MakeCandidate(const Camera& camera, const Board& board,
       TiltedRotation(ray, tilt_deg, tilt_direction_deg);
   const Eigen::Vector3d normal = rotation.col(2);
   // The angle between the line of sight and the board plane.
-  const double view_angle_deg = std::asin(std::abs(ray.dot(normal))) / kDeg;
+  const double view_angle_deg = std::asin(std::abs(ray.dot(normal))) / kDegree;
   if (view_angle_deg < options.min_view_angle_deg) return false;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = rotation;
@@ -388,7 +388,7 @@ std::vector<Candidate> MakeCandidates(const Camera& camera, const Board& board,
 bool NearDuplicate(const Candidate& a, const Candidate& b, double diagonal,
                    const AdviceOptions& options) {
   const double normal_deg =
-      std::acos(std::clamp(a.normal.dot(b.normal), -1.0, 1.0)) / kDeg;
+      std::acos(std::clamp(a.normal.dot(b.normal), -1.0, 1.0)) / kDegree;
   const double ratio = std::max(a.distance_m, b.distance_m) /
                        std::min(a.distance_m, b.distance_m);
   return (a.centre_px - b.centre_px).norm() <

@@ -1,32 +1,17 @@
 #include "advice/view_information.h"
 
-#include <ceres/rotation.h>
-
 #include <Eigen/Cholesky>
 
 #include "calib/reprojection_error.h"
 
 namespace puzzlecal {
-namespace {
-
-// The solvers' pose block (angle-axis, translation) of a pose.
-void PoseBlock(const Eigen::Isometry3d& cam_from_board, double* pose) {
-  const Eigen::Matrix3d rotation = cam_from_board.linear();
-  ceres::RotationMatrixToAngleAxis(
-      ceres::ColumnMajorAdapter3x3(rotation.data()), pose);
-  for (int k = 0; k < 3; ++k) pose[3 + k] = cam_from_board.translation()(k);
-}
-
-}  // namespace
-
 bool ViewInformation(const Camera& camera,
                      const std::vector<Eigen::Vector3d>& board_points,
                      const Eigen::Isometry3d& cam_from_board, double weight,
                      Eigen::MatrixXd* information) {
   const int n = CameraModelNumParams(camera.model);
   if (static_cast<int>(camera.params.size()) != n) return false;
-  double pose[kPoseBlockSize];
-  PoseBlock(cam_from_board, pose);
+  const PoseBlock pose = PoseBlockFromIsometry(cam_from_board);
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
   Eigen::MatrixXd b = Eigen::MatrixXd::Zero(n, kPoseBlockSize);
   Eigen::Matrix<double, kPoseBlockSize, kPoseBlockSize> c =
@@ -35,8 +20,8 @@ bool ViewInformation(const Camera& camera,
   Eigen::Matrix<double, 2, kPoseBlockSize, Eigen::RowMajor> j_pose;
   int used = 0;
   for (const Eigen::Vector3d& point : board_points) {
-    if (!ReprojectionJacobians(camera.model, camera.params.data(), pose, point,
-                               j_intrinsics.data(), j_pose.data()) ||
+    if (!ReprojectionJacobians(camera.model, camera.params.data(), pose.data(),
+                               point, j_intrinsics.data(), j_pose.data()) ||
         !j_intrinsics.allFinite() || !j_pose.allFinite()) {
       continue;
     }

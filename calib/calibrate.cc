@@ -23,26 +23,7 @@
 namespace puzzlecal {
 namespace {
 
-using Pose = std::array<double, kPoseBlockSize>;
-
-Pose PoseFromIsometry(const Eigen::Isometry3d& cam_from_board) {
-  Pose pose;
-  const Eigen::Matrix3d rotation = cam_from_board.linear();
-  ceres::RotationMatrixToAngleAxis(
-      ceres::ColumnMajorAdapter3x3(rotation.data()), pose.data());
-  for (int k = 0; k < 3; ++k) pose[3 + k] = cam_from_board.translation()(k);
-  return pose;
-}
-
-Eigen::Isometry3d IsometryFromPose(const Pose& pose) {
-  Eigen::Matrix3d rotation;
-  ceres::AngleAxisToRotationMatrix(
-      pose.data(), ceres::ColumnMajorAdapter3x3(rotation.data()));
-  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
-  result.linear() = rotation;
-  result.translation() = Eigen::Vector3d(pose[3], pose[4], pose[5]);
-  return result;
-}
+using Pose = PoseBlock;
 
 // Everything one Calibrate() call works on: its inputs, the current
 // estimate, the correspondences in play and the last solve.
@@ -140,7 +121,7 @@ bool FailParallelViews(const CalibrationState& s, double spread_deg) {
 bool Residual(const CalibrationState& s, size_t v, size_t i,
               Eigen::Vector2d* residual) {
   const CalibrationView& view = s.views[v];
-  const Eigen::Isometry3d pose = IsometryFromPose(s.poses[v]);
+  const Eigen::Isometry3d pose = IsometryFromPoseBlock(s.poses[v].data());
   Eigen::Vector2d pixel;
   if (!ProjectPoint(s.model, s.params.data(), pose * view.board_points[i],
                     &pixel)) {
@@ -262,7 +243,7 @@ bool InitialiseFromGivenPoses(CalibrationState* s) {
   s->params = s->options.initial_params;
   s->poses.assign(s->views.size(), Pose{});
   for (size_t v = 0; v < s->views.size(); ++v) {
-    if (s->view_used[v]) s->poses[v] = PoseFromIsometry(given[v]);
+    if (s->view_used[v]) s->poses[v] = PoseBlockFromIsometry(given[v]);
   }
   s->result->initialization_method = "intrinsics and poses given by the caller";
   s->result->orientation_spread_deg = OrientationSpreadDeg(given, s->view_used);
@@ -310,7 +291,7 @@ bool Initialise(CalibrationState* s) {
                      "no initial pose: " + init.view_reason[v]);
       continue;
     }
-    s->poses[v] = PoseFromIsometry(init.cam_from_board[v]);
+    s->poses[v] = PoseBlockFromIsometry(init.cam_from_board[v]);
   }
   return CheckPosedViews(*s);
 }
@@ -651,7 +632,7 @@ void FillResult(CalibrationState* s) {
   for (size_t v = 0; v < num_views; ++v) {
     if (!s->view_used[v]) continue;
     r->view_outcome[v] = ViewOutcome::kUsed;
-    r->cam_from_board[v] = IsometryFromPose(s->poses[v]);
+    r->cam_from_board[v] = IsometryFromPoseBlock(s->poses[v].data());
     double view_sum2 = 0;
     int view_corners = 0;
     for (size_t i = 0; i < s->residuals[v].size(); ++i) {

@@ -381,18 +381,14 @@ template <typename Model>
 bool RefinePose(const Camera& camera, const CalibrationView& view,
                 const InitializationOptions& options,
                 Eigen::Isometry3d* cam_from_board) {
-  double pose[kPoseBlockSize];
-  const Eigen::Matrix3d rotation = cam_from_board->linear();
-  ceres::RotationMatrixToAngleAxis(
-      ceres::ColumnMajorAdapter3x3(rotation.data()), pose);
-  for (int k = 0; k < 3; ++k) pose[3 + k] = cam_from_board->translation()(k);
+  PoseBlock pose = PoseBlockFromIsometry(*cam_from_board);
   std::vector<double> intrinsics = camera.params;
   ceres::Problem problem;
   for (size_t i = 0; i < view.board_points.size(); ++i) {
     problem.AddResidualBlock(ReprojectionError<Model>::Create(
                                  view.board_points[i], view.image_points[i]),
                              new ceres::HuberLoss(options.pose_refine_loss_px),
-                             intrinsics.data(), pose);
+                             intrinsics.data(), pose.data());
   }
   problem.SetParameterBlockConstant(intrinsics.data());
   ceres::Solver::Options solver_options;
@@ -406,20 +402,8 @@ bool RefinePose(const Camera& camera, const CalibrationView& view,
       !(summary.final_cost <= summary.initial_cost)) {
     return false;
   }
-  Eigen::Matrix3d refined;
-  ceres::AngleAxisToRotationMatrix(
-      pose, ceres::ColumnMajorAdapter3x3(refined.data()));
-  cam_from_board->linear() = refined;
-  cam_from_board->translation() = Eigen::Vector3d(pose[3], pose[4], pose[5]);
+  *cam_from_board = IsometryFromPoseBlock(pose.data());
   return true;
-}
-
-// Angle-axis + translation block of a pose.
-void PoseToBlock(const Eigen::Isometry3d& cam_from_board, double* block) {
-  const Eigen::Matrix3d rotation = cam_from_board.linear();
-  ceres::RotationMatrixToAngleAxis(
-      ceres::ColumnMajorAdapter3x3(rotation.data()), block);
-  for (int k = 0; k < 3; ++k) block[3 + k] = cam_from_board.translation()(k);
 }
 
 // Joint refinement of the starting intrinsics on a subset of the posed views
@@ -434,7 +418,7 @@ bool RefineStartOnSubset(const std::vector<const CalibrationView*>& views,
                          const InitializationOptions& options, Camera* camera,
                          int* iterations) {
   std::vector<double> intrinsics = camera->params;
-  std::vector<std::array<double, kPoseBlockSize>> blocks(views.size());
+  std::vector<PoseBlock> blocks(views.size());
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
@@ -442,7 +426,7 @@ bool RefineStartOnSubset(const std::vector<const CalibrationView*>& views,
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   int residuals = 0;
   for (size_t v = 0; v < views.size(); ++v) {
-    PoseToBlock(poses[v], blocks[v].data());
+    blocks[v] = PoseBlockFromIsometry(poses[v]);
     const size_t n = views[v]->board_points.size();
     const size_t take = std::min<size_t>(
         n, static_cast<size_t>(options.start_refine_max_corners_per_view));

@@ -1,6 +1,27 @@
 #include "calib/reprojection_error.h"
 
+#include <ceres/rotation.h>
+
 namespace puzzlecal {
+
+PoseBlock PoseBlockFromIsometry(const Eigen::Isometry3d& transform) {
+  PoseBlock pose;
+  const Eigen::Matrix3d rotation = transform.linear();
+  ceres::RotationMatrixToAngleAxis(
+      ceres::ColumnMajorAdapter3x3(rotation.data()), pose.data());
+  for (int k = 0; k < 3; ++k) pose[3 + k] = transform.translation()(k);
+  return pose;
+}
+
+Eigen::Isometry3d IsometryFromPoseBlock(const double* pose) {
+  Eigen::Matrix3d rotation;
+  ceres::AngleAxisToRotationMatrix(
+      pose, ceres::ColumnMajorAdapter3x3(rotation.data()));
+  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
+  result.linear() = rotation;
+  result.translation() = Eigen::Vector3d(pose[3], pose[4], pose[5]);
+  return result;
+}
 
 template class ReprojectionCost<PinholeRadtanModel>;
 template class ReprojectionCost<PinholeRationalModel>;

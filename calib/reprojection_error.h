@@ -11,6 +11,8 @@
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
 
 #include "camera/camera_models.h"
 
@@ -18,6 +20,11 @@ namespace puzzlecal {
 
 // Pose block layout: angle-axis rotation then translation (metres).
 inline constexpr int kPoseBlockSize = 6;
+using PoseBlock = std::array<double, kPoseBlockSize>;
+
+// A rigid transform as a pose block and back.
+PoseBlock PoseBlockFromIsometry(const Eigen::Isometry3d& transform);
+Eigen::Isometry3d IsometryFromPoseBlock(const double* pose);
 
 template <typename Model>
 class ReprojectionError {

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "calib/reprojection_error.h"
+#include "util/angles.h"
 #include "util/failure.h"
 #include "util/parallel_for.h"
 #include "util/statistics.h"
@@ -22,27 +23,7 @@
 namespace puzzlecal {
 namespace {
 
-using Pose = std::array<double, kPoseBlockSize>;
-constexpr double kDegree = M_PI / 180.0;
-
-Pose PoseFromIsometry(const Eigen::Isometry3d& transform) {
-  Pose pose;
-  const Eigen::Matrix3d rotation = transform.linear();
-  ceres::RotationMatrixToAngleAxis(
-      ceres::ColumnMajorAdapter3x3(rotation.data()), pose.data());
-  for (int k = 0; k < 3; ++k) pose[3 + k] = transform.translation()(k);
-  return pose;
-}
-
-Eigen::Isometry3d IsometryFromPose(const double* pose) {
-  Eigen::Matrix3d rotation;
-  ceres::AngleAxisToRotationMatrix(
-      pose, ceres::ColumnMajorAdapter3x3(rotation.data()));
-  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
-  result.linear() = rotation;
-  result.translation() = Eigen::Vector3d(pose[3], pose[4], pose[5]);
-  return result;
-}
+using Pose = PoseBlock;
 
 // The pixel error of one board corner seen by a camera that is not the
 // reference: intrinsics, cam_from_rig and the frame's rig_from_board (both
@@ -127,8 +108,9 @@ bool Residual(const JointState& state, size_t c, size_t f, size_t i,
               Eigen::Vector2d* residual) {
   const CalibrationView& view = (*state.input)[c].frames[f];
   const Eigen::Vector3d point =
-      IsometryFromPose(state.cam_from_rig(c)) *
-      (IsometryFromPose(state.rig_from_board[f].data()) * view.board_points[i]);
+      IsometryFromPoseBlock(state.cam_from_rig(c)) *
+      (IsometryFromPoseBlock(state.rig_from_board[f].data()) *
+       view.board_points[i]);
   Eigen::Vector2d pixel;
   if (!ProjectPoint((*state.input)[c].model, state.params(c), point, &pixel)) {
     return false;
@@ -351,15 +333,15 @@ bool JointMarginalCovariance(const JointState& state, SolveOutcome* outcome,
 // R(pose) to R(pose + delta), to first order: its 3x6 Jacobian in delta.
 Eigen::Matrix<double, 3, 6> RotationJacobian(const Pose& pose) {
   Eigen::Matrix<double, 3, 6> jacobian = Eigen::Matrix<double, 3, 6>::Zero();
-  const Eigen::Matrix3d r0 = IsometryFromPose(pose.data()).linear();
+  const Eigen::Matrix3d r0 = IsometryFromPoseBlock(pose.data()).linear();
   constexpr double kStep = 1e-7;
   for (int k = 0; k < 3; ++k) {
     Pose plus = pose, minus = pose;
     plus[k] += kStep;
     minus[k] -= kStep;
-    const Eigen::AngleAxisd dp(IsometryFromPose(plus.data()).linear() *
+    const Eigen::AngleAxisd dp(IsometryFromPoseBlock(plus.data()).linear() *
                                r0.transpose());
-    const Eigen::AngleAxisd dm(IsometryFromPose(minus.data()).linear() *
+    const Eigen::AngleAxisd dm(IsometryFromPoseBlock(minus.data()).linear() *
                                r0.transpose());
     jacobian.col(k) =
         (dp.angle() * dp.axis() - dm.angle() * dm.axis()) / (2 * kStep);
@@ -371,7 +353,7 @@ Eigen::Matrix<double, 3, 6> RotationJacobian(const Pose& pose) {
 // Jacobian.
 double Baseline(const Pose& pose, Eigen::Matrix<double, 1, 6>* jacobian) {
   auto centre_norm = [](const Pose& p) {
-    const Eigen::Isometry3d t = IsometryFromPose(p.data());
+    const Eigen::Isometry3d t = IsometryFromPoseBlock(p.data());
     return (t.linear().transpose() * t.translation()).norm();
   };
   const double value = centre_norm(pose);
@@ -699,7 +681,7 @@ void StartJointState(const std::vector<RigCameraInput>& cameras,
     state->global.insert(state->global.end(), single[c].camera.params.begin(),
                          single[c].camera.params.end());
     state->extrinsics_offset.push_back(state->global.size());
-    const Pose pose = PoseFromIsometry(cam_from_rig[c]);
+    const Pose pose = PoseBlockFromIsometry(cam_from_rig[c]);
     state->global.insert(state->global.end(), pose.begin(), pose.end());
     state->fixed[c] = single[c].param_fixed;
   }
@@ -716,8 +698,8 @@ void StartJointState(const std::vector<RigCameraInput>& cameras,
       }
     }
     if (best < 0) continue;
-    state->rig_from_board[f] = PoseFromIsometry(cam_from_rig[best].inverse() *
-                                                single[best].cam_from_board[f]);
+    state->rig_from_board[f] = PoseBlockFromIsometry(
+        cam_from_rig[best].inverse() * single[best].cam_from_board[f]);
     state->frame_posed[f] = true;
   }
   state->used.assign(num_cameras, std::vector<bool>(num_frames, false));
@@ -870,7 +852,7 @@ double FillRigResult(const JointState& state, const JointSolveRun& run,
     out.camera.params = state.Params(c);
     out.param_fixed = state.fixed[c];
     out.param_stddev.assign(state.num_params[c], 0.0);
-    out.cam_from_rig = IsometryFromPose(state.cam_from_rig(c));
+    out.cam_from_rig = IsometryFromPoseBlock(state.cam_from_rig(c));
     if (c == 0) out.cam_from_rig = Eigen::Isometry3d::Identity();
     out.frame_used = state.used[c];
     out.residuals = run.residuals[c];
@@ -913,7 +895,7 @@ double FillRigResult(const JointState& state, const JointSolveRun& run,
     if (!result->frame_used[f]) continue;
     ++result->num_frames_used;
     result->rig_from_board[f] =
-        IsometryFromPose(state.rig_from_board[f].data());
+        IsometryFromPoseBlock(state.rig_from_board[f].data());
   }
   result->num_corners_used = corners_all;
   result->num_outliers = outliers_all;

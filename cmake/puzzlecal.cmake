@@ -38,6 +38,14 @@ function(puzzlecal_add_library name)
     target_link_libraries(${name} PUBLIC ${ARG_PUBLIC} PRIVATE ${ARG_PRIVATE})
     puzzlecal_library_pch_host()
     target_precompile_headers(${name} REUSE_FROM puzzlecal_library_pch)
+    # One compilation per batch of a folder's files (PUZZLECAL_UNITY_BUILD):
+    # most of a file's compile time is instantiating the templates it uses
+    # (Eigen's decompositions and products, Ceres's dual numbers), and the
+    # files of one folder use largely the same ones.
+    if(PUZZLECAL_UNITY_BUILD)
+      set_target_properties(${name} PROPERTIES UNITY_BUILD ON
+                            UNITY_BUILD_BATCH_SIZE 8)
+    endif()
   else()  # headers only
     add_library(${name} INTERFACE)
     target_include_directories(${name} INTERFACE ${includes})

@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+#include "util/angles.h"
 #include "util/failure.h"
 #include "util/parallel_for.h"
 #include "util/string_format.h"
@@ -20,18 +21,10 @@ namespace puzzlecal {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kDeg = M_PI / 180.0;
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
       .count();
-}
-
-std::string Printf(const char* format, double a, double b = 0, double c = 0,
-                   double d = 0, double e = 0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), format, a, b, c, d, e);
-  return buffer;
 }
 
 double Quantile(std::vector<double> values, double q) {
@@ -57,7 +50,7 @@ bool ProjectDirection(const Camera& camera, const Eigen::Vector3d& ray,
 }
 
 double FieldAngleDeg(const Eigen::Vector3d& ray) {
-  return std::atan2(ray.head<2>().norm(), ray.z()) / kDeg;
+  return std::atan2(ray.head<2>().norm(), ray.z()) / kDegree;
 }
 
 // d pixel / d intrinsics (jacobian, 2 x n) and d pixel / d point (point, 2 x
@@ -428,10 +421,11 @@ ProjectionUncertainty ComputeProjectionUncertainty(
   out.points.push_back(centre);
   std::vector<std::pair<std::string, double>> angles;
   for (double angle : options.report_angles_deg) {
-    angles.emplace_back(Printf("%.0f deg", angle), angle);
+    angles.emplace_back(StringPrintf("%.0f deg", angle), angle);
   }
   if (max_angle_deg > 0) {
-    angles.emplace_back(Printf("rim (%.1f deg)", max_angle_deg), max_angle_deg);
+    angles.emplace_back(StringPrintf("rim (%.1f deg)", max_angle_deg),
+                        max_angle_deg);
   }
   for (const auto& [label, angle] : angles) {
     UncertaintyPoint point;
@@ -439,9 +433,9 @@ ProjectionUncertainty ComputeProjectionUncertainty(
     point.angle_deg = angle;
     for (int a = 0; a < options.report_azimuths; ++a) {
       const double phi = 2 * M_PI * a / options.report_azimuths;
-      const Eigen::Vector3d ray(std::sin(angle * kDeg) * std::cos(phi),
-                                std::sin(angle * kDeg) * std::sin(phi),
-                                std::cos(angle * kDeg));
+      const Eigen::Vector3d ray(std::sin(angle * kDegree) * std::cos(phi),
+                                std::sin(angle * kDegree) * std::sin(phi),
+                                std::cos(angle * kDegree));
       Eigen::Vector2d pixel;
       if (!ProjectDirection(camera, ray, &pixel) || pixel.x() < 0 ||
           pixel.y() < 0 || pixel.x() > camera.width - 1 ||
@@ -763,7 +757,7 @@ ProjectionDiff ProjectionDifference(const Camera& a, const Camera& b,
     return out;
   }
   out.b_from_a = FitRotation(b, rays);
-  out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDeg;
+  out.rotation_deg = Eigen::AngleAxisd(out.b_from_a).angle() / kDegree;
   for (size_t k = 0; k < map.values.size(); ++k) {
     Eigen::Vector2d projected;
     if (rays.valid[k] &&
@@ -887,22 +881,23 @@ std::string EvidenceText(const Evidence& evidence) {
   const CrossValidation& cv = evidence.cross_validation;
   if (cv.ok) {
     text << "cross-validation (" << cv.views_a << " + " << cv.views_b
-         << " views, RMS " << Printf("%.3f / %.3f px", cv.rms_a_px, cv.rms_b_px)
+         << " views, RMS "
+         << StringPrintf("%.3f / %.3f px", cv.rms_a_px, cv.rms_b_px)
          << ", rotation between the halves "
-         << Printf("%.3f deg", cv.rotation_deg) << "):\n";
+         << StringPrintf("%.3f deg", cv.rotation_deg) << "):\n";
     text << "  field angle   |A-B| median   p95   expected median   p95\n";
     for (size_t b = 0; b < cv.difference_bands.size(); ++b) {
       const AngleBand& d = cv.difference_bands[b];
       const AngleBand& e = cv.expected_bands[b];
       if (d.count == 0) continue;
-      text << Printf("  %3.0f-%3.0f deg   %8.3f   %8.3f", d.lo_deg, d.hi_deg,
-                     d.median, d.p95)
-           << Printf("   %8.3f   %8.3f px", e.median, e.p95)
+      text << StringPrintf("  %3.0f-%3.0f deg   %8.3f   %8.3f", d.lo_deg,
+                           d.hi_deg, d.median, d.p95)
+           << StringPrintf("   %8.3f   %8.3f px", e.median, e.p95)
            << "  n=" << d.count << "\n";
     }
     if (cv.intrinsics_dof > 0) {
-      text << Printf(
-          "  intrinsics as a whole: chi-square %.1f for %.0f free "
+      text << StringPrintf(
+          "  intrinsics as a whole: chi-square %.1f for %d free "
           "parameters (z = %.1f)\n",
           cv.intrinsics_chi2, cv.intrinsics_dof,
           ChiSquareZ(cv.intrinsics_chi2, cv.intrinsics_dof));
@@ -916,9 +911,9 @@ std::string EvidenceText(const Evidence& evidence) {
             "removed / in the camera frame):";
     for (const UncertaintyPoint& p : u.points) {
       text << " " << p.label << " "
-           << (p.in_image
-                   ? Printf("%.3f / %.3f", p.sigma_px, p.camera_frame_sigma_px)
-                   : "not in image")
+           << (p.in_image ? StringPrintf("%.3f / %.3f", p.sigma_px,
+                                         p.camera_frame_sigma_px)
+                          : "not in image")
            << ";";
     }
     text << "\n";
@@ -929,10 +924,10 @@ std::string EvidenceText(const Evidence& evidence) {
                   const char* unit, int decimals) {
     text << title << "\n";
     for (const ResidualBin& b : list) {
-      text << (decimals == 0 ? Printf("  %5.0f-%5.0f ", b.lo, b.hi)
-                             : Printf("  %5.2f-%5.2f ", b.lo, b.hi))
+      text << (decimals == 0 ? StringPrintf("  %5.0f-%5.0f ", b.lo, b.hi)
+                             : StringPrintf("  %5.2f-%5.2f ", b.lo, b.hi))
            << unit
-           << Printf(
+           << StringPrintf(
                   "  radial %+.3f +- %.3f  tangential %+.3f +- %.3f  RMS "
                   "%.3f px",
                   b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
@@ -942,15 +937,16 @@ std::string EvidenceText(const Evidence& evidence) {
   };
   const ViewConsistency& vc = evidence.view_consistency;
   if (vc.ok) {
-    text << Printf(
-        "focal length per view (the rest held): %.0f views, spread %.2f "
-        "times their sigma (chi-square %.1f for %.0f), moving the corners "
+    text << StringPrintf(
+        "focal length per view (the rest held): %zu views, spread %.2f "
+        "times their sigma (chi-square %.1f for %d), moving the corners "
         "by %.3f px RMS\n",
         vc.views.size(), vc.spread_ratio, vc.chi2, vc.dof, vc.effect_px);
     for (const ViewFocal& f : MostInconsistentViews(vc, 5)) {
       text << "  " << f.name
-           << Printf(": f = %.1f +- %.1f px (z = %+.1f)", vc.focal_px * f.scale,
-                     vc.focal_px * f.scale_sigma, f.z)
+           << StringPrintf(": f = %.1f +- %.1f px (z = %+.1f)",
+                           vc.focal_px * f.scale, vc.focal_px * f.scale_sigma,
+                           f.z)
            << "\n";
     }
   } else {
@@ -968,9 +964,9 @@ std::string EvidenceText(const Evidence& evidence) {
     for (size_t k = 0; k < fields.size() && k < 5; ++k) {
       const ViewField& f = fields[k];
       text << "  " << f.name
-           << Printf(": %.3f / %.3f / %.3f, %.0f of %.0f corners rejected\n",
-                     f.smooth_rms_px, f.expected_smooth_px, f.rest_rms_px,
-                     f.outliers, f.corners);
+           << StringPrintf(": %.3f / %.3f / %.3f, %d of %d corners rejected\n",
+                           f.smooth_rms_px, f.expected_smooth_px, f.rest_rms_px,
+                           f.outliers, f.corners);
     }
   }
   bins("residual means by field angle:", evidence.residuals.by_angle, "deg", 0);

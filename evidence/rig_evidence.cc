@@ -4,14 +4,13 @@
 #include <cmath>
 #include <sstream>
 
+#include "util/angles.h"
 #include "util/failure.h"
 #include "util/statistics.h"
 #include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 // The robust centre of relative poses: the rotation closest to all others
 // (least summed angle) and the per-axis median translation.

@@ -5,16 +5,10 @@
 #include <cstdio>
 
 #include "util/failure.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
-
-std::string Printf(const char* format, double a, double b = 0, double c = 0,
-                   double d = 0, double e = 0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), format, a, b, c, d, e);
-  return buffer;
-}
 
 struct Finding {
   VerdictKind kind;
@@ -57,10 +51,10 @@ std::string BinText(const ResidualBin& bin, const char* unit, bool metres) {
   const double mean = radial ? bin.mean_radial_px : bin.mean_tangential_px;
   const double se = radial ? bin.se_radial_px : bin.se_tangential_px;
   return std::string(radial ? "radial" : "tangential") + " residual mean " +
-         Printf("%+.3f +- %.3f px", mean, se) + " at " +
-         (metres ? Printf("%.2f-%.2f ", bin.lo, bin.hi)
-                 : Printf("%.0f-%.0f ", bin.lo, bin.hi)) +
-         unit + Printf(" (n=%.0f)", bin.count);
+         StringPrintf("%+.3f +- %.3f px", mean, se) + " at " +
+         (metres ? StringPrintf("%.2f-%.2f ", bin.lo, bin.hi)
+                 : StringPrintf("%.0f-%.0f ", bin.lo, bin.hi)) +
+         unit + StringPrintf(" (n=%d)", bin.count);
 }
 
 // The judged band (min_count samples or more, a positive prediction) where
@@ -113,14 +107,16 @@ void AddUniformHalvesFinding(const CrossValidation& cv, double halves_scale,
   }
   findings->push_back(
       {VerdictKind::kInconsistentViews,
-       Printf("the two halves of the views differ %.1f times more than their "
-              "uncertainty predicts in every field-angle band, by %.2f px or "
-              "more (median, at %.0f",
-              halves_scale, best->median, best->lo_deg) +
-           Printf("-%.0f deg where they agree best); corner errors shared "
-                  "within views explain up to about %.0f times, so the "
-                  "halves do not see one camera",
-                  best->hi_deg, options.halves_max_scale)});
+       StringPrintf(
+           "the two halves of the views differ %.1f times more than their "
+           "uncertainty predicts in every field-angle band, by %.2f px or "
+           "more (median, at %.0f",
+           halves_scale, best->median, best->lo_deg) +
+           StringPrintf(
+               "-%.0f deg where they agree best); corner errors shared "
+               "within views explain up to about %.0f times, so the "
+               "halves do not see one camera",
+               best->hi_deg, options.halves_max_scale)});
 }
 
 // Model error: a field-angle band where the halves differ far beyond their
@@ -139,13 +135,13 @@ void AddHalvesFindings(const CrossValidation& cv, double halves_scale,
     if (ratio > options.halves_factor && d.median > options.halves_floor_px &&
         ratio > worst_ratio) {
       worst_ratio = ratio;
-      halves_text = Printf(
+      halves_text = StringPrintf(
           "the two halves of the views differ by %.3f px (median) at "
           "%.0f-%.0f deg, %.1f times what their uncertainty predicts "
           "(%.3f px)",
           d.median, d.lo_deg, d.hi_deg, ratio, halves_scale * e.median);
       if (halves_scale > 1) {
-        halves_text += Printf(
+        halves_text += StringPrintf(
             ", the prediction scaled by %.2f, the best-agreeing band's "
             "excess",
             halves_scale);
@@ -157,8 +153,8 @@ void AddHalvesFindings(const CrossValidation& cv, double halves_scale,
     const double z = ChiSquareZ(
         cv.intrinsics_chi2 / (halves_scale * halves_scale), cv.intrinsics_dof);
     if (options.halves_min_z > 0 && z <= options.halves_min_z) return;
-    halves_text += Printf(
-        "; their intrinsics differ with chi-square %.1f for %.0f parameters "
+    halves_text += StringPrintf(
+        "; their intrinsics differ with chi-square %.1f for %d parameters "
         "(z = %.1f)",
         cv.intrinsics_chi2 / (halves_scale * halves_scale), cv.intrinsics_dof,
         z);
@@ -228,9 +224,10 @@ bool AddSystematicResidualFindings(const SystematicResiduals& residuals,
              (other_model_error || near_rms > options.closeness_floor_px)) {
     findings->push_back(
         {VerdictKind::kModelError,
-         Printf("the residuals grow as the board comes closer (RMS %.3f px "
-                "for the nearest corners, %.3f px for the farthest)",
-                near_rms, far_rms)});
+         StringPrintf(
+             "the residuals grow as the board comes closer (RMS %.3f px "
+             "for the nearest corners, %.3f px for the farthest)",
+             near_rms, far_rms)});
   }
   return nearest_systematic || rms_grows;
 }
@@ -297,9 +294,10 @@ int AddBadDetectionFindings(const CalibrationResult& result,
   if (outlier_fraction > options.max_outlier_fraction) {
     findings->push_back(
         {VerdictKind::kBadDetections,
-         Printf("%.1f %% of the corners were rejected as outliers (limit "
-                "%.1f %%)",
-                100 * outlier_fraction, 100 * options.max_outlier_fraction)});
+         StringPrintf("%.1f %% of the corners were rejected as outliers (limit "
+                      "%.1f %%)",
+                      100 * outlier_fraction,
+                      100 * options.max_outlier_fraction)});
   }
   std::vector<ViewJudgement>& judged = verdict->views;
   judged.assign(result.view_used.size(), ViewJudgement());
@@ -341,18 +339,18 @@ int AddBadDetectionFindings(const CalibrationResult& result,
     if (!result.view_used[v] || v >= result.residuals.size()) continue;
     ViewJudgement& view = judged[v];
     const std::string rejected_text =
-        Printf("%.0f of %.0f corners rejected", view.rejected, view.corners);
+        StringPrintf("%d of %d corners rejected", view.rejected, view.corners);
     if (view.inlier_rms_px > limit) {
-      add_bad(v, Printf("inliers %.2f px", view.inlier_rms_px) +
+      add_bad(v, StringPrintf("inliers %.2f px", view.inlier_rms_px) +
                      (view.rejected > 0 ? ", " + rejected_text : ""));
     } else if (view.rejected >
                options.max_view_outlier_fraction * view.corners) {
       add_bad(v, rejected_text);
     } else if (view.rejected > 0) {
       view.standing = ViewStanding::kHandled;
-      view.why =
-          rejected_text + Printf(", up to %.1f px off; the rest fit at %.2f px",
-                                 view.worst_rejected_px, view.inlier_rms_px);
+      view.why = rejected_text +
+                 StringPrintf(", up to %.1f px off; the rest fit at %.2f px",
+                              view.worst_rejected_px, view.inlier_rms_px);
       ++num_handled_views;
       if (num_handled_views <= 5) {
         handled_views += (handled_views.empty() ? "" : ", ") + view_label(v) +
@@ -364,18 +362,19 @@ int AddBadDetectionFindings(const CalibrationResult& result,
       num_bad_views <= options.max_bad_view_fraction * inlier_rms.size()) {
     findings->push_back(
         {VerdictKind::kBadDetections,
-         Printf("%.0f view(s) dropped, with more than %.0f %% of their "
-                "corners rejected, or with inliers above %.2f px (%.0f x the "
-                "median view's %.3f px): ",
-                num_bad_views, 100 * options.max_view_outlier_fraction, limit,
-                options.view_rms_factor, median) +
+         StringPrintf(
+             "%d view(s) dropped, with more than %.0f %% of their "
+             "corners rejected, or with inliers above %.2f px (%.0f x the "
+             "median view's %.3f px): ",
+             num_bad_views, 100 * options.max_view_outlier_fraction, limit,
+             options.view_rms_factor, median) +
              bad_views});
   }
   if (num_handled_views > 0) {
     notes->push_back(
-        Printf("isolated rejected corners, taken out by the outlier "
-               "rejection, in %.0f view(s) whose other corners fit: ",
-               num_handled_views) +
+        StringPrintf("isolated rejected corners, taken out by the outlier "
+                     "rejection, in %d view(s) whose other corners fit: ",
+                     num_handled_views) +
         handled_views + (num_handled_views > 5 ? ", ..." : ""));
   }
   return num_bad_views;
@@ -392,15 +391,16 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
                                  std::vector<std::string>* notes) {
   const Camera& camera = result.camera;
   if (result.num_views_used < options.min_views) {
-    findings->push_back({VerdictKind::kInsufficientData,
-                         Printf("only %.0f views used (want %.0f or more)",
-                                result.num_views_used, options.min_views)});
+    findings->push_back(
+        {VerdictKind::kInsufficientData,
+         StringPrintf("only %d views used (want %d or more)",
+                      result.num_views_used, options.min_views)});
   }
   if (result.coverage < options.min_coverage) {
     findings->push_back(
         {VerdictKind::kInsufficientData,
-         Printf("the corners cover %.0f %% of the image (want %.0f %%)",
-                100 * result.coverage, 100 * options.min_coverage)});
+         StringPrintf("the corners cover %.0f %% of the image (want %.0f %%)",
+                      100 * result.coverage, 100 * options.min_coverage)});
   }
   if (!result.covariance_ok) {
     findings->push_back({VerdictKind::kInsufficientData,
@@ -418,10 +418,10 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
     if (worst > options.max_uncertainty_px) {
       findings->push_back(
           {VerdictKind::kInsufficientData,
-           Printf("the projection uncertainty reaches %.3f px (median at "
-                  "%.0f-%.0f deg; limit %.2f px)",
-                  worst, at, at + evidence_options.band_width_deg,
-                  options.max_uncertainty_px)});
+           StringPrintf("the projection uncertainty reaches %.3f px (median at "
+                        "%.0f-%.0f deg; limit %.2f px)",
+                        worst, at, at + evidence_options.band_width_deg,
+                        options.max_uncertainty_px)});
     }
   }
   std::string undetermined_coefficients;
@@ -439,15 +439,15 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
         continue;
       }
       const std::string text =
-          names[k] + Printf(" (%.4g +- %.3g)", camera.params[k], sigma);
+          names[k] + StringPrintf(" (%.4g +- %.3g)", camera.params[k], sigma);
       if (distortion && !options.check_distortion_determined) {
         undetermined_coefficients +=
             (undetermined_coefficients.empty() ? "" : ", ") + text;
       } else {
         findings->push_back(
             {VerdictKind::kInsufficientData,
-             names[k] + Printf(" is undetermined (%.4g +- %.3g)",
-                               camera.params[k], sigma)});
+             names[k] + StringPrintf(" is undetermined (%.4g +- %.3g)",
+                                     camera.params[k], sigma)});
       }
     }
   }
@@ -482,20 +482,21 @@ void AddInconsistentViewFindings(const ViewConsistency& vc,
   for (const ViewFocal& f :
        MostInconsistentViews(vc, options.max_named_views)) {
     named += (named.empty() ? "" : ", ") + f.name +
-             Printf(" (f = %.1f +- %.1f px)", vc.focal_px * f.scale,
-                    vc.focal_px * f.scale_sigma);
+             StringPrintf(" (f = %.1f +- %.1f px)", vc.focal_px * f.scale,
+                          vc.focal_px * f.scale_sigma);
   }
   findings->push_back(
       {VerdictKind::kInconsistentViews,
-       Printf("the views disagree on the focal length: fitted per view (the "
-              "rest held) it spreads %.1f times its standard deviation "
-              "(chi-square %.0f for %.0f views), and a focal length of "
-              "their own moves the views' corners by %.3f px RMS (noise "
-              "alone: %.3f px); ",
-              vc.spread_ratio, vc.chi2, vc.dof + 1, vc.effect_px,
-              vc.expected_effect_px) +
-           Printf("the calibration's is %.1f px, most different: ",
-                  vc.focal_px) +
+       StringPrintf(
+           "the views disagree on the focal length: fitted per view (the "
+           "rest held) it spreads %.1f times its standard deviation "
+           "(chi-square %.0f for %d views), and a focal length of "
+           "their own moves the views' corners by %.3f px RMS (noise "
+           "alone: %.3f px); ",
+           vc.spread_ratio, vc.chi2, vc.dof + 1, vc.effect_px,
+           vc.expected_effect_px) +
+           StringPrintf("the calibration's is %.1f px, most different: ",
+                        vc.focal_px) +
            named});
 }
 
@@ -538,24 +539,24 @@ std::vector<int> AddViewErrorFindings(const ViewConsistency& vc,
     if (static_cast<int>(views.size()) > options.max_named_views) continue;
     named +=
         (named.empty() ? "" : "; ") + f->name +
-        Printf(
+        StringPrintf(
             " (its residuals form a smooth field of %.2f px RMS "
             "across the board, the median view's %.3f px, noise "
             "gives %.3f px, %.2f px left beside it",
             f->smooth_rms_px, median, f->expected_smooth_px, f->rest_rms_px);
     if (f->outliers > 0) {
-      named += Printf(
-          "; %.0f of its %.0f corners were rejected as outliers, "
-          "%.0f of them follow the field",
+      named += StringPrintf(
+          "; %d of its %d corners were rejected as outliers, "
+          "%d of them follow the field",
           f->outliers, f->corners, f->outliers_explained);
     }
     named += ")";
   }
   findings->push_back(
       {VerdictKind::kViewErrors,
-       Printf("view-level errors in %.0f view(s), a bent board, a focus "
-              "change or motion rather than bad corners: ",
-              views.size()) +
+       StringPrintf("view-level errors in %zu view(s), a bent board, a focus "
+                    "change or motion rather than bad corners: ",
+                    views.size()) +
            named});
   return views;
 }
@@ -571,7 +572,7 @@ void MarkViewErrors(const ViewConsistency& vc, const std::vector<int>& flagged,
     }
     ViewJudgement& view = (*views)[f.view];
     view.standing = ViewStanding::kViewError;
-    view.why = Printf(
+    view.why = StringPrintf(
         "a smooth residual field of %.2f px RMS across the board (noise "
         "gives %.3f px): a bent board, a focus change or motion",
         f.smooth_rms_px, f.expected_smooth_px);
@@ -619,7 +620,7 @@ void SuggestModel(CameraModelId model, bool grows_with_closeness,
             : " (the central model leaves structured residuals)";
   } else if (CameraModelIsPinhole(model) &&
              verdict->suggested_model == "kannala-brandt") {
-    verdict->next_step += Printf(
+    verdict->next_step += StringPrintf(
         " (corners reach %.0f deg off the axis, beyond the %.0f deg a "
         "pinhole model is meant for)",
         max_angle_deg, options.pinhole_max_field_deg);
@@ -638,14 +639,14 @@ std::string GoodReason(const CalibrationResult& result,
       worst_expected = cv.expected_bands[b].median;
     }
   }
-  std::string reason = Printf("RMS %.3f px", result.rms_px);
+  std::string reason = StringPrintf("RMS %.3f px", result.rms_px);
   if (cv.ok) {
-    reason += Printf(
+    reason += StringPrintf(
         "; the halves agree (largest band median %.3f px, noise predicts "
         "%.3f px",
         worst_diff, worst_expected);
     if (halves_scale > 1) {
-      reason += Printf(
+      reason += StringPrintf(
           "; they differ %.2f times more than it in every band: corner "
           "errors shared within views, the stated uncertainty is "
           "optimistic by about that factor",

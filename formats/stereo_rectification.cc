@@ -8,14 +8,13 @@
 #include <vector>
 
 #include "formats/yaml_emit.h"
+#include "util/angles.h"
 #include "util/failure.h"
 #include "util/statistics.h"
 #include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d s;
@@ -75,7 +74,7 @@ bool HorizontalCoverage(const Camera& camera,
                         double* low_deg, double* high_deg) {
   bool any = false;
   for (double a = -89.5; a <= 89.5; a += 0.25) {
-    const Eigen::Vector3d d(std::sin(a * kDeg), 0, std::cos(a * kDeg));
+    const Eigen::Vector3d d(std::sin(a * kDegree), 0, std::cos(a * kDegree));
     Eigen::Vector2d pixel;
     if (!SeesRay(camera, camera_from_rectified * d, &pixel)) continue;
     if (!any) *low_deg = a;
@@ -167,8 +166,9 @@ bool OwnTarget(const Camera& first, const Camera& second,
                 error);
   }
   const int w = first.width, h = first.height;
-  const double f = (w - 1) / (std::tan(high * kDeg) - std::tan(low * kDeg));
-  const double cx = -f * std::tan(low * kDeg);
+  const double f =
+      (w - 1) / (std::tan(high * kDegree) - std::tan(low * kDegree));
+  const double cx = -f * std::tan(low * kDegree);
   const double cy = 0.5 * (h - 1);
   Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
   k(0, 0) = k(1, 1) = f;
@@ -215,11 +215,11 @@ bool CheckRectification(const Camera& first, const Camera& second,
   }
   rect->field_of_view_deg =
       (std::atan((rect->width - 1 - k1(0, 2)) / f) + std::atan(k1(0, 2) / f)) /
-      kDeg;
+      kDegree;
   rect->vertical_field_of_view_deg =
       (std::atan((rect->height - 1 - k1(1, 2)) / k1(1, 1)) +
        std::atan(k1(1, 2) / k1(1, 1))) /
-      kDeg;
+      kDegree;
   rect->valid_fraction[0] =
       ValidFraction(first, rect->r1.transpose(), k1, rect->width, rect->height);
   rect->valid_fraction[1] = ValidFraction(second, rect->r2.transpose(), k2,

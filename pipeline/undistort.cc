@@ -7,12 +7,12 @@
 #include <sstream>
 #include <vector>
 
+#include "util/angles.h"
 #include "util/failure.h"
 
 namespace puzzlecal {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 // Map value of target pixels without a source pixel (outside every image).
 constexpr float kNoSource = -1000.0f;
 
@@ -42,7 +42,8 @@ double JacobianDeterminant(const Camera& camera, double x, double y) {
 // with min_area_ratio to spare) and within max_angle_deg of the axis.
 bool InsideFold(const Camera& camera, double x, double y,
                 const UndistortOptions& options) {
-  if (std::atan(std::hypot(x, y)) > options.max_angle_deg * kDeg) return false;
+  if (std::atan(std::hypot(x, y)) > options.max_angle_deg * kDegree)
+    return false;
   const double on_axis = JacobianDeterminant(camera, 0, 0);
   constexpr int kSteps = 8;
   for (int k = 1; k <= kSteps; ++k) {
@@ -67,7 +68,7 @@ bool InvertPixel(const Camera& camera, const Eigen::Vector2d& pixel,
     return false;
   }
   const double angle = std::atan2(ray.head<2>().norm(), ray.z());
-  if (angle > options.max_angle_deg * kDeg) {
+  if (angle > options.max_angle_deg * kDegree) {
     if (beyond_angle != nullptr) *beyond_angle = true;
     return false;
   }
@@ -211,7 +212,7 @@ UndistortResult ChooseUndistortTarget(const Camera& source_camera,
       const double x = (u - target.params[2]) / target.params[0];
       const double y = (v - target.params[3]) / target.params[1];
       result.target_max_angle_deg = std::max(
-          result.target_max_angle_deg, std::atan(std::hypot(x, y)) / kDeg);
+          result.target_max_angle_deg, std::atan(std::hypot(x, y)) / kDegree);
     }
   }
   // Coverage on every 4th pixel.
@@ -259,10 +260,10 @@ std::string UndistortResult::Summary(const UndistortOptions& options) const {
   const auto& p = target.params;
   const double hfov = (std::atan((0.5 + p[2]) / p[0]) +
                        std::atan((target.width - 0.5 - p[2]) / p[0])) /
-                      kDeg;
+                      kDegree;
   const double vfov = (std::atan((0.5 + p[3]) / p[1]) +
                        std::atan((target.height - 0.5 - p[3]) / p[1])) /
-                      kDeg;
+                      kDegree;
   out << "target: pinhole without distortion, " << target.width << "x"
       << target.height << ", fx " << p[0] << " fy " << p[1] << " cx " << p[2]
       << " cy " << p[3] << " (alpha " << options.alpha << ")\n";

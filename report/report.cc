@@ -16,6 +16,7 @@
 #include "report/image_chart.h"
 #include "report/overlay.h"
 #include "report/plot.h"
+#include "util/angles.h"
 #include "util/atomic_file.h"
 #include "util/failure.h"
 #include "util/string_format.h"
@@ -25,7 +26,6 @@ namespace {
 
 using plot::Colour;
 
-constexpr double kDeg = M_PI / 180.0;
 // Largest image side the report accepts (guards the plot sizes).
 constexpr int kMaxImageSide = 100000;
 
@@ -1010,7 +1010,7 @@ bool DistortionShift(const Camera& lens, const Eigen::Vector2d& pixel,
     }
   }
   *shift_px = (ideal - pixel).norm();
-  *ray_angle_deg = theta / kDeg;
+  *ray_angle_deg = theta / kDegree;
   return true;
 }
 
@@ -1618,8 +1618,7 @@ bool WriteReport(const std::string& dir, const ReportInput& input,
   }
   if (input.advice != nullptr && input.advice->ok && size_ok) {
     std::vector<std::string> advice_files;
-    if (!WriteAdviceFiles(dir, *input.advice,
-                          SeenCorners(*input.views, result),
+    if (!WriteAdviceFiles(dir, *input.advice, SeenCorners(*input.views, result),
                           options.image_plot_width, &advice_files, error)) {
       return false;
     }

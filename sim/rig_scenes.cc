@@ -11,11 +11,10 @@
 #include "formats/png_writer.h"
 #include "sim/pixel_rays.h"
 #include "sim/scenes.h"
+#include "util/angles.h"
 
 namespace puzzlecal {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 // A camera centred at `centre` (rig frame, metres) whose optical axis is
 // turned by `yaw_deg` about the rig's y axis (positive: towards +x) and

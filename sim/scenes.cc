@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <random>
 
+#include "util/angles.h"
 #include "util/failure.h"
 
 namespace puzzlecal {
@@ -15,8 +16,6 @@ double UniformDraw(std::mt19937_64* rng, double lo, double hi) {
 }
 
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 std::string ViewName(int index) {
   char name[32];
