@@ -52,10 +52,6 @@ DEFINE_string(watch, "",
               "uncertainty, verdict, the next advised photo); ends when the "
               "verdict is good, on Ctrl-C or after --watch-idle seconds "
               "without a photo, and writes what calibrate writes.");
-DEFINE_bool(same_focal, false,
-            "calibrate: one focal length, fy = fx (square pixels; OpenCV's "
-            "CALIB_FIX_ASPECT_RATIO with an aspect of 1); the options "
-            "file's calibration.same_focal_length.");
 DEFINE_double(watch_idle, 0,
               "calibrate --watch: stop after this many seconds without a new "
               "photo (0: wait for Ctrl-C or a good verdict).");

@@ -50,7 +50,9 @@ constexpr char kUsage[] =
     "--model M[,M1,...] --out rig.yaml\n"
     "                        [--format puzzlecal|opencv|ros|kalibr] "
     "[--report DIR] [--threads N]\n"
-    "                        [--options FILE] [--match_by_order]\n\n"
+    "                        [--options FILE] [--match_by_order] "
+    "[--fix NAMES] [--initial NAME=FILE,...]\n"
+    "                        [--same-focal]\n\n"
     "Calibrates a rig of cameras. DIR holds one subfolder per camera; sorted "
     "by name, the first\nis the reference camera (the rig frame). The same "
     "file name in different subfolders is the\nsame instant; a camera "
@@ -189,6 +191,10 @@ int ParseRigRequest(RigRequest* request) {
     std::cerr << kName << ": " << error << "\n";
     return kExitBadInput;
   }
+  if (FLAGS_same_focal) {
+    request->options.calibration.same_focal_length = true;
+    request->options.rig.camera.same_focal_length = true;
+  }
   request->user_fixed = request->options.calibration.fixed_params;
   request->options.calibration.fixed_params.clear();
   request->options.rig.camera.fixed_params.clear();
@@ -288,13 +294,13 @@ int CheckCameraInputs(const RigRequest& request,
   int first_video = -1, first_photos = -1;
   for (size_t c = 0; c < listings.size(); ++c) {
     const std::string camera = "camera '" +
-                               request.folders[c].filename().string() +
-                               "' (" + request.folders[c].string() + ")";
+                               request.folders[c].filename().string() + "' (" +
+                               request.folders[c].string() + ")";
     const ImageListing& listing = listings[c];
     if (listing.videos.size() > 1) {
-      std::cerr << kName << ": " << camera << " holds "
-                << listing.videos.size() << " videos ("
-                << FileNames(listing.videos) << "); " << kRule << ".\n";
+      std::cerr << kName << ": " << camera << " holds " << listing.videos.size()
+                << " videos (" << FileNames(listing.videos) << "); " << kRule
+                << ".\n";
       return kExitBadInput;
     }
     if (!listing.videos.empty() && !listing.images.empty()) {
@@ -308,13 +314,11 @@ int CheckCameraInputs(const RigRequest& request,
   }
   if (first_video >= 0 && first_photos >= 0) {
     const size_t v = first_video, p = first_photos;
-    std::cerr << kName << ": camera '"
-              << request.folders[v].filename().string() << "' ("
-              << request.folders[v].string() << ") holds a video ("
+    std::cerr << kName << ": camera '" << request.folders[v].filename().string()
+              << "' (" << request.folders[v].string() << ") holds a video ("
               << FileNames(listings[v].videos) << "), camera '"
               << request.folders[p].filename().string() << "' ("
-              << request.folders[p].string() << ") photos; " << kRule
-              << ".\n";
+              << request.folders[p].string() << ") photos; " << kRule << ".\n";
     return kExitBadInput;
   }
   videos->clear();
@@ -627,8 +631,7 @@ bool WriteReport(const RigCalibrationResult& result, bool calibrated,
         // Each camera video's frames: which were taken and why the others
         // not, and the reference frame each was paired with.
         for (size_t c = 0; c < videos.size(); ++c) {
-          const std::string name =
-              "video_frames_" + camera_names[c] + ".csv";
+          const std::string name = "video_frames_" + camera_names[c] + ".csv";
           if (!WriteFileAtomically((fs::path(folder) / name).string(),
                                    videos[c].Csv(true), why)) {
             return false;
@@ -731,7 +734,7 @@ PUZZLECAL_REGISTER_SUBCOMMAND(
     calibrate_rig, "calibrate-rig",
     "calibrate a multi-camera rig from one photo folder per camera", kUsage,
     {"images", "board", "model", "out", "format", "report", "threads",
-     "options", "match_by_order", "quiet", "fix", "initial"},
+     "options", "match_by_order", "quiet", "fix", "initial", "same_focal"},
     &RunCalibrateRig);
 
 }  // namespace

@@ -42,6 +42,11 @@ DEFINE_string(initial, "",
               "Start from this camera file (any format puzzlecal reads); with "
               "--fix all only the poses are fitted. calibrate-rig: "
               "NAME=FILE,... per camera folder.");
+DEFINE_bool(same_focal, false,
+            "One focal length, fy = fx (square pixels; OpenCV's "
+            "CALIB_FIX_ASPECT_RATIO with an aspect of 1); the options "
+            "file's calibration.same_focal_length. calibrate-rig: every "
+            "camera.");
 DEFINE_bool(quiet, false, "Print only errors and what was written.");
 DEFINE_bool(verbose, false,
             "Print every image's outcome and the timings as well.");

@@ -21,6 +21,7 @@ DECLARE_string(camera_name);
 DECLARE_string(options);
 DECLARE_string(fix);
 DECLARE_string(initial);
+DECLARE_bool(same_focal);
 
 DECLARE_bool(quiet);
 DECLARE_bool(verbose);

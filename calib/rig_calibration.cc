@@ -12,6 +12,7 @@
 #include <memory>
 #include <sstream>
 
+#include "calib/intrinsics_manifold.h"
 #include "calib/reprojection_error.h"
 #include "util/angles.h"
 #include "util/failure.h"
@@ -102,6 +103,15 @@ struct JointState {
   std::vector<std::vector<std::vector<bool>>> valid;
   std::vector<std::vector<std::vector<bool>>> inlier;
   std::vector<std::vector<bool>> fixed;
+  // fy tied to fx in every camera (same_focal_length).
+  bool same_focal = false;
+  // The parameters of camera c without a tangent coordinate of their own:
+  // the fixed ones, and fy when it is tied to fx.
+  std::vector<bool> TangentFixed(size_t c) const {
+    std::vector<bool> tangent_fixed = fixed[c];
+    if (same_focal && tangent_fixed.size() > 1) tangent_fixed[1] = true;
+    return tangent_fixed;
+  }
 };
 
 bool Residual(const JointState& state, size_t c, size_t f, size_t i,
@@ -197,7 +207,14 @@ void SolveJoint(JointState* state, const CalibrationOptions& options,
     for (int k = 0; k < n; ++k) {
       if (state->fixed[c][k]) fixed_indices.push_back(k);
     }
-    if (static_cast<int>(fixed_indices.size()) == n) {
+    if (state->same_focal) {
+      auto manifold = std::make_unique<TiedFocalManifold>(n, state->fixed[c]);
+      if (manifold->TangentSize() == 0) {
+        problem.SetParameterBlockConstant(state->params(c));
+      } else {
+        problem.SetManifold(state->params(c), manifold.release());
+      }
+    } else if (static_cast<int>(fixed_indices.size()) == n) {
       problem.SetParameterBlockConstant(state->params(c));
     } else if (!fixed_indices.empty()) {
       problem.SetManifold(state->params(c),
@@ -241,8 +258,9 @@ bool JointMarginalCovariance(const JointState& state, SolveOutcome* outcome,
   layout->size = 0;
   for (size_t c = 0; c < num_cameras; ++c) {
     if (!outcome->params_in_problem[c]) continue;
+    const std::vector<bool> tangent_fixed = state.TangentFixed(c);
     const int free = static_cast<int>(
-        std::count(state.fixed[c].begin(), state.fixed[c].end(), false));
+        std::count(tangent_fixed.begin(), tangent_fixed.end(), false));
     if (free > 0) {
       evaluate.parameter_blocks.push_back(const_cast<double*>(state.params(c)));
       layout->params_begin[c] = layout->size;
@@ -958,12 +976,15 @@ void FillRigCovariance(const JointState& state, double sum2_all,
     RigCameraResult& out = result->cameras[c];
     if (layout.params_begin[c] >= 0) {
       int index = layout.params_begin[c];
+      const std::vector<bool> tangent_fixed = state.TangentFixed(c);
       for (int k = 0; k < state.num_params[c]; ++k) {
-        if (state.fixed[c][k]) continue;
+        if (tangent_fixed[k]) continue;
         out.param_stddev[k] =
             std::sqrt(std::max(0.0, covariance(index, index)));
         ++index;
       }
+      // fy is fx.
+      if (state.same_focal) out.param_stddev[1] = out.param_stddev[0];
     }
     if (layout.extrinsics_begin[c] < 0) continue;
     const int e = layout.extrinsics_begin[c];
@@ -1089,13 +1110,6 @@ bool CalibrateRig(const std::vector<RigCameraInput>& input_cameras,
   std::string why;
   if (!options.Check(&why))
     return Fail("rig calibration options: " + why, error);
-  if (options.camera.same_focal_length) {
-    // The joint solve and its covariance hold parameters by subset only.
-    return Fail(
-        "same_focal_length (--same-focal) is for single cameras; the rig "
-        "calibration does not tie fy to fx",
-        error);
-  }
   if (!CheckRigInput(cameras, error)) return false;
   const size_t num_cameras = cameras.size();
   const size_t num_frames = cameras[0].frames.size();
@@ -1140,6 +1154,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& input_cameras,
         Eigen::Vector3d(2 * symmetry.centre.x(), 2 * symmetry.centre.y(), 0);
   }
   JointState state;
+  state.same_focal = copt.same_focal_length;
   StartJointState(cameras, single, cam_from_rig, copt.min_corners_per_view,
                   &state);
   JointSolveRun run;

@@ -117,7 +117,11 @@ bool ListRigCameraFolders(const std::string& root,
   std::vector<fs::path> found;
   for (fs::directory_iterator it(root, ec), end; !ec && it != end;
        it.increment(ec)) {
-    if (it->is_directory(ec)) found.push_back(it->path());
+    // Hidden folders (".report.partial", ".git", ...) are no cameras.
+    const std::string name = it->path().filename().string();
+    if (it->is_directory(ec) && !name.empty() && name[0] != '.') {
+      found.push_back(it->path());
+    }
   }
   if (ec) {
     return Fail(root + ": cannot read the folder (" + ec.message() + ")",

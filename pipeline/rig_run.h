@@ -26,7 +26,8 @@
 
 namespace puzzlecal {
 
-// The camera subfolders of `root` (one per camera), sorted by name: the
+// The camera subfolders of `root` (one per camera; hidden ones, whose name
+// starts with a dot, are left out), sorted by name: the
 // first is the reference camera. False with a message naming `root` when
 // it is not a folder or holds fewer than two subfolders.
 bool ListRigCameraFolders(const std::string& root,

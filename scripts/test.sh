@@ -69,14 +69,17 @@ if [ "$full" = 1 ]; then
     export ASAN_OPTIONS="halt_on_error=1:detect_leaks=0:print_stacktrace=1"
   fi
   # Left out here (the Release run above has them): tests that run one code
-  # path many times over -- Monte-Carlo spreads, a tilt series, a second
-  # model-selection scene, a second fisheye lattice, the program end to end
-  # on a rendered stereo rig and on a 1280x960 fisheye + pinhole rig (205 of
-  # the 1135 test-seconds left after the others; the mixed-model rig solve
-  # runs in RigCalibrationTest, the program's rig path in the other
-  # CalibrateRigTest cases). Each path they take runs under the sanitizers
-  # in a smaller test.
-  asan_skip='^(ProjectionUncertainty[.](MatchesEmpiricalSpread|RotationRemovedMatchesEmpiricalSpread)|GridRenderTest[.](TiltSeries|SteepFisheyeCheckerboardIsOneComponent)|SelectModel[.]ChoosesRadtanForARadtanLens|CalibrateRigTest[.](StereoPinholeRendersInOpenCvFormat|FisheyeAndPinholeRendersMeetTheFigures)|RigCalibrationTest[.]StatedSigmaDescribesTheErrorsOverDraws)$'
+  # path many times over -- Monte-Carlo spreads, false-alarm rates over 60
+  # and 20 clean scenes, a tilt series, a second model-selection scene, a
+  # second fisheye lattice, the program end to end on a rendered stereo rig
+  # and on a 1280x960 fisheye + pinhole rig, a second rendered clip for the
+  # near-duplicate rule and a second stereo clip pair (one camera late)
+  # (about 560 of the 3080 test-seconds under the sanitizers; the
+  # mixed-model rig solve runs in RigCalibrationTest, the program's rig path
+  # in the other CalibrateRigTest cases, the video paths in the other
+  # VideoFrames and CalibrateRigVideo cases). Each path they take runs under
+  # the sanitizers in a smaller test.
+  asan_skip='^(ProjectionUncertainty[.](MatchesEmpiricalSpread|RotationRemovedMatchesEmpiricalSpread)|GridRenderTest[.](TiltSeries|SteepFisheyeCheckerboardIsOneComponent)|SelectModel[.]ChoosesRadtanForARadtanLens|CalibrateRigTest[.](StereoPinholeRendersInOpenCvFormat|FisheyeAndPinholeRendersMeetTheFigures)|RigCalibrationTest[.]StatedSigmaDescribesTheErrorsOverDraws|Verdict[.]FalseAlarmRateOnCleanRandomScenesIsAtMostTwoPercent|RigEvidenceTest[.]NoCleanFrameIsNamedInTwentyCleanScenes|VideoFrames[.]NearDuplicatesAreSkippedAndTheCapSpreadsTheChoice|CalibrateRigVideo[.]ACameraSeveralFramesLateIsNotCalledGood)$'
   (cd build-asan && ctest --output-on-failure --parallel "$(nproc)" --timeout 600 -E "$asan_skip")
   phase_done "ctest (Asan)"
 

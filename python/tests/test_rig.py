@@ -309,3 +309,19 @@ def test_the_rig_example_runs(rendered, tmp_path):
     assert "baseline 120.0" in run.stdout  # the render's 120.08 mm
     assert "rig: verdict: good" in run.stdout
     assert out.exists()
+
+
+def test_same_focal_length_ties_every_camera(rendered):
+    """One focal length per camera through the options, as --same-focal."""
+    root, truth, _ = rendered
+    board = truth["board"]
+    result = puzzlecal.calibrate_rig(
+        detections_as_observations(root, board), board,
+        models=["pinhole-radtan"] * 2, image_sizes=(640, 480),
+        options=puzzlecal.options(calibration={"same_focal_length": True}))
+    for camera, true in zip(result.cameras, truth["cameras"]):
+        params, sigma = camera.params_by_name, camera.stddev_by_name
+        assert params["fx"] == params["fy"]
+        assert sigma["fx"] == sigma["fy"] > 0
+        assert params["fx"] == pytest.approx(true["camera"].params[0],
+                                             rel=MAX_FOCAL_RELATIVE_ERROR)

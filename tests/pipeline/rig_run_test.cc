@@ -5,7 +5,9 @@
 #include "pipeline/rig_run.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,25 @@ ImageListing Listing(const std::vector<std::string>& images) {
   ImageListing listing;
   listing.images = images;
   return listing;
+}
+
+TEST(RigRunTest, HiddenFoldersAreNoCameras) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() /
+                        ("puzzlecal_rig_folders_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  for (const char* name : {"cam1", "cam0", ".report.partial", ".git"}) {
+    fs::create_directories(root / name);
+  }
+  std::vector<std::string> folders;
+  std::string error;
+  ASSERT_TRUE(ListRigCameraFolders(root.string(), &folders, &error)) << error;
+  EXPECT_EQ(folders, (std::vector<std::string>{(root / "cam0").string(),
+                                               (root / "cam1").string()}));
+  fs::remove_all(root / "cam1");
+  EXPECT_FALSE(ListRigCameraFolders(root.string(), &folders, &error));
+  EXPECT_NE(error.find("1 camera subfolder "), std::string::npos) << error;
+  fs::remove_all(root);
 }
 
 TEST(RigRunTest, FramesAreMatchedByFileName) {
