@@ -123,7 +123,7 @@ function(puzzlecal_add_tests dir)
   puzzlecal_test_compile_options(${target})
   target_precompile_headers(${target} REUSE_FROM puzzlecal_test_pch)
   set_target_properties(${target} PROPERTIES UNITY_BUILD ON
-                        UNITY_BUILD_BATCH_SIZE 4)
+                        UNITY_BUILD_BATCH_SIZE 8)
   gtest_discover_tests(${target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
                        DISCOVERY_TIMEOUT 60
                        PROPERTIES ENVIRONMENT
