@@ -547,9 +547,14 @@ int DetectAll(const CalibrateRequest& request, CalibrationRun* run) {
   for (const ImageResult& image : run->images) {
     std::cerr << image.reason << "\n";
   }
-  std::cerr << "puzzlecal calibrate: none of the " << run->images.size()
-            << " image and video files in " << FLAGS_images
-            << " could be read; no calibration written.\n";
+  const size_t count = run->images.size();
+  std::cerr << "puzzlecal calibrate: "
+            << (count == 1 ? "the one image or video file in " + FLAGS_images +
+                                 " could not be read"
+                           : "none of the " + std::to_string(count) +
+                                 " image and video files in " + FLAGS_images +
+                                 " could be read")
+            << "; no calibration written.\n";
   return kExitBadInput;
 }
 
@@ -569,7 +574,9 @@ int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
               << "\n";
     return kExitNoResult;
   }
-  if (!request->watching) std::cout << run->selection.Table();
+  if (!request->watching && request->verbosity != Verbosity::kQuiet) {
+    std::cout << run->selection.Table();
+  }
   request->model = run->selection.candidates[run->selection.chosen].model;
   if (!CameraFormatFixedParams(request->format, request->model,
                                &request->calibration_options.fixed_params,

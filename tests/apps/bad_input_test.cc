@@ -307,7 +307,18 @@ TEST_F(BadInputTest, FolderOfNonImages) {
   EXPECT_EQ(calibrate.exit_code, kExitBadInput) << calibrate.all();
   EXPECT_NE(calibrate.all().find("fake.png"), std::string::npos)
       << calibrate.all();
+  EXPECT_NE(calibrate.err.find("none of the 2 image and video files in"),
+            std::string::npos)
+      << calibrate.err;
   EXPECT_FALSE(fs::exists(camera));
+
+  // One file: said as one.
+  fs::remove(folder / "random.jpg");
+  const ProgramRun one = Calibrate(folder, camera);
+  EXPECT_EQ(one.exit_code, kExitBadInput) << one.all();
+  EXPECT_NE(one.err.find("the one image or video file in"), std::string::npos)
+      << one.err;
+  EXPECT_NE(one.err.find("could not be read"), std::string::npos) << one.err;
 }
 
 // `detect --board` on a good view beside a broken file: the broken file is
@@ -863,6 +874,11 @@ TEST_F(BadInputTest, ConsoleVersionHelpAndQuiet) {
   EXPECT_NE(run.out.find("\nwrote " + camera.string() + "\n"),
             std::string::npos)
       << run.out;
+  // With --model auto too: the model-selection table is not printed.
+  run = Calibrate(folder, camera, "--quiet --model auto");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_EQ(run.out.rfind("verdict: ", 0), 0u) << run.out;
+  EXPECT_EQ(std::count(run.out.begin(), run.out.end(), '\n'), 2) << run.out;
   run = Calibrate(folder, camera, "--quiet --verbose");
   EXPECT_EQ(run.exit_code, kExitUsage) << run.all();
 }
