@@ -1209,7 +1209,7 @@ void MarkdownHeader(const ReportInput& input, std::ostringstream& md) {
 // RMS, counts, orientations, coverage, initialisation and solver.
 void MarkdownResult(const ReportInput& input, std::ostringstream& md) {
   const CalibrationResult& result = *input.result;
-  md << "## Result\n\n| | |\n|---|---|\n";
+  md << "## Result\n\n| what | value |\n|---|---|\n";
   md << StringPrintf(
       "| RMS reprojection error | %.4f px per coordinate (%.4f px "
       "per corner, OpenCV's figure) |\n",

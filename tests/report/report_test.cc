@@ -289,6 +289,22 @@ TEST(ReportTest, WritesSummaryAndPlotsForARenderedRun) {
   EXPECT_NE(markdown.find("pinhole-radtan"), std::string::npos);
   EXPECT_NE(markdown.find("640 x 480"), std::string::npos);
   EXPECT_EQ(markdown.find("Calibration failed"), std::string::npos);
+  // Every table's header row names its columns (a header row is the line
+  // above a "|---" line).
+  {
+    std::istringstream lines(markdown);
+    std::string previous, line;
+    int tables = 0;
+    while (std::getline(lines, line)) {
+      if (line.rfind("|---", 0) == 0) {
+        ++tables;
+        EXPECT_EQ(previous.find("| |"), std::string::npos) << previous;
+        EXPECT_EQ(previous.find("||"), std::string::npos) << previous;
+      }
+      previous = line;
+    }
+    EXPECT_GE(tables, 3);
+  }
 
   // Every parameter, printed to the precision its sigma asks for, matches
   // the result to that precision and the truth within 5 sigma.
