@@ -62,6 +62,87 @@ double Percentile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<size_t>(q * v.size()))];
 }
 
+// A distortion-free pinhole of focal length `fx` whose principal point is
+// `offset` from the image centre.
+Camera PinholeCamera(double fx, int width, int height,
+                     const Eigen::Vector2d& offset) {
+  Camera camera;
+  camera.model = CameraModelId::kPinholeRadtan;
+  camera.width = width;
+  camera.height = height;
+  camera.params = {
+      fx, fx, width / 2.0 + offset.x(), height / 2.0 + offset.y(), 0, 0, 0,
+      0,  0};
+  return camera;
+}
+
+// The pose that turns the board by `rotation` about its centre and puts the
+// centre `z` metres ahead on the optical axis.
+Eigen::Isometry3d CentredPose(const Board& board,
+                              const Eigen::Matrix3d& rotation, double z) {
+  const Eigen::Vector3d centre((board.cols - 1) * 0.5 * board.tile_size_m,
+                               (board.rows - 1) * 0.5 * board.tile_size_m, 0.0);
+  Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
+  cam_from_board.linear() = rotation;
+  cam_from_board.translation() = Eigen::Vector3d(0, 0, z) - rotation * centre;
+  return cam_from_board;
+}
+
+std::vector<Eigen::Vector2d> VisibleCorners(const RenderTruth& truth) {
+  std::vector<Eigen::Vector2d> xy;
+  for (const TruthCorner& t : truth.corners) {
+    if (t.visible) xy.push_back(t.xy);
+  }
+  return xy;
+}
+
+std::vector<Eigen::Vector2d> DetectedPoints(const cv::Mat& image,
+                                            const DetectorOptions& options) {
+  std::vector<Eigen::Vector2d> found;
+  for (const Corner& c : DetectCorners(image, options)) found.push_back(c.xy);
+  return found;
+}
+
+// Every truth corner counts as expected; the ones with a point of `found`
+// within `match_radius` add their distance to it.
+void Score(const std::vector<Eigen::Vector2d>& found,
+           const std::vector<Eigen::Vector2d>& truth_xy, double match_radius,
+           ErrorStats* stats) {
+  stats->expected += static_cast<int>(truth_xy.size());
+  for (const Eigen::Vector2d& t : truth_xy) {
+    double d;
+    if (Nearest(found, t, &d) >= 0 && d < match_radius) stats->Add(d);
+  }
+}
+
+// cv::cornerSubPix started from the detector's integer peaks that lie within
+// `match_radius` of a truth corner, with the window the detector picks (half
+// the tile, 2-12 px).
+std::vector<Eigen::Vector2d> CornerSubPixFromPeaks(
+    const cv::Mat& image, const std::vector<Eigen::Vector2d>& truth_xy,
+    double match_radius, double tile_px) {
+  DetectorOptions options;
+  options.subpixel = SubpixelMethod::kNone;
+  std::vector<cv::Point2f> start;
+  for (const Corner& c : DetectCorners(image, options)) {
+    double d;
+    if (Nearest(truth_xy, c.xy, &d) >= 0 && d < match_radius) {
+      start.emplace_back(c.xy.x(), c.xy.y());
+    }
+  }
+  if (!start.empty()) {
+    const int window =
+        std::clamp(static_cast<int>(std::floor(0.5 * tile_px)), 2, 12);
+    cv::cornerSubPix(
+        image, start, cv::Size(window, window), cv::Size(-1, -1),
+        cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50,
+                         0.001));
+  }
+  std::vector<Eigen::Vector2d> found;
+  for (const cv::Point2f& p : start) found.emplace_back(p.x, p.y);
+  return found;
+}
+
 std::string Num(double v) {
   if (!std::isfinite(v)) return "null";
   char buffer[32];
@@ -99,102 +180,45 @@ int main(int argc, char** argv) {
         // Tile size 20..60 px, a rotation about the optical axis and a tilt.
         const double tile_px = 20.0 + 40.0 * v / std::max(1, views - 1);
         const double fx = 800.0;
-        Camera camera;
-        camera.model = CameraModelId::kPinholeRadtan;
-        camera.width = static_cast<int>(tile_px * 15);
-        camera.height = static_cast<int>(tile_px * 12);
-        camera.params = {fx,
-                         fx,
-                         camera.width / 2.0 - 0.3,
-                         camera.height / 2.0 + 0.2,
-                         0,
-                         0,
-                         0,
-                         0,
-                         0};
+        const Camera camera =
+            PinholeCamera(fx, static_cast<int>(tile_px * 15),
+                          static_cast<int>(tile_px * 12), {-0.3, 0.2});
         const double z = fx * board.tile_size_m / tile_px;
-        Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
         const Eigen::Matrix3d rotation =
             (Eigen::AngleAxisd(0.15 + 0.37 * v, Eigen::Vector3d::UnitZ()) *
              Eigen::AngleAxisd(0.12 * ((v % 3) - 1), Eigen::Vector3d::UnitX()) *
              Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()))
                 .toRotationMatrix();
-        const Eigen::Vector3d centre((board.cols - 1) * 0.5 * board.tile_size_m,
-                                     (board.rows - 1) * 0.5 * board.tile_size_m,
-                                     0.0);
-        cam_from_board.linear() = rotation;
-        cam_from_board.translation() =
-            Eigen::Vector3d(0, 0, z) - rotation * centre;
         RenderOptions render;
         render.blur_sigma_px = blur;
         render.noise_sigma = noise;
         render.seed = 1000 + v;
         RenderTruth truth;
-        const cv::Mat image =
-            RenderBoard(board, camera, cam_from_board, render, &truth);
+        const cv::Mat image = RenderBoard(
+            board, camera, CentredPose(board, rotation, z), render, &truth);
         if (image.empty()) continue;
-        std::vector<Eigen::Vector2d> truth_xy;
-        for (const TruthCorner& t : truth.corners) {
-          if (t.visible) truth_xy.push_back(t.xy);
-        }
+        const std::vector<Eigen::Vector2d> truth_xy = VisibleCorners(truth);
         const double match_radius = std::max(2.0, 0.3 * tile_px);
 
-        auto score = [&](const std::vector<Eigen::Vector2d>& found,
-                         ErrorStats* stats) {
-          stats->expected += static_cast<int>(truth_xy.size());
-          for (const Eigen::Vector2d& t : truth_xy) {
-            double d;
-            if (Nearest(found, t, &d) >= 0 && d < match_radius) stats->Add(d);
-          }
-        };
         DetectorOptions options;
-        std::vector<Eigen::Vector2d> found;
-        for (const Corner& c : DetectCorners(image, options))
-          found.push_back(c.xy);
-        score(found, &ours);
-
+        Score(DetectedPoints(image, options), truth_xy, match_radius, &ours);
         options.subpixel = SubpixelMethod::kCentroid;
-        found.clear();
-        for (const Corner& c : DetectCorners(image, options))
-          found.push_back(c.xy);
-        score(found, &centroid);
-
+        Score(DetectedPoints(image, options), truth_xy, match_radius,
+              &centroid);
         options.subpixel = SubpixelMethod::kGradientOrthogonality;
-        found.clear();
-        for (const Corner& c : DetectCorners(image, options))
-          found.push_back(c.xy);
-        score(found, &gradient);
-
-        // cornerSubPix from the detector's integer peaks, the window size the
-        // detector picks (half the tile, at most 12 px).
-        options.subpixel = SubpixelMethod::kNone;
-        std::vector<cv::Point2f> start;
-        for (const Corner& c : DetectCorners(image, options)) {
-          double d;
-          if (Nearest(truth_xy, c.xy, &d) >= 0 && d < match_radius) {
-            start.emplace_back(c.xy.x(), c.xy.y());
-          }
-        }
-        if (!start.empty()) {
-          const int window =
-              std::clamp(static_cast<int>(std::floor(0.5 * tile_px)), 2, 12);
-          cv::cornerSubPix(
-              image, start, cv::Size(window, window), cv::Size(-1, -1),
-              cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
-                               50, 0.001));
-        }
-        found.clear();
-        for (const cv::Point2f& p : start) found.emplace_back(p.x, p.y);
-        score(found, &subpix);
+        Score(DetectedPoints(image, options), truth_xy, match_radius,
+              &gradient);
+        Score(CornerSubPixFromPeaks(image, truth_xy, match_radius, tile_px),
+              truth_xy, match_radius, &subpix);
 
         std::vector<cv::Point2f> sb_corners;
         if (cv::findChessboardCornersSB(
                 image, cv::Size(board.cols, board.rows), sb_corners,
                 cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) {
           ++sb_views;
-          found.clear();
+          std::vector<Eigen::Vector2d> found;
           for (const cv::Point2f& p : sb_corners) found.emplace_back(p.x, p.y);
-          score(found, &sb);
+          Score(found, truth_xy, match_radius, &sb);
         }
       }
       std::printf(
@@ -231,79 +255,31 @@ int main(int argc, char** argv) {
         ErrorStats ours, subpix;
         for (int v = 0; v < 3; ++v) {
           const double fx = 800.0;
-          Camera camera;
-          camera.model = CameraModelId::kPinholeRadtan;
-          camera.width = static_cast<int>(tile_px * 16);
-          camera.height = static_cast<int>(tile_px * 13);
-          camera.params = {fx,
-                           fx,
-                           camera.width / 2.0 - 0.3,
-                           camera.height / 2.0 + 0.2,
-                           0,
-                           0,
-                           0,
-                           0,
-                           0};
+          const Camera camera =
+              PinholeCamera(fx, static_cast<int>(tile_px * 16),
+                            static_cast<int>(tile_px * 13), {-0.3, 0.2});
           const double z = fx * tilted->tile_size_m / tile_px;
           const Eigen::Matrix3d rotation =
               (Eigen::AngleAxisd(tilt_deg * M_PI / 180,
                                  Eigen::Vector3d::UnitX()) *
                Eigen::AngleAxisd(0.2 + 0.5 * v, Eigen::Vector3d::UnitZ()))
                   .toRotationMatrix();
-          const Eigen::Vector3d centre(
-              (tilted->cols - 1) * 0.5 * tilted->tile_size_m,
-              (tilted->rows - 1) * 0.5 * tilted->tile_size_m, 0.0);
-          Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
-          cam_from_board.linear() = rotation;
-          cam_from_board.translation() =
-              Eigen::Vector3d(0, 0, z) - rotation * centre;
           RenderOptions render;
           render.blur_sigma_px = 0.8;
           render.noise_sigma = 0.01;
           render.seed = 2000 + v;
           RenderTruth truth;
           const cv::Mat image =
-              RenderBoard(*tilted, camera, cam_from_board, render, &truth);
+              RenderBoard(*tilted, camera, CentredPose(*tilted, rotation, z),
+                          render, &truth);
           if (image.empty()) continue;
-          std::vector<Eigen::Vector2d> truth_xy;
-          for (const TruthCorner& t : truth.corners) {
-            if (t.visible) truth_xy.push_back(t.xy);
-          }
+          const std::vector<Eigen::Vector2d> truth_xy = VisibleCorners(truth);
           const double match_radius =
               std::max(1.5, 0.3 * tile_px * std::cos(tilt_deg * M_PI / 180));
-          auto score = [&](const std::vector<Eigen::Vector2d>& found,
-                           ErrorStats* stats) {
-            stats->expected += static_cast<int>(truth_xy.size());
-            for (const Eigen::Vector2d& t : truth_xy) {
-              double d;
-              if (Nearest(found, t, &d) >= 0 && d < match_radius) stats->Add(d);
-            }
-          };
-          DetectorOptions options;
-          std::vector<Eigen::Vector2d> found;
-          for (const Corner& c : DetectCorners(image, options))
-            found.push_back(c.xy);
-          score(found, &ours);
-          options.subpixel = SubpixelMethod::kNone;
-          std::vector<cv::Point2f> start;
-          for (const Corner& c : DetectCorners(image, options)) {
-            double d;
-            if (Nearest(truth_xy, c.xy, &d) >= 0 && d < match_radius) {
-              start.emplace_back(c.xy.x(), c.xy.y());
-            }
-          }
-          if (!start.empty()) {
-            const int window =
-                std::clamp(static_cast<int>(std::floor(0.5 * tile_px)), 2, 12);
-            cv::cornerSubPix(image, start, cv::Size(window, window),
-                             cv::Size(-1, -1),
-                             cv::TermCriteria(cv::TermCriteria::EPS +
-                                                  cv::TermCriteria::COUNT,
-                                              50, 0.001));
-          }
-          found.clear();
-          for (const cv::Point2f& p : start) found.emplace_back(p.x, p.y);
-          score(found, &subpix);
+          Score(DetectedPoints(image, DetectorOptions()), truth_xy,
+                match_radius, &ours);
+          Score(CornerSubPixFromPeaks(image, truth_xy, match_radius, tile_px),
+                truth_xy, match_radius, &subpix);
         }
         std::printf(
             "%s    {\"board\": \"%s\", \"tile_px_frontal\": %.0f, "
@@ -336,24 +312,15 @@ int main(int argc, char** argv) {
     int expected = 0, found = 0, false_on_board = 0;
     for (int v = 0; v < 2; ++v) {
       const double fx = 1000.0;
-      Camera camera;
-      camera.model = CameraModelId::kPinholeRadtan;
-      camera.width = static_cast<int>(tile_px * 15 + 40);
-      camera.height = static_cast<int>(tile_px * 12 + 40);
-      camera.params = {fx, fx, camera.width / 2.0, camera.height / 2.0, 0, 0, 0,
-                       0,  0};
+      const Camera camera =
+          PinholeCamera(fx, static_cast<int>(tile_px * 15 + 40),
+                        static_cast<int>(tile_px * 12 + 40), {0, 0});
       const double z = fx * puzzle.tile_size_m / tile_px;
       const Eigen::Matrix3d rotation =
           (Eigen::AngleAxisd(0.3 + 0.5 * v, Eigen::Vector3d::UnitZ()) *
            Eigen::AngleAxisd(0.15, Eigen::Vector3d::UnitX()))
               .toRotationMatrix();
-      const Eigen::Vector3d centre((puzzle.cols - 1) * 0.5 * puzzle.tile_size_m,
-                                   (puzzle.rows - 1) * 0.5 * puzzle.tile_size_m,
-                                   0);
-      Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
-      cam_from_board.linear() = rotation;
-      cam_from_board.translation() =
-          Eigen::Vector3d(0, 0, z) - rotation * centre;
+      const Eigen::Isometry3d cam_from_board = CentredPose(puzzle, rotation, z);
       RenderOptions render;
       render.blur_sigma_px = 0.8;
       render.noise_sigma = 0.01;

@@ -23,6 +23,7 @@
 
 #include "calib/rig_calibration.h"
 #include "sim/rig_scenes.h"
+#include "tests/calib/stereo_reference.h"
 
 namespace {
 
@@ -77,14 +78,9 @@ Timing Time(const std::vector<RigCameraInput>& inputs,
 // The bench's scene: frames in which both cameras see the whole board;
 // frames_seed 0 keeps StereoPinholeRig's own frames.
 RigSceneSpec BenchScene(uint64_t frames_seed) {
-  RigSceneSpec scene = puzzlecal::StereoPinholeRig();
+  RigSceneSpec scene = puzzlecal::testing::WholeBoardStereoRig();
   scene.random_frames.count = 3 * kFrames;
   if (frames_seed != 0) scene.random_frames.seed = frames_seed;
-  scene.random_frames.min_distance_m = 1.1;
-  scene.random_frames.max_distance_m = 1.4;
-  scene.random_frames.max_off_axis_deg = 8;
-  scene.random_frames.max_roll_deg = 20;
-  scene.min_visible_corners = scene.board.NumCorners();
   return scene;
 }
 

@@ -59,10 +59,12 @@ double FramePeriodMs(const VideoFrames& reference) {
 }  // namespace
 
 bool RigVideoOptions::Check(std::string* why) const {
-  if (!(max_time_difference_ms >= 0) || !std::isfinite(max_time_difference_ms)) {
-    return Fail("max_time_difference_ms must be >= 0 (0: a quarter of the "
-                "reference video's frame period)",
-                why);
+  if (!(max_time_difference_ms >= 0) ||
+      !std::isfinite(max_time_difference_ms)) {
+    return Fail(
+        "max_time_difference_ms must be >= 0 (0: a quarter of the "
+        "reference video's frame period)",
+        why);
   }
   return true;
 }
@@ -81,17 +83,16 @@ std::vector<TimePairing> PairFramesByTime(
         std::lower_bound(reference_ms.begin(), reference_ms.end(), t) -
         reference_ms.begin());
     int nearest = static_cast<int>(std::min(after, reference_ms.size() - 1));
-    if (after > 0 &&
-        (after == reference_ms.size() ||
-         t - reference_ms[after - 1] <= reference_ms[after] - t)) {
+    if (after > 0 && (after == reference_ms.size() ||
+                      t - reference_ms[after - 1] <= reference_ms[after] - t)) {
       nearest = static_cast<int>(after - 1);  // ties: the earlier
     }
     p.nearest = nearest;
     p.difference_ms = t - reference_ms[nearest];
     if (!(std::abs(p.difference_ms) <= tolerance_ms)) continue;
     int& holder = claimed_by[nearest];
-    if (holder >= 0 && std::abs(pairings[holder].difference_ms) <=
-                           std::abs(p.difference_ms)) {
+    if (holder >= 0 &&
+        std::abs(pairings[holder].difference_ms) <= std::abs(p.difference_ms)) {
       p.taken = true;  // an earlier frame is at least as near
       continue;
     }
@@ -225,20 +226,29 @@ std::string RigVideoFrames::Summary() const {
   return out.str();
 }
 
-bool ReadRigVideos(const std::vector<std::string>& videos, const Board& board,
-                   const PipelineOptions& pipeline,
-                   const VideoFrameOptions& video_options,
-                   const RigVideoOptions& options, int num_threads,
-                   RigVideoFrames* frames, std::string* error) {
-  *frames = RigVideoFrames();
-  std::string why;
-  if (!video_options.Check(&why)) return Fail("video: " + why, error);
-  if (!options.Check(&why)) return Fail("rig_video: " + why, error);
+namespace {
+
+// Per camera, per position in the reference video's examined frames: the
+// position of the record paired with it (-1 when none).
+using Partners = std::vector<std::vector<int>>;
+
+// The rig frames in which some camera's frame passed the video tests.
+struct RigCandidates {
+  std::vector<int> reference;               // rig frame -> reference position
+  std::vector<std::vector<int>> candidate;  // rig frame -> per camera (-1)
+  std::vector<RigFrameOutlines> outlines;   // rig frame -> outlines
+};
+
+// Stage 1: each video examined by itself; only the corners of the frames
+// that pass are kept (`candidates`, per camera).
+bool ExamineRigVideos(const std::vector<std::string>& videos,
+                      const Board& board, const PipelineOptions& pipeline,
+                      const VideoFrameOptions& video_options, int num_threads,
+                      RigVideoFrames* frames,
+                      std::vector<std::vector<VideoFrameCandidate>>* candidates,
+                      std::string* error) {
   const size_t num_cameras = videos.size();
-  if (num_cameras < 1) return Fail("no video", error);
-  // Each video examined by itself; only the corners of the frames that
-  // pass are kept.
-  std::vector<std::vector<VideoFrameCandidate>> candidates(num_cameras);
+  candidates->assign(num_cameras, {});
   std::vector<std::string> errors(num_cameras);
   std::vector<char> read(num_cameras, 0);
   frames->videos.resize(num_cameras);
@@ -246,14 +256,41 @@ bool ReadRigVideos(const std::vector<std::string>& videos, const Board& board,
     read[c] = ExamineVideo(
         videos[c], board, pipeline, video_options,
         [&](VideoFrameCandidate&& candidate) {
-          candidates[c].push_back(std::move(candidate));
+          (*candidates)[c].push_back(std::move(candidate));
         },
         &frames->videos[c], &errors[c]);
   });
   for (size_t c = 0; c < num_cameras; ++c) {
     if (!read[c]) return Fail(errors[c], error);
   }
-  // Pairing by time stamp with the reference video's examined frames.
+  return true;
+}
+
+// The reason of a kept frame that found no partner in the reference video.
+std::string NoPartnerReason(const VideoFrames& reference,
+                            const TimePairing& pairing, double tolerance_ms) {
+  const std::string reference_name = FileName(reference.file);
+  if (pairing.nearest < 0) return reference_name + " has no frame";
+  if (pairing.taken) {
+    return StringPrintf(
+        "%s's frame %d (%+.1f ms) is paired with a nearer frame of this "
+        "video",
+        reference_name.c_str(), reference.frames[pairing.nearest].index,
+        pairing.difference_ms);
+  }
+  return StringPrintf(
+      "no frame of %s within %.1f ms (the nearest, frame %d, is %+.1f ms "
+      "away)",
+      reference_name.c_str(), tolerance_ms,
+      reference.frames[pairing.nearest].index, pairing.difference_ms);
+}
+
+// Stage 2: every camera's examined frames paired by time stamp with the
+// reference video's (tolerance_ms, unpaired_frames, matched_frames and the
+// records' partners and outcomes).
+bool PairRigVideos(const RigVideoOptions& options, RigVideoFrames* frames,
+                   Partners* partner, std::string* error) {
+  const size_t num_cameras = frames->videos.size();
   const VideoFrames& reference = frames->videos[0];
   frames->tolerance_ms = options.max_time_difference_ms > 0
                              ? options.max_time_difference_ms
@@ -265,15 +302,12 @@ bool ReadRigVideos(const std::vector<std::string>& videos, const Board& board,
   if (!std::is_sorted(reference_ms.begin(), reference_ms.end())) {
     return Fail(reference.file + ": its time stamps do not increase", error);
   }
-  // Per camera, per reference position: the record paired with it (-1).
-  std::vector<std::vector<int>> partner(
-      num_cameras, std::vector<int>(reference_ms.size(), -1));
+  partner->assign(num_cameras, std::vector<int>(reference_ms.size(), -1));
   for (size_t i = 0; i < reference.frames.size(); ++i) {
     VideoFrameRecord& r = frames->videos[0].frames[i];
     r.reference_frame = r.index;
-    partner[0][i] = static_cast<int>(i);
+    (*partner)[0][i] = static_cast<int>(i);
   }
-  const std::string reference_name = FileName(reference.file);
   for (size_t c = 1; c < num_cameras; ++c) {
     std::vector<VideoFrameRecord>& records = frames->videos[c].frames;
     std::vector<double> times;
@@ -290,53 +324,43 @@ bool ReadRigVideos(const std::vector<std::string>& videos, const Board& board,
       if (p.reference >= 0) {
         r.reference_frame = reference.frames[p.reference].index;
         r.time_difference_ms = p.difference_ms;
-        partner[c][p.reference] = static_cast<int>(i);
+        (*partner)[c][p.reference] = static_cast<int>(i);
         continue;
       }
       ++frames->unpaired_frames;
       if (r.outcome != VideoFrameOutcome::kKept) continue;
       r.outcome = VideoFrameOutcome::kNoPartner;
-      if (p.nearest < 0) {
-        r.reason = reference_name + " has no frame";
-      } else if (p.taken) {
-        r.reason = StringPrintf(
-            "%s's frame %d (%+.1f ms) is paired with a nearer frame of this "
-            "video",
-            reference_name.c_str(), reference.frames[p.nearest].index,
-            p.difference_ms);
-      } else {
-        r.reason = StringPrintf(
-            "no frame of %s within %.1f ms (the nearest, frame %d, is %+.1f "
-            "ms away)",
-            reference_name.c_str(), frames->tolerance_ms,
-            reference.frames[p.nearest].index, p.difference_ms);
-      }
+      r.reason = NoPartnerReason(reference, p, frames->tolerance_ms);
     }
   }
   for (size_t i = 0; i < reference_ms.size(); ++i) {
     bool all = true;
-    for (size_t c = 1; c < num_cameras; ++c) all = all && partner[c][i] >= 0;
+    for (size_t c = 1; c < num_cameras; ++c) all = all && (*partner)[c][i] >= 0;
     frames->matched_frames += all;
   }
-  // The rig frames in which some camera's frame passed: per reference
-  // position, per camera the candidate (position in candidates[c]).
+  return true;
+}
+
+// Stage 3: the rig frames in which some camera's paired frame passed.
+RigCandidates CollectRigCandidates(
+    const std::vector<std::vector<VideoFrameCandidate>>& candidates,
+    const Partners& partner, const RigVideoFrames& frames) {
+  const size_t num_cameras = candidates.size();
   std::vector<std::map<int, int>> candidate_at(num_cameras);  // index -> pos
   for (size_t c = 0; c < num_cameras; ++c) {
     for (size_t k = 0; k < candidates[c].size(); ++k) {
       candidate_at[c][candidates[c][k].index] = static_cast<int>(k);
     }
   }
-  std::vector<int> rig_reference;             // rig frame -> reference pos
-  std::vector<std::vector<int>> rig_candidate;  // rig frame -> per camera
-  std::vector<RigFrameOutlines> outlines;
-  for (size_t i = 0; i < reference_ms.size(); ++i) {
+  RigCandidates rig;
+  for (size_t i = 0; i < partner[0].size(); ++i) {
     std::vector<int> at(num_cameras, -1);
     RigFrameOutlines frame;
     frame.seen.assign(num_cameras, false);
     frame.outlines.assign(num_cameras, BoardOutline::Zero());
     for (size_t c = 0; c < num_cameras; ++c) {
       if (partner[c][i] < 0) continue;
-      const VideoFrameRecord& r = frames->videos[c].frames[partner[c][i]];
+      const VideoFrameRecord& r = frames.videos[c].frames[partner[c][i]];
       if (r.outcome != VideoFrameOutcome::kKept) continue;
       at[c] = candidate_at[c].at(r.index);
       const VideoFrameCandidate& candidate = candidates[c][at[c]];
@@ -346,35 +370,34 @@ bool ReadRigVideos(const std::vector<std::string>& videos, const Board& board,
           static_cast<int>(candidate.result.decode.observation.id.size());
     }
     if (CamerasSeeing(frame) == 0) continue;
-    rig_reference.push_back(static_cast<int>(i));
-    rig_candidate.push_back(at);
-    outlines.push_back(std::move(frame));
+    rig.reference.push_back(static_cast<int>(i));
+    rig.candidate.push_back(at);
+    rig.outlines.push_back(std::move(frame));
   }
-  frames->candidate_frames = static_cast<int>(outlines.size());
-  std::vector<double> diagonals;
-  for (const VideoFrames& video : frames->videos) {
-    diagonals.push_back(std::max(1.0, std::hypot(video.width, video.height)));
-  }
-  const RigFrameChoice choice =
-      ChooseRigFrames(outlines, diagonals, video_options.min_pose_change,
-                      video_options.max_frames);
-  // The outcomes of the candidates' records.
+  return rig;
+}
+
+// Stage 4: the outcome of every candidate frame that was not chosen (near
+// duplicate or not needed, with the chosen frame most like it).
+void RecordRigChoice(const RigFrameChoice& choice, const RigCandidates& rig,
+                     const Partners& partner, RigVideoFrames* frames) {
+  const size_t num_cameras = partner.size();
   const auto record_of = [&](size_t c, int rig_frame) -> VideoFrameRecord& {
-    return frames->videos[c].frames[partner[c][rig_reference[rig_frame]]];
+    return frames->videos[c].frames[partner[c][rig.reference[rig_frame]]];
   };
   const auto index_in = [&](size_t c, int rig_frame) {
-    return rig_frame >= 0 && rig_candidate[rig_frame][c] >= 0
+    return rig_frame >= 0 && rig.candidate[rig_frame][c] >= 0
                ? record_of(c, rig_frame).index
                : -1;
   };
-  for (size_t k = 0; k < outlines.size(); ++k) {
+  for (size_t k = 0; k < rig.outlines.size(); ++k) {
     const int similar = choice.duplicate_of[k] >= 0 ? choice.duplicate_of[k]
                                                     : choice.closest[k];
     if (choice.duplicate_of[k] >= 0) ++frames->near_duplicates;
     if (choice.not_needed[k]) ++frames->not_needed;
     if (similar < 0) continue;  // kept
     for (size_t c = 0; c < num_cameras; ++c) {
-      if (rig_candidate[k][c] < 0) continue;
+      if (rig.candidate[k][c] < 0) continue;
       VideoFrameRecord& r = record_of(c, static_cast<int>(k));
       r.outcome = choice.duplicate_of[k] >= 0
                       ? VideoFrameOutcome::kNearDuplicate
@@ -382,28 +405,68 @@ bool ReadRigVideos(const std::vector<std::string>& videos, const Board& board,
       r.similar_frame = index_in(c, similar);
       r.pose_change_px =
           r.similar_frame >= 0
-              ? OutlineDistance(outlines[k].outlines[c],
-                                outlines[similar].outlines[c])
+              ? OutlineDistance(rig.outlines[k].outlines[c],
+                                rig.outlines[similar].outlines[c])
               : -1;
     }
   }
-  // The chosen frames' views and names.
+}
+
+// Stage 5: the chosen frames' views (moved out of `candidates`) and names.
+void TakeChosenViews(const std::vector<int>& kept, const RigCandidates& rig,
+                     const Partners& partner,
+                     const std::vector<std::string>& videos,
+                     std::vector<std::vector<VideoFrameCandidate>>* candidates,
+                     RigVideoFrames* frames) {
+  const size_t num_cameras = partner.size();
   frames->views.assign(num_cameras, {});
   frames->frame_files.assign(num_cameras, {});
-  for (const int k : choice.kept) {
+  for (const int k : kept) {
     for (size_t c = 0; c < num_cameras; ++c) {
-      const int paired = partner[c][rig_reference[k]];
+      const int paired = partner[c][rig.reference[k]];
       frames->frame_files[c].push_back(
           paired < 0 ? std::string()
                      : VideoFrameName(videos[c],
                                       frames->videos[c].frames[paired].index));
       ImageResult view;
-      if (rig_candidate[k][c] >= 0) {
-        view = std::move(candidates[c][rig_candidate[k][c]].result);
+      if (rig.candidate[k][c] >= 0) {
+        view = std::move((*candidates)[c][rig.candidate[k][c]].result);
       }
       frames->views[c].push_back(std::move(view));
     }
   }
+}
+
+}  // namespace
+
+bool ReadRigVideos(const std::vector<std::string>& videos, const Board& board,
+                   const PipelineOptions& pipeline,
+                   const VideoFrameOptions& video_options,
+                   const RigVideoOptions& options, int num_threads,
+                   RigVideoFrames* frames, std::string* error) {
+  *frames = RigVideoFrames();
+  std::string why;
+  if (!video_options.Check(&why)) return Fail("video: " + why, error);
+  if (!options.Check(&why)) return Fail("rig_video: " + why, error);
+  if (videos.empty()) return Fail("no video", error);
+  std::vector<std::vector<VideoFrameCandidate>> candidates;
+  Partners partner;
+  if (!ExamineRigVideos(videos, board, pipeline, video_options, num_threads,
+                        frames, &candidates, error) ||
+      !PairRigVideos(options, frames, &partner, error)) {
+    return false;
+  }
+  const RigCandidates rig = CollectRigCandidates(candidates, partner, *frames);
+  frames->candidate_frames = static_cast<int>(rig.outlines.size());
+  std::vector<double> diagonals;
+  for (const VideoFrames& video : frames->videos) {
+    diagonals.push_back(std::max(1.0, std::hypot(video.width, video.height)));
+  }
+  const RigFrameChoice choice =
+      ChooseRigFrames(rig.outlines, diagonals, video_options.min_pose_change,
+                      video_options.max_frames);
+  RecordRigChoice(choice, rig, partner, frames);
+  TakeChosenViews(choice.kept, rig, partner, videos, &candidates, frames);
   return true;
 }
 

@@ -16,6 +16,7 @@
 #include "sim/rig_scenes.h"
 #include "sim/scenes.h"
 #include "target/board.h"
+#include "tests/calib/stereo_reference.h"
 
 namespace puzzlecal {
 namespace {
@@ -257,36 +258,13 @@ TEST(RigCalibrationTest, CamerasSeeingDifferentCornersMeetTheFigures) {
 
 TEST(RigCalibrationTest, SameRAndTAsOpenCvStereoCalibrate) {
   // Both cameras see the whole board in every frame: far, nearly head on.
-  RigSceneSpec scene = StereoPinholeRig();
-  scene.random_frames.count = 30;
-  scene.random_frames.min_distance_m = 1.1;
-  scene.random_frames.max_distance_m = 1.4;
-  scene.random_frames.max_off_axis_deg = 8;
-  scene.random_frames.max_roll_deg = 20;
-  scene.min_visible_corners = scene.board.NumCorners();
-  std::vector<RigCameraInput> all = RigCorrespondences(scene, kNoisePx, 11);
-  std::vector<RigCameraInput> inputs = all;
-  for (RigCameraInput& input : inputs) input.frames.clear();
-  std::vector<std::vector<cv::Point3f>> object;
-  std::vector<std::vector<cv::Point2f>> image[2];
-  for (size_t f = 0; f < all[0].frames.size(); ++f) {
-    if (all[0].frames[f].board_points.empty() ||
-        all[1].frames[f].board_points.empty()) {
-      continue;
-    }
-    ASSERT_EQ(all[0].frames[f].board_points, all[1].frames[f].board_points);
-    object.emplace_back();
-    for (const Eigen::Vector3d& p : all[0].frames[f].board_points) {
-      object.back().emplace_back(p.x(), p.y(), p.z());
-    }
-    for (int c = 0; c < 2; ++c) {
-      inputs[c].frames.push_back(all[c].frames[f]);
-      image[c].emplace_back();
-      for (const Eigen::Vector2d& p : all[c].frames[f].image_points) {
-        image[c].back().emplace_back(p.x(), p.y());
-      }
-    }
-  }
+  const RigSceneSpec scene = testing::WholeBoardStereoRig();
+  testing::SharedStereoFrames shared;
+  ASSERT_TRUE(testing::CollectSharedStereoFrames(
+      RigCorrespondences(scene, kNoisePx, 11), &shared));
+  const std::vector<RigCameraInput>& inputs = shared.inputs;
+  const auto& object = shared.object;
+  const auto& image = shared.image;
   ASSERT_GE(object.size(), 10u);
 
   // puzzlecal with OpenCV's objective: plain least squares on every corner.

@@ -13,9 +13,9 @@
 
 #include "calib/calibrate.h"
 #include "calib/rig_calibration.h"
-#include "sim/rig_scenes.h"
 #include "sim/synthetic_views.h"
 #include "tests/calib/opencv_reference.h"
+#include "tests/calib/stereo_reference.h"
 
 namespace puzzlecal {
 namespace {
@@ -78,41 +78,16 @@ TEST(SameFocalLength, TiesFyToFxAndMatchesOpenCvsFixedAspect) {
 // cv::stereoCalibrate's with CALIB_FIX_ASPECT_RATIO (each camera started
 // from calibrateCamera with the same flag) on the same corners.
 TEST(SameFocalLength, ARigTiesEachCameraAndMatchesOpenCvsStereoCalibrate) {
-  RigSceneSpec scene = StereoPinholeRig();
-  scene.random_frames.count = 30;
-  scene.random_frames.min_distance_m = 1.1;
-  scene.random_frames.max_distance_m = 1.4;
-  scene.random_frames.max_off_axis_deg = 8;
-  scene.random_frames.max_roll_deg = 20;
-  scene.min_visible_corners = scene.board.NumCorners();
+  RigSceneSpec scene = testing::WholeBoardStereoRig();
   for (RigSceneCamera& camera : scene.cameras) {
     camera.camera.params[1] = camera.camera.params[0];  // square pixels
   }
-  // The frames both cameras see whole (OpenCV needs the same points in
-  // both).
-  const std::vector<RigCameraInput> all = RigCorrespondences(scene, 0.05, 17);
-  std::vector<RigCameraInput> inputs = all;
-  for (RigCameraInput& input : inputs) input.frames.clear();
-  std::vector<std::vector<cv::Point3f>> object;
-  std::vector<std::vector<cv::Point2f>> image[2];
-  for (size_t f = 0; f < all[0].frames.size(); ++f) {
-    if (all[0].frames[f].board_points.empty() ||
-        all[1].frames[f].board_points.empty()) {
-      continue;
-    }
-    ASSERT_EQ(all[0].frames[f].board_points, all[1].frames[f].board_points);
-    object.emplace_back();
-    for (const Eigen::Vector3d& p : all[0].frames[f].board_points) {
-      object.back().emplace_back(p.x(), p.y(), p.z());
-    }
-    for (int c = 0; c < 2; ++c) {
-      inputs[c].frames.push_back(all[c].frames[f]);
-      image[c].emplace_back();
-      for (const Eigen::Vector2d& p : all[c].frames[f].image_points) {
-        image[c].back().emplace_back(p.x(), p.y());
-      }
-    }
-  }
+  testing::SharedStereoFrames shared;
+  ASSERT_TRUE(testing::CollectSharedStereoFrames(
+      RigCorrespondences(scene, 0.05, 17), &shared));
+  const std::vector<RigCameraInput>& inputs = shared.inputs;
+  const auto& object = shared.object;
+  const auto& image = shared.image;
   ASSERT_GE(object.size(), 10u);
 
   RigCalibrationOptions options;
