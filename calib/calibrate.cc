@@ -14,6 +14,7 @@
 #include "calib/marginal_covariance.h"
 #include "calib/parallel_reprojection.h"
 #include "calib/reprojection_error.h"
+#include "util/angles.h"
 #include "util/enum_names.h"
 #include "util/failure.h"
 #include "util/statistics.h"
@@ -308,7 +309,8 @@ std::vector<bool> FixedParams(const CalibrationState& s) {
     else
       fixed[k] = s.options.fix_distortion;
     const auto& named = s.options.fixed_params;
-    if (std::find(named.begin(), named.end(), s.names[k]) != named.end()) {
+    if (std::find(named.begin(), named.end(), s.names[k]) != named.end() ||
+        CameraModelParamIsStructural(s.model, k)) {
       fixed[k] = true;
     }
   }
@@ -407,6 +409,8 @@ int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
     num_residuals += view_residuals;
   }
   if (num_residuals == 0) return 0;
+  AddSplinePrior(s->model, s->params.data(), s->options.spline_prior,
+                 s->problem.get());
   ordering->AddElementToGroup(s->params.data(), 1);
   std::vector<int> fixed_indices;
   for (int k = 0; k < Model::kNumParams; ++k) {
@@ -681,7 +685,10 @@ bool CeresCovariance(CalibrationState* s, Eigen::MatrixXd* cov) {
   ceres::Covariance covariance(covariance_options);
   std::vector<std::pair<const double*, const double*>> blocks = {
       {s->params.data(), s->params.data()}};
-  Eigen::Matrix<double, kNumParams, kNumParams, Eigen::RowMajor> row_major;
+  // Heap-allocated: a splined model's block (209 x 209) is too big for
+  // the stack.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>
+      row_major(kNumParams, kNumParams);
   if (!covariance.Compute(blocks, s->problem.get()) ||
       !covariance.GetCovarianceBlock(s->params.data(), s->params.data(),
                                      row_major.data())) {
@@ -831,36 +838,81 @@ bool CheckArguments(CameraModelId model, int width, int height,
                     std::to_string(names.size()),
                 error);
   }
+  if (!options.initial_params.empty() && CameraModelIsSplined(model) &&
+      !(options.initial_params[KannalaBrandtSplinedModel::kGridRadiusIndex] >
+        0)) {
+    return Fail(std::string("calibration options: initial_params must give ") +
+                    CameraModelName(model) + " a grid_radius > 0",
+                error);
+  }
   return true;
 }
 
-// A non-central model without initial_params starts from the central
-// calibration of its far-field model (kannala-brandt for
-// kannala-brandt-noncentral) with the pupil shift at 0: `options` gets
-// initial_params and the central solve's final trust-region radius from it,
-// and `method` says so. Unchanged (and `method` empty) for central models
-// and given initial_params.
-bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
-                            CameraModelId model, int width, int height,
-                            CalibrationOptions* options, std::string* method,
-                            std::string* error) {
-  if (CameraModelIsCentral(model) || !options->initial_params.empty()) {
-    return true;
+// The model whose calibration starts one of `model` when no initial_params
+// are given: kannala-brandt for kannala-brandt-noncentral and
+// kannala-brandt-splined, kannala-brandt-noncentral for
+// kannala-brandt-splined-noncentral. The others start from
+// calib/initialization.h (`model` itself is returned).
+CameraModelId StartModel(CameraModelId model) {
+  switch (model) {
+    case CameraModelId::kPinholeRadtan:
+    case CameraModelId::kPinholeRational:
+    case CameraModelId::kKannalaBrandt:
+      return model;
+    case CameraModelId::kKannalaBrandtNoncentral:
+    case CameraModelId::kKannalaBrandtSplined:
+      return CameraModelId::kKannalaBrandt;
+    case CameraModelId::kKannalaBrandtSplinedNoncentral:
+      return CameraModelId::kKannalaBrandtNoncentral;
   }
-  Camera far;
-  far.model = model;
-  far.params.assign(CameraModelNumParams(model), 0.0);
-  far = FarFieldCamera(far);
-  const std::vector<std::string> far_names = CameraModelParamNames(far.model);
-  CalibrationOptions central = *options;
-  central.compute_covariance = false;
-  central.function_tolerance = options->far_field_start_function_tolerance;
-  central.outlier_iterations = options->far_field_start_outlier_iterations;
-  central.fixed_params.clear();
+  return model;
+}
+
+// The grid radius of a splined model over the field of the views' corners
+// as `camera` sees them: `margin` times the largest |e_x| or |e_y|, e the
+// equidistant image point of a corner's ray. 0 when no corner unprojects.
+double SplineGridRadius(const Camera& camera,
+                        const std::vector<CalibrationView>& views,
+                        double margin) {
+  double widest = 0;
+  for (const CalibrationView& view : views) {
+    for (const Eigen::Vector2d& pixel : view.image_points) {
+      if (!pixel.allFinite()) continue;
+      Eigen::Vector3d ray;
+      if (!camera.Unproject(pixel, &ray).converged) continue;
+      const double r = ray.head<2>().norm();
+      if (!(r > 0)) continue;
+      const double theta = std::atan2(r, ray.z());
+      widest = std::max(widest, theta * std::max(std::abs(ray.x()),
+                                                 std::abs(ray.y())) / r);
+    }
+  }
+  return margin * widest;
+}
+
+// A model that StartModel gives another model for, without initial_params,
+// starts from that model's calibration: `options` gets initial_params (the
+// start's parameters by name, 0 for the rest, and a splined model's grid
+// radius over the corners' field) and the start solve's final trust-region
+// radius, and `method` says so. Unchanged (and `method` empty) for the
+// other models and given initial_params.
+bool StartFromSimplerModel(const std::vector<CalibrationView>& views,
+                           CameraModelId model, int width, int height,
+                           CalibrationOptions* options, std::string* method,
+                           std::string* error) {
+  const CameraModelId start_model = StartModel(model);
+  if (start_model == model || !options->initial_params.empty()) return true;
+  const std::vector<std::string> start_names =
+      CameraModelParamNames(start_model);
+  CalibrationOptions start = *options;
+  start.compute_covariance = false;
+  start.function_tolerance = options->far_field_start_function_tolerance;
+  start.outlier_iterations = options->far_field_start_outlier_iterations;
+  start.fixed_params.clear();
   for (const std::string& name : options->fixed_params) {
-    if (std::find(far_names.begin(), far_names.end(), name) !=
-        far_names.end()) {
-      central.fixed_params.push_back(name);
+    if (std::find(start_names.begin(), start_names.end(), name) !=
+        start_names.end()) {
+      start.fixed_params.push_back(name);
     }
   }
   const size_t max_views =
@@ -873,27 +925,55 @@ bool StartFromFarFieldModel(const std::vector<CalibrationView>& views,
   }
   CalibrationResult result;
   std::string why;
-  if (!Calibrate(spread.empty() ? views : spread, far.model, width, height,
-                 central, &result, &why)) {
-    return Fail(std::string("the central ") + CameraModelName(far.model) +
+  if (!Calibrate(spread.empty() ? views : spread, start_model, width, height,
+                 start, &result, &why)) {
+    return Fail(std::string("the ") + CameraModelName(start_model) +
                     " calibration that starts " + CameraModelName(model) +
                     " failed: " + why,
                 error);
   }
-  options->initial_params = result.camera.params;
-  options->initial_params.resize(CameraModelNumParams(model), 0.0);
-  // The non-central solve continues the central one: near its minimum, where
-  // a restart at a small radius damps the first steps (deltille: 11 -> 9
-  // iterations from the central fit's final radius).
+  const std::vector<std::string> names = CameraModelParamNames(model);
+  options->initial_params.assign(names.size(), 0.0);
+  for (size_t k = 0; k < names.size(); ++k) {
+    const auto found =
+        std::find(start_names.begin(), start_names.end(), names[k]);
+    if (found != start_names.end()) {
+      options->initial_params[k] = result.camera.params[found - start_names.begin()];
+    }
+  }
+  std::string what_else;
+  if (CameraModelIsSplined(model)) {
+    const double radius = SplineGridRadius(
+        FarFieldCamera(result.camera), views, options->spline_grid_margin);
+    if (!(radius > 0)) {
+      return Fail(std::string("no corner unprojects through the ") +
+                      CameraModelName(start_model) + " calibration that "
+                      "starts " + CameraModelName(model) +
+                      ", so its spline grid has no field to cover",
+                  error);
+    }
+    options->initial_params[KannalaBrandtSplinedModel::kGridRadiusIndex] =
+        radius;
+    what_else += StringPrintf(", correction 0 on a grid over +-%.0f deg",
+                              radius / kDegree);
+  }
+  if (!CameraModelIsCentral(model) && CameraModelIsCentral(start_model)) {
+    what_else += ", pupil shift 0";
+  }
+  // The solve continues the start's: near its minimum, where a restart at
+  // a small radius damps the first steps (deltille, kannala-brandt ->
+  // kannala-brandt-noncentral: 11 -> 9 iterations from the start's final
+  // radius).
   options->initial_trust_region_radius = std::max(
       options->initial_trust_region_radius, result.trust_region_radius);
-  *method = std::string("the central ") + CameraModelName(far.model) +
-            " calibration (" +
+  *method = std::string("the ") +
+            (CameraModelIsCentral(start_model) ? "central " : "") +
+            CameraModelName(start_model) + " calibration (" +
             (spread.empty() ? std::string("all views")
                             : std::to_string(spread.size()) + " of " +
                                   std::to_string(views.size()) + " views") +
-            ", RMS " + StringPrintf("%.3f", result.rms_px) +
-            " px), pupil shift 0";
+            ", RMS " + StringPrintf("%.3f", result.rms_px) + " px)" +
+            what_else;
   return true;
 }
 
@@ -1003,6 +1083,10 @@ bool CalibrationOptions::Check(std::string* why) const {
     return Fail("max_focal_relative_stddev must be > 0", why);
   }
   if (!(max_rms_px > 0)) return Fail("max_rms_px must be > 0", why);
+  if (!(spline_grid_margin >= 1)) {
+    return Fail("spline_grid_margin must be >= 1", why);
+  }
+  if (!spline_prior.Check(why)) return false;
   return initialization.Check(why);
 }
 
@@ -1050,7 +1134,7 @@ bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
   }
   CalibrationOptions start = options;
   std::string start_method;
-  if (!StartFromFarFieldModel(views, model, width, height, &start,
+  if (!StartFromSimplerModel(views, model, width, height, &start,
                               &start_method, error)) {
     return false;
   }

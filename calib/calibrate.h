@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "calib/initialization.h"
+#include "calib/spline_prior.h"
 #include "camera/calibration_view.h"
 #include "camera/camera_models.h"
 
@@ -165,6 +166,15 @@ struct CalibrationOptions {
   // input (0: all): a start needs the intrinsics roughly, not from every
   // view. Default 32.
   int far_field_start_max_views = 32;
+
+  // The prior on a splined model's correction (calib/spline_prior.h).
+  SplinePriorOptions spline_prior;
+  // A splined model's grid covers the field the corners were seen in: its
+  // grid_radius is this factor times the largest |e_x| or |e_y| of a corner
+  // under the kannala-brandt start (e the equidistant image point), so that
+  // the outermost corners are inside the grid rather than on its edge.
+  // Unused when initial_params gives grid_radius. Default 1.05. >= 1.
+  double spline_grid_margin = 1.05;
 
   InitializationOptions initialization;
 

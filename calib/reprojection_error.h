@@ -164,6 +164,8 @@ extern template class ReprojectionCost<PinholeRadtanModel>;
 extern template class ReprojectionCost<PinholeRationalModel>;
 extern template class ReprojectionCost<KannalaBrandtModel>;
 extern template class ReprojectionCost<KannalaBrandtNoncentralModel>;
+extern template class ReprojectionCost<KannalaBrandtSplinedModel>;
+extern template class ReprojectionCost<KannalaBrandtSplinedNoncentralModel>;
 
 // The Jacobians of the reprojection error of `board_point` under `model`
 // with `intrinsics` and the pose block `pose` (angle-axis, translation):

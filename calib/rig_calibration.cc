@@ -201,6 +201,8 @@ void SolveJoint(JointState* state, const CalibrationOptions& options,
       ordering->AddElementToGroup(state->cam_from_rig(c), 1);
     }
     if (!outcome->params_in_problem[c]) continue;
+    AddSplinePrior((*state->input)[c].model, state->params(c),
+                   options.spline_prior, &problem);
     ordering->AddElementToGroup(state->params(c), 1);
     const int n = state->num_params[c];
     std::vector<int> fixed_indices;

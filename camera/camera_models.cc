@@ -68,6 +68,16 @@ double MaxMonotonicRadius(const Camera& camera) {
   });
 }
 
+bool CameraModelIsSplined(CameraModelId id) {
+  return id == CameraModelId::kKannalaBrandtSplined ||
+         id == CameraModelId::kKannalaBrandtSplinedNoncentral;
+}
+
+bool CameraModelParamIsStructural(CameraModelId id, int k) {
+  return CameraModelIsSplined(id) &&
+         k == KannalaBrandtSplinedModel::kGridRadiusIndex;
+}
+
 Camera FarFieldCamera(const Camera& camera) {
   Camera far = camera;
   far.model = DispatchCameraModel(

@@ -32,6 +32,8 @@ enum class CameraModelId {
   kPinholeRational,
   kKannalaBrandt,
   kKannalaBrandtNoncentral,
+  kKannalaBrandtSplined,
+  kKannalaBrandtSplinedNoncentral,
 };
 
 // How a model maps the field angle to the image: pinhole models through the
@@ -486,10 +488,17 @@ struct KannalaBrandtNoncentralModel {
   }
 };
 
+}  // namespace puzzlecal
+
+#include "camera/splined_model.h"  // IWYU pragma: export
+
+namespace puzzlecal {
+
 // The one list of models, in the order of CameraModelId.
 using CameraModelList =
     std::tuple<PinholeRadtanModel, PinholeRationalModel, KannalaBrandtModel,
-               KannalaBrandtNoncentralModel>;
+               KannalaBrandtNoncentralModel, KannalaBrandtSplinedModel,
+               KannalaBrandtSplinedNoncentralModel>;
 inline constexpr int kNumCameraModels = std::tuple_size_v<CameraModelList>;
 
 namespace internal {
@@ -525,6 +534,10 @@ decltype(auto) DispatchCameraModel(CameraModelId id, Fn&& fn) {
       return fn(std::tuple_element_t<2, CameraModelList>{});
     case CameraModelId::kKannalaBrandtNoncentral:
       return fn(std::tuple_element_t<3, CameraModelList>{});
+    case CameraModelId::kKannalaBrandtSplined:
+      return fn(std::tuple_element_t<4, CameraModelList>{});
+    case CameraModelId::kKannalaBrandtSplinedNoncentral:
+      return fn(std::tuple_element_t<5, CameraModelList>{});
   }
   return fn(std::tuple_element_t<0, CameraModelList>{});  // invalid ids only
 }
@@ -550,6 +563,13 @@ bool CameraModelIsPinhole(CameraModelId id);
 bool CameraModelIsFisheye(CameraModelId id);
 // False for models whose rays do not all start at the camera origin.
 bool CameraModelIsCentral(CameraModelId id);
+// True for the models with a spline correction (kannala-brandt-splined and
+// its non-central form).
+bool CameraModelIsSplined(CameraModelId id);
+// True for parameter k of a model that shapes the model and is never
+// estimated: the spline's grid_radius (set from the observed field before
+// a solve, held fixed in it).
+bool CameraModelParamIsStructural(CameraModelId id, int k);
 
 // Runtime wrappers around Model::Project / Model::Unproject. `params` must
 // hold CameraModelNumParams(id) values.

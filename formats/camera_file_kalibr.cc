@@ -48,6 +48,10 @@ bool FormatKalibr(const Camera& camera, const std::string& rostopic,
       break;
     case CameraModelId::kKannalaBrandt:
     case CameraModelId::kKannalaBrandtNoncentral:  // its far-field part
+    // Their kannala-brandt part; FormatCameraFile hands this function the
+    // best-fitting kannala-brandt instead (CameraForFormat).
+    case CameraModelId::kKannalaBrandtSplined:
+    case CameraModelId::kKannalaBrandtSplinedNoncentral:
       model = "equidistant";
       coeffs = {p[4], p[5], p[6], p[7]};
       break;

@@ -86,6 +86,9 @@ const char* RosDistortionModel(CameraModelId id) {
       return "rational_polynomial";
     case CameraModelId::kKannalaBrandt:
     case CameraModelId::kKannalaBrandtNoncentral:  // its far-field part
+    // The best-fitting kannala-brandt (CameraForFormat).
+    case CameraModelId::kKannalaBrandtSplined:
+    case CameraModelId::kKannalaBrandtSplinedNoncentral:
       return "equidistant";
   }
   return "plumb_bob";
@@ -118,10 +121,7 @@ bool CameraFormatFixedParams(CameraFileFormat format, CameraModelId model,
   }
   // equidistant; a non-central camera is written as its far-field part
   // (see DescribeCameraFileOmission).
-  if (model == CameraModelId::kKannalaBrandt ||
-      model == CameraModelId::kKannalaBrandtNoncentral) {
-    return true;
-  }
+  if (CameraModelIsFisheye(model)) return true;
   return Fail(std::string("the kalibr format cannot hold a ") +
                   CameraModelName(model) +
                   " camera (its camchain has pinhole-radtan with k3 = 0 and "
@@ -164,12 +164,31 @@ double FarFieldErrorPx(const Camera& camera, double distance_m,
   return worst;
 }
 
+Camera CameraForFormat(const Camera& camera, CameraFileFormat format,
+                       const CameraFileStats& stats, CameraFitReport* fit) {
+  CameraFitReport report;
+  if (format == CameraFileFormat::kPuzzlecal) return camera;
+  const Camera far = FarFieldCamera(camera);
+  if (!CameraModelIsSplined(far.model)) return far;
+  CameraFitOptions options;
+  // The observed field, or else the circle the spline's grid covers.
+  options.max_field_angle_deg =
+      stats.max_field_angle_deg > 0
+          ? stats.max_field_angle_deg
+          : far.params[KannalaBrandtSplinedModel::kGridRadiusIndex] * 180 /
+                M_PI;
+  const Camera fitted = FitCameraModel(far, CameraModelId::kKannalaBrandt,
+                                       options, fit != nullptr ? fit : &report);
+  return fitted;
+}
+
 CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
                                               CameraFileFormat format,
                                               const CameraFileStats& stats) {
   CameraFileOmission omission;
   if (format == CameraFileFormat::kPuzzlecal ||
-      CameraModelIsCentral(camera.model) ||
+      (CameraModelIsCentral(camera.model) &&
+       !CameraModelIsSplined(camera.model)) ||
       static_cast<int>(camera.params.size()) !=
           CameraModelNumParams(camera.model)) {
     return omission;
@@ -177,7 +196,7 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
   omission.lossy = true;
   const Camera far = FarFieldCamera(camera);
   const std::vector<std::string> names = CameraModelParamNames(camera.model);
-  char buffer[96];
+  char buffer[160];
   for (size_t k = far.params.size(); k < names.size(); ++k) {
     std::snprintf(buffer, sizeof(buffer), "%s%s = %.6g m",
                   omission.left_out.empty() ? "" : ", ", names[k].c_str(),
@@ -188,9 +207,40 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
   omission.max_field_angle_deg = stats.max_field_angle_deg;
   std::string note = std::string("the ") + CameraFileFormatName(format) +
                      " format has no " + CameraModelName(camera.model) +
-                     " model: it holds the far-field part (" +
-                     CameraModelName(far.model) +
-                     ") without the entrance pupil shift " + omission.left_out;
+                     " model: it holds ";
+  if (CameraModelIsSplined(camera.model)) {
+    CameraFitReport fit;
+    CameraForFormat(camera, format, stats, &fit);
+    omission.fitted = fit.ok;
+    omission.fit_rms_px = fit.rms_px;
+    omission.fit_max_px = fit.max_px;
+    if (fit.ok) {
+      std::snprintf(buffer, sizeof(buffer),
+                    "the best-fitting kannala-brandt, off from the splined "
+                    "far-field projection by up to %.2f px (RMS %.2f px)",
+                    fit.max_px, fit.rms_px);
+    } else {
+      std::snprintf(buffer, sizeof(buffer),
+                    "kannala-brandt's part of it without the spline (no "
+                    "kannala-brandt could be fitted: %s)",
+                    fit.error.c_str());
+    }
+    note += buffer;
+    if (omission.max_field_angle_deg > 0) {
+      std::snprintf(buffer, sizeof(buffer), " over field angles up to %.0f deg",
+                    omission.max_field_angle_deg);
+      note += buffer;
+    }
+    if (CameraModelIsCentral(camera.model)) {
+      omission.note = note;
+      return omission;
+    }
+    note += ", and";
+  } else {
+    note += std::string("the far-field part (") + CameraModelName(far.model) +
+            ")";
+  }
+  note += " without the entrance pupil shift " + omission.left_out;
   if (omission.distance_m > 0) {
     omission.max_error_px = FarFieldErrorPx(camera, omission.distance_m,
                                             omission.max_field_angle_deg);
@@ -223,8 +273,8 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
     // The far-field part in the format, and a comment that says what is
     // missing (after OpenCV's "%YAML:1.0" line, which must come first).
     std::string body;
-    if (!FormatCameraFile(FarFieldCamera(camera), stats, format, &body, error,
-                          names)) {
+    if (!FormatCameraFile(CameraForFormat(camera, format, stats), stats,
+                          format, &body, error, names)) {
       return false;
     }
     const std::string comment = "# " + omission.note + "\n";

@@ -21,6 +21,7 @@
 
 #include "calib/calibrate.h"
 #include "camera/camera_models.h"
+#include "camera/model_fit.h"
 #include "formats/yaml_fields.h"
 
 namespace puzzlecal {
@@ -109,8 +110,23 @@ struct CameraFileOmission {
   // up to max_field_angle_deg from the axis (0: all the model can image).
   double max_error_px = 0;
   double max_field_angle_deg = 0;
+  // A splined camera in a format without splines: the file holds the
+  // best-fitting kannala-brandt over the observed field; its RMS and
+  // largest far-field difference from the splined projection (pixels).
+  bool fitted = false;
+  double fit_rms_px = 0;
+  double fit_max_px = 0;
   std::string note;  // one line for the user; empty when !lossy
 };
+// The camera a file in `format` holds for `camera`: the camera itself in
+// the puzzlecal format and for central models the format has; the
+// far-field part of a non-central camera; for a splined camera the
+// kannala-brandt that fits its far-field projection best over the image
+// pixels within stats.max_field_angle_deg (when 0: within the circle its
+// spline grid covers). `fit` (optional) gets the fit's figures.
+Camera CameraForFormat(const Camera& camera, CameraFileFormat format,
+                       const CameraFileStats& stats,
+                       CameraFitReport* fit = nullptr);
 // `stats` supplies closest_board_distance_m and max_field_angle_deg.
 CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
                                               CameraFileFormat format,

@@ -301,11 +301,12 @@ bool FormatRigFiles(const RigCalibrationResult& result, CameraFileFormat format,
                     const RigFileJudgement* judgement) {
   files->clear();
   if (!CheckCameras(result, error)) return false;
-  // opencv, ros and kalibr have no non-central model: they get each
-  // camera's far-field part (the same camera for central models).
+  // opencv, ros and kalibr have no non-central and no splined model: they
+  // get each camera's far-field part, a splined one as the best-fitting
+  // kannala-brandt (the same camera for the models they have).
   RigCalibrationResult far_field = result;
   for (RigCameraResult& cam : far_field.cameras) {
-    cam.camera = FarFieldCamera(cam.camera);
+    cam.camera = CameraForFormat(cam.camera, format, CameraFileStats());
   }
   RigFileText file;
   file.path = out_path;

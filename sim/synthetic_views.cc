@@ -37,6 +37,34 @@ Camera TruthFisheye190() {
                     {495.0, 494.2, 801.7, 598.4, 0.02, -0.005, 0.001, -0.0002});
 }
 
+Camera TruthBumpyFisheye(double bump_px, double prism_px) {
+  Camera camera = TruthFisheye190();
+  camera.model = CameraModelId::kKannalaBrandtSplined;
+  constexpr double kGridRadius = 1.9;
+  constexpr double kBumpAngle = 50 * M_PI / 180, kBumpWidth = 0.3;
+  const double focal = camera.params[0];
+  camera.params.push_back(kGridRadius);
+  const double spacing = 2 * kGridRadius / (kSplineKnots - 3);
+  std::vector<double> du, dv;
+  for (int row = 0; row < kSplineKnots; ++row) {
+    for (int col = 0; col < kSplineKnots; ++col) {
+      const double x = -kGridRadius + (col - 1) * spacing;
+      const double y = -kGridRadius + (row - 1) * spacing;
+      const double rho = std::hypot(x, y);
+      const double bump =
+          bump_px / focal *
+          std::exp(-0.5 * std::pow((rho - kBumpAngle) / kBumpWidth, 2));
+      const double prism =
+          prism_px / focal * std::pow(rho / (0.5 * M_PI), 2);
+      du.push_back((rho > 0 ? bump * x / rho : 0.0) + prism);
+      dv.push_back((rho > 0 ? bump * y / rho : 0.0) - prism);
+    }
+  }
+  camera.params.insert(camera.params.end(), du.begin(), du.end());
+  camera.params.insert(camera.params.end(), dv.begin(), dv.end());
+  return camera;
+}
+
 SyntheticData MakeSyntheticData(const SyntheticScene& scene) {
   std::mt19937 rng(scene.seed);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);

@@ -68,6 +68,16 @@ Camera TruthRational();
 // the top and bottom edges, the image corners see 114 degrees off the axis.
 Camera TruthFisheye190();
 
+// TruthFisheye190 with a distortion kannala-brandt cannot follow: a radial
+// bump of `bump_px` pixels around 50 degrees from the axis (a moulded
+// asphere's ripple) and a thin-prism term (a decentred element) that moves
+// the image by up to `prism_px` pixels at 90 degrees, along +x and -y. Its
+// truth is a kannala-brandt-splined camera whose correction samples that
+// function on a grid over 1.9 rad, wider than any calibration's grid over
+// its observed field, so that the knots of a fitted spline fall elsewhere
+// and it can only approximate the truth.
+Camera TruthBumpyFisheye(double bump_px = 2.0, double prism_px = 3.0);
+
 // The scene's views: random poses (deterministic for scene.seed), the
 // visible corners projected through scene.camera, noise and outliers added.
 SyntheticData MakeSyntheticData(const SyntheticScene& scene);

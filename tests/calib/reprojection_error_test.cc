@@ -34,6 +34,14 @@ std::vector<double> ParamsOf(CameraModelId id) {
       params.push_back(0.0003);  // e2
       return params;
     }
+    case CameraModelId::kKannalaBrandtSplined:
+      return sim::TruthBumpyFisheye().params;
+    case CameraModelId::kKannalaBrandtSplinedNoncentral: {
+      std::vector<double> params = sim::TruthBumpyFisheye().params;
+      params.push_back(0.001);   // e1, metres
+      params.push_back(0.0003);  // e2
+      return params;
+    }
   }
   return {};
 }

@@ -23,8 +23,30 @@ const std::vector<double> kFisheye = {495.0, 494.2,  801.7, 598.4,
 const std::vector<double> kNoncentral = {
     495.0, 494.2, 801.7, 598.4, 0.02, -0.005, 0.001, -0.0002, 0.95e-3, 0.31e-3};
 
+// kFisheye with a spline correction of a few pixels (a smooth pattern over
+// the knots) on a grid over 1.7 rad, and with the pupil of kNoncentral.
+std::vector<double> SplinedParams(bool pupil) {
+  std::vector<double> params = kFisheye;
+  params.push_back(1.7);  // grid_radius
+  for (int c = 0; c < 2; ++c) {
+    for (int row = 0; row < kSplineKnots; ++row) {
+      for (int col = 0; col < kSplineKnots; ++col) {
+        params.push_back(0.004 * std::sin(0.9 * row + 1.3 * col + c));
+      }
+    }
+  }
+  if (pupil) params.insert(params.end(), {0.95e-3, 0.31e-3});
+  return params;
+}
+const std::vector<double> kSplined = SplinedParams(false);
+const std::vector<double> kSplinedNoncentral = SplinedParams(true);
+
 const std::vector<double>& ParamsFor(CameraModelId id) {
   switch (id) {
+    case CameraModelId::kKannalaBrandtSplined:
+      return kSplined;
+    case CameraModelId::kKannalaBrandtSplinedNoncentral:
+      return kSplinedNoncentral;
     case CameraModelId::kPinholeRadtan:
       return kRadtan;
     case CameraModelId::kPinholeRational:
@@ -140,7 +162,9 @@ TEST(CameraModelsTest, UnprojectRoundTripsOverTheWholeImage) {
   };
   for (const Case& c : {Case{CameraModelId::kPinholeRadtan, 1280, 960},
                         Case{CameraModelId::kPinholeRational, 1280, 960},
-                        Case{CameraModelId::kKannalaBrandt, 1600, 1200}}) {
+                        Case{CameraModelId::kKannalaBrandt, 1600, 1200},
+                        Case{CameraModelId::kKannalaBrandtSplined, 1600,
+                             1200}}) {
     SCOPED_TRACE(CameraModelName(c.id));
     const std::vector<double>& params = ParamsFor(c.id);
     double max_error = 0;

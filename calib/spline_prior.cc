@@ -1,0 +1,132 @@
+#include "calib/spline_prior.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "util/failure.h"
+
+namespace puzzlecal {
+namespace {
+
+constexpr int kK = kSplineKnots;
+constexpr int kSecondDifferences = 2 * kK * (kK - 2);
+constexpr int kPerComponent = kSecondDifferences + kSplineValues;
+
+// One residual: a weighted sum of control values (their indices within the
+// component's K x K values).
+struct PriorRow {
+  int count = 0;
+  int index[3] = {0, 0, 0};
+  double weight[3] = {0, 0, 0};
+};
+
+// The rows of one component, in the order of SplinePriorResidualCount.
+std::vector<PriorRow> ComponentRows(double smoothness, double zero) {
+  std::vector<PriorRow> rows;
+  rows.reserve(kPerComponent);
+  auto second_difference = [&](int a, int b, int c) {
+    PriorRow row;
+    row.count = 3;
+    row.index[0] = a;
+    row.index[1] = b;
+    row.index[2] = c;
+    row.weight[0] = smoothness;
+    row.weight[1] = -2 * smoothness;
+    row.weight[2] = smoothness;
+    rows.push_back(row);
+  };
+  for (int r = 0; r < kK; ++r) {
+    for (int c = 1; c + 1 < kK; ++c) {
+      second_difference(r * kK + c - 1, r * kK + c, r * kK + c + 1);
+    }
+  }
+  for (int c = 0; c < kK; ++c) {
+    for (int r = 1; r + 1 < kK; ++r) {
+      second_difference((r - 1) * kK + c, r * kK + c, (r + 1) * kK + c);
+    }
+  }
+  for (int i = 0; i < kSplineValues; ++i) {
+    PriorRow row;
+    row.count = 1;
+    row.index[0] = i;
+    row.weight[0] = zero;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+class SplinePriorCost : public ceres::CostFunction {
+ public:
+  SplinePriorCost(int num_params, double fx, double fy,
+                  const SplinePriorOptions& options)
+      : num_params_(num_params),
+        rows_(ComponentRows(options.smoothness_weight, options.zero_weight)),
+        scale_{fx, fy} {
+    set_num_residuals(SplinePriorResidualCount());
+    mutable_parameter_block_sizes()->push_back(num_params);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* spline =
+        parameters[0] + KannalaBrandtSplinedModel::kSplineBegin;
+    double* jacobian = jacobians != nullptr ? jacobians[0] : nullptr;
+    if (jacobian != nullptr) {
+      std::fill(jacobian, jacobian + num_residuals() * num_params_, 0.0);
+    }
+    int out = 0;
+    for (int component = 0; component < 2; ++component) {
+      const double* values = spline + component * kSplineValues;
+      const int column_begin =
+          KannalaBrandtSplinedModel::kSplineBegin + component * kSplineValues;
+      for (const PriorRow& row : rows_) {
+        double sum = 0;
+        for (int k = 0; k < row.count; ++k) {
+          const double w = scale_[component] * row.weight[k];
+          sum += w * values[row.index[k]];
+          if (jacobian != nullptr) {
+            jacobian[out * num_params_ + column_begin + row.index[k]] = w;
+          }
+        }
+        residuals[out++] = sum;
+      }
+    }
+    return true;
+  }
+
+ private:
+  const int num_params_;
+  const std::vector<PriorRow> rows_;
+  const double scale_[2];
+};
+
+}  // namespace
+
+bool SplinePriorOptions::Check(std::string* why) const {
+  if (!(smoothness_weight > 0)) {
+    return Fail("spline smoothness_weight must be > 0", why);
+  }
+  if (!(zero_weight > 0)) return Fail("spline zero_weight must be > 0", why);
+  return true;
+}
+
+int SplinePriorResidualCount() { return 2 * kPerComponent; }
+
+ceres::CostFunction* CreateSplinePriorCost(CameraModelId model, double fx,
+                                           double fy,
+                                           const SplinePriorOptions& options) {
+  return new SplinePriorCost(CameraModelNumParams(model), std::abs(fx),
+                             std::abs(fy), options);
+}
+
+void AddSplinePrior(CameraModelId model, double* intrinsics,
+                    const SplinePriorOptions& options,
+                    ceres::Problem* problem) {
+  if (!CameraModelIsSplined(model)) return;
+  problem->AddResidualBlock(
+      CreateSplinePriorCost(model, intrinsics[0], intrinsics[1], options),
+      nullptr, intrinsics);
+}
+
+}  // namespace puzzlecal

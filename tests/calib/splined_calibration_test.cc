@@ -1,0 +1,160 @@
+// The splined models in the solver: the grid covers the observed field and
+// is not estimated, the start is the kannala-brandt fit, the prior keeps
+// the unseen part of the grid bounded, and bad options are refused.
+// (tests/evidence/splined_evidence_test.cc: the lens kannala-brandt cannot
+// follow, recovered and chosen.)
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "calib/calibrate.h"
+#include "calib/spline_prior.h"
+#include "sim/synthetic_views.h"
+
+namespace puzzlecal {
+namespace {
+
+sim::SyntheticData BumpyData(unsigned seed, int num_views = 30) {
+  sim::SyntheticScene scene;
+  scene.camera = sim::TruthBumpyFisheye();
+  scene.num_views = num_views;
+  scene.noise_px = 0.1;
+  scene.max_direction_deg = 70;
+  scene.min_visible_fraction = 0.5;
+  scene.seed = seed;
+  return sim::MakeSyntheticData(scene);
+}
+
+CalibrationResult CalibrateOrDie(const sim::SyntheticData& data,
+                                 CameraModelId model, const Camera& truth) {
+  CalibrationResult result;
+  std::string error;
+  EXPECT_TRUE(Calibrate(data.views, model, truth.width, truth.height,
+                        CalibrationOptions(), &result, &error))
+      << CameraModelName(model) << ": " << error;
+  return result;
+}
+
+// The grid covers the corners' field, is held fixed by the solve (and has
+// no standard deviation), and the start is the kannala-brandt fit.
+TEST(SplinedCalibration, GridCoversTheObservedFieldAndIsNotEstimated) {
+  const sim::SyntheticData data = BumpyData(12, 16);
+  const Camera truth = sim::TruthBumpyFisheye();
+  const CalibrationResult result =
+      CalibrateOrDie(data, CameraModelId::kKannalaBrandtSplined, truth);
+  const int grid = KannalaBrandtSplinedModel::kGridRadiusIndex;
+  double widest = 0;
+  for (const auto& view : data.exact) {
+    for (const Eigen::Vector2d& pixel : view) {
+      Eigen::Vector3d ray;
+      ASSERT_TRUE(truth.Unproject(pixel, &ray).converged);
+      const double r = ray.head<2>().norm();
+      const double theta = std::atan2(r, ray.z());
+      widest = std::max(widest, theta * ray.head<2>().cwiseAbs().maxCoeff() / r);
+    }
+  }
+  // 1.05 times the widest corner, up to the kannala-brandt start's error.
+  EXPECT_NEAR(result.camera.params[grid], 1.05 * widest, 0.02 * widest);
+  EXPECT_TRUE(result.param_fixed[grid]);
+  EXPECT_EQ(result.param_stddev[grid], 0.0);
+  EXPECT_NE(result.initialization_method.find("kannala-brandt calibration"),
+            std::string::npos)
+      << result.initialization_method;
+  EXPECT_NE(result.initialization_method.find("grid over"), std::string::npos);
+}
+
+// Where no corner was seen (the grid is square, the observed field round)
+// the prior decides: every control value stays finite and small, and the
+// covariance of all 209 parameters exists.
+TEST(SplinedCalibration, UnseenCellsStayBoundedAndTheCovarianceExists) {
+  // A narrow field: board directions within 25 degrees, so that the outer
+  // ring of the grid (which covers 1.05x the widest corner) sees little.
+  sim::SyntheticScene scene;
+  scene.camera = sim::TruthBumpyFisheye();
+  scene.num_views = 20;
+  scene.noise_px = 0.1;
+  scene.max_direction_deg = 25;
+  scene.seed = 13;
+  const sim::SyntheticData data = sim::MakeSyntheticData(scene);
+  const CalibrationResult result = CalibrateOrDie(
+      data, CameraModelId::kKannalaBrandtSplined, scene.camera);
+  // Every value finite and the correction below a few pixels everywhere.
+  const double fx = result.camera.params[0];
+  for (int k = KannalaBrandtSplinedModel::kSplineBegin;
+       k < KannalaBrandtSplinedModel::kNumParams; ++k) {
+    ASSERT_TRUE(std::isfinite(result.camera.params[k]));
+    EXPECT_LT(std::abs(result.camera.params[k]) * fx, 10.0) << k;
+  }
+  ASSERT_TRUE(result.covariance_ok);
+}
+
+TEST(SplinedCalibration, OptionsAreChecked) {
+  CalibrationOptions options;
+  std::string why;
+  EXPECT_TRUE(options.Check(&why));
+  options.spline_prior.smoothness_weight = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("smoothness"), std::string::npos);
+  options = CalibrationOptions();
+  options.spline_grid_margin = 0.9;
+  EXPECT_FALSE(options.Check(&why));
+  // A given start without a grid radius is refused, by name.
+  const sim::SyntheticData data = BumpyData(14, 8);
+  const Camera truth = sim::TruthBumpyFisheye();
+  options = CalibrationOptions();
+  options.initial_params = truth.params;
+  options.initial_params[KannalaBrandtSplinedModel::kGridRadiusIndex] = 0;
+  CalibrationResult result;
+  EXPECT_FALSE(Calibrate(data.views, CameraModelId::kKannalaBrandtSplined,
+                         truth.width, truth.height, options, &result, &why));
+  EXPECT_NE(why.find("grid_radius"), std::string::npos) << why;
+}
+
+// The prior's Jacobian is its residuals' linear map: residual = J x.
+TEST(SplinePrior, ResidualsAreTheJacobianTimesTheValues) {
+  const Camera truth = sim::TruthBumpyFisheye();
+  SplinePriorOptions options;
+  std::unique_ptr<ceres::CostFunction> cost(CreateSplinePriorCost(
+      CameraModelId::kKannalaBrandtSplined, 400, 500, options));
+  const int n = static_cast<int>(truth.params.size());
+  const int m = SplinePriorResidualCount();
+  ASSERT_EQ(cost->num_residuals(), m);
+  std::vector<double> residuals(m), jacobian(static_cast<size_t>(m) * n);
+  const double* parameters[1] = {truth.params.data()};
+  double* jacobians[1] = {jacobian.data()};
+  ASSERT_TRUE(cost->Evaluate(parameters, residuals.data(), jacobians));
+  for (int r = 0; r < m; ++r) {
+    double sum = 0;
+    for (int k = 0; k < n; ++k) sum += jacobian[r * n + k] * truth.params[k];
+    EXPECT_NEAR(residuals[r], sum, 1e-12);
+    // Only the correction values' columns.
+    for (int k = 0; k < KannalaBrandtSplinedModel::kSplineBegin; ++k) {
+      EXPECT_EQ(jacobian[r * n + k], 0.0);
+    }
+  }
+  // A plane of control values has no second differences: only the pull
+  // towards zero is left.
+  std::vector<double> plane = truth.params;
+  for (int c = 0; c < 2; ++c) {
+    for (int i = 0; i < kSplineValues; ++i) {
+      plane[KannalaBrandtSplinedModel::kSplineBegin + c * kSplineValues + i] =
+          0.001 * (i % kSplineKnots) - 0.002 * (i / kSplineKnots) + c;
+    }
+  }
+  parameters[0] = plane.data();
+  ASSERT_TRUE(cost->Evaluate(parameters, residuals.data(), nullptr));
+  const int per_component = m / 2;
+  const int second_differences = 2 * kSplineKnots * (kSplineKnots - 2);
+  for (int c = 0; c < 2; ++c) {
+    for (int r = 0; r < second_differences; ++r) {
+      EXPECT_NEAR(residuals[c * per_component + r], 0.0, 1e-9);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace puzzlecal
