@@ -14,6 +14,7 @@
 #include "calib/marginal_covariance.h"
 #include "calib/parallel_reprojection.h"
 #include "calib/reprojection_error.h"
+#include "calib/splined_reprojection.h"
 #include "util/angles.h"
 #include "util/enum_names.h"
 #include "util/failure.h"
@@ -58,6 +59,9 @@ struct CalibrationState {
   std::vector<double> params;
   std::vector<Pose> poses;
   std::vector<bool> fixed;
+  // A splined model's problem: the spline cell each corner's cost was made
+  // for, in the order the costs were added (see SplinedReprojectionCost).
+  std::vector<std::array<int, 2>> spline_cells;
   // Views and correspondences in play.
   std::vector<bool> view_used;
   std::vector<std::vector<bool>> valid;   // finite input, usable at all
@@ -366,6 +370,63 @@ void ResetLoss(const CalibrationOptions& options,
   }
 }
 
+// The cost of corner i of view v, added to the problem: one intrinsics
+// block, or for a splined model its blocks around the corner's cell (which
+// `s->spline_cells` records).
+template <typename Model>
+void AddCornerCost(CalibrationState* s, size_t v, size_t i,
+                   ParallelReprojection<Model>* parallel) {
+  const CalibrationView& view = s->views[v];
+  double* pose = s->poses[v].data();
+  if constexpr (CameraModelIsSplinedModel<Model>()) {
+    const Eigen::Vector3d point_cam =
+        IsometryFromPoseBlock(pose) * view.board_points[i];
+    const std::array<int, 2> cell =
+        SplineCellOf<Model>(s->params.data(), point_cam);
+    s->spline_cells.push_back(cell);
+    auto* cost = new SplinedReprojectionCost<Model>(
+        view.board_points[i], view.image_points[i], cell);
+    s->problem->AddResidualBlock(cost, s->loss.get(),
+                                 cost->Blocks(s->params.data(), pose));
+  } else {
+    ceres::CostFunction* cost =
+        parallel != nullptr
+            ? parallel->Add(view.board_points[i], view.image_points[i], pose)
+            : ReprojectionError<Model>::Create(view.board_points[i],
+                                               view.image_points[i]);
+    s->problem->AddResidualBlock(cost, s->loss.get(), s->params.data(), pose);
+  }
+}
+
+// Holds the intrinsics `fixed` marks: per intrinsics block (IntrinsicsBlocks)
+// a manifold without them (fy tied to fx in the first block with
+// same_focal_length), or the whole block constant.
+void HoldFixedIntrinsics(CalibrationState* s, const std::vector<bool>& fixed) {
+  for (const IntrinsicsBlock& block : IntrinsicsBlocks(s->model)) {
+    double* values = s->params.data() + block.begin;
+    if (!s->problem->HasParameterBlock(values)) continue;
+    const std::vector<bool> held(fixed.begin() + block.begin,
+                                 fixed.begin() + block.begin + block.size);
+    std::vector<int> held_indices;
+    for (int k = 0; k < block.size; ++k) {
+      if (held[k]) held_indices.push_back(k);
+    }
+    if (s->options.same_focal_length && block.begin == 0) {
+      auto manifold = std::make_unique<TiedFocalManifold>(block.size, held);
+      if (manifold->TangentSize() == 0) {
+        s->problem->SetParameterBlockConstant(values);
+      } else {
+        s->problem->SetManifold(values, manifold.release());
+      }
+    } else if (static_cast<int>(held_indices.size()) == block.size) {
+      s->problem->SetParameterBlockConstant(values);
+    } else if (!held_indices.empty()) {
+      s->problem->SetManifold(
+          values, new ceres::SubsetManifold(block.size, held_indices));
+    }
+  }
+}
+
 // A Ceres problem over the current inliers, with the poses in the first
 // elimination group; `fixed[k]` holds intrinsic k. Returns the number of
 // residual blocks (0: nothing to fit, and no intrinsics block added).
@@ -376,9 +437,12 @@ int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
   // first.
   s->problem.reset();
   s->evaluation.reset();
+  s->spline_cells.clear();
   ResetLoss(s->options, &s->loss);
   ParallelReprojection<Model>* parallel = nullptr;
-  if (s->options.deterministic && s->options.num_threads > 1) {
+  // (A splined model's costs are already cheap; they are not cached.)
+  if (s->options.deterministic && s->options.num_threads > 1 &&
+      !CameraModelIsSplinedModel<Model>()) {
     parallel = new ParallelReprojection<Model>(s->params.data(),
                                                s->options.num_threads);
     s->evaluation.reset(parallel);
@@ -390,18 +454,10 @@ int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
   int num_residuals = 0;
   for (size_t v = 0; v < s->views.size(); ++v) {
     if (!s->view_used[v]) continue;
-    const CalibrationView& view = s->views[v];
     int view_residuals = 0;
-    for (size_t i = 0; i < view.board_points.size(); ++i) {
+    for (size_t i = 0; i < s->views[v].board_points.size(); ++i) {
       if (!s->inlier[v][i]) continue;
-      ceres::CostFunction* cost =
-          parallel != nullptr
-              ? parallel->Add(view.board_points[i], view.image_points[i],
-                              s->poses[v].data())
-              : ReprojectionError<Model>::Create(view.board_points[i],
-                                                 view.image_points[i]);
-      s->problem->AddResidualBlock(cost, s->loss.get(), s->params.data(),
-                                   s->poses[v].data());
+      AddCornerCost<Model>(s, v, i, parallel);
       ++view_residuals;
     }
     // Only blocks the problem holds may be named in the ordering.
@@ -409,29 +465,40 @@ int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
     num_residuals += view_residuals;
   }
   if (num_residuals == 0) return 0;
-  AddSplinePrior(s->model, s->params.data(), s->options.spline_prior,
-                 s->problem.get());
-  ordering->AddElementToGroup(s->params.data(), 1);
-  std::vector<int> fixed_indices;
-  for (int k = 0; k < Model::kNumParams; ++k) {
-    if (fixed[k]) fixed_indices.push_back(k);
-  }
-  if (s->options.same_focal_length) {
-    auto manifold =
-        std::make_unique<TiedFocalManifold>(Model::kNumParams, fixed);
-    if (manifold->TangentSize() == 0) {
-      s->problem->SetParameterBlockConstant(s->params.data());
-    } else {
-      s->problem->SetManifold(s->params.data(), manifold.release());
+  AddSplinePriorOnKnots(s->model, s->params.data(), s->options.spline_prior,
+                        s->problem.get());
+  for (const IntrinsicsBlock& block : IntrinsicsBlocks(s->model)) {
+    double* values = s->params.data() + block.begin;
+    if (s->problem->HasParameterBlock(values)) {
+      ordering->AddElementToGroup(values, 1);
     }
-  } else if (static_cast<int>(fixed_indices.size()) == Model::kNumParams) {
-    s->problem->SetParameterBlockConstant(s->params.data());
-  } else if (!fixed_indices.empty()) {
-    s->problem->SetManifold(
-        s->params.data(),
-        new ceres::SubsetManifold(Model::kNumParams, fixed_indices));
   }
+  HoldFixedIntrinsics(s, fixed);
   return num_residuals;
+}
+
+// True when a splined model's corner has moved out of the cell its cost was
+// made for (the problem is then built again; see SplinedReprojectionCost).
+template <typename Model>
+bool SplineCellsChanged(const CalibrationState& s) {
+  if constexpr (!CameraModelIsSplinedModel<Model>()) {
+    return false;
+  } else {
+    size_t next = 0;
+    for (size_t v = 0; v < s.views.size(); ++v) {
+      if (!s.view_used[v]) continue;
+      const Eigen::Isometry3d cam_from_board =
+          IsometryFromPoseBlock(s.poses[v].data());
+      for (size_t i = 0; i < s.views[v].board_points.size(); ++i) {
+        if (!s.inlier[v][i]) continue;
+        if (next >= s.spline_cells.size()) return true;
+        const std::array<int, 2> cell = SplineCellOf<Model>(
+            s.params.data(), cam_from_board * s.views[v].board_points[i]);
+        if (cell != s.spline_cells[next++]) return true;
+      }
+    }
+    return false;
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -465,12 +532,23 @@ void Solve(CalibrationState* s, const std::vector<bool>& fixed) {
     s->summary.message = "no corners left to fit";
     return;
   }
-  ceres::Solve(SolverOptions(s->options, s->trust_region_radius, ordering),
-               s->problem.get(), &s->summary);
-  s->iterations += static_cast<int>(s->summary.iterations.size());
-  if (!s->summary.iterations.empty()) {
-    s->trust_region_radius = ContinuedTrustRegionRadius(
-        s->summary.iterations.back().trust_region_radius, s->options);
+  // A splined model's corners whose cell changed get new costs: at most a
+  // few rebuilds (the cells are 25 degrees wide; the poses settle early).
+  constexpr int kMaxSplineRebuilds = 3;
+  for (int rebuild = 0;; ++rebuild) {
+    ceres::Solve(SolverOptions(s->options, s->trust_region_radius, ordering),
+                 s->problem.get(), &s->summary);
+    s->iterations += static_cast<int>(s->summary.iterations.size());
+    if (!s->summary.iterations.empty()) {
+      s->trust_region_radius = ContinuedTrustRegionRadius(
+          s->summary.iterations.back().trust_region_radius, s->options);
+    }
+    if (rebuild == kMaxSplineRebuilds || !s->summary.IsSolutionUsable() ||
+        !SplineCellsChanged<Model>(*s)) {
+      break;
+    }
+    ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    BuildProblem<Model>(s, fixed, ordering.get());
   }
   s->result->trust_region_radius = s->trust_region_radius;
 }
@@ -721,7 +799,15 @@ void ComputeCovariance(CalibrationState* s) {
     for (size_t v = 0; v < s->poses.size(); ++v) {
       if (s->view_used[v]) poses.push_back(s->poses[v].data());
     }
-    ok = MarginalCovariance(s->problem.get(), s->params.data(), poses,
+    std::vector<double*> intrinsics;
+    for (const IntrinsicsBlock& block : IntrinsicsBlocks(s->model)) {
+      double* values = s->params.data() + block.begin;
+      if (s->problem->HasParameterBlock(values) &&
+          !s->problem->IsParameterBlockConstant(values)) {
+        intrinsics.push_back(values);
+      }
+    }
+    ok = MarginalCovariance(s->problem.get(), intrinsics, poses,
                             CovarianceFixed(*s),
                             s->options.covariance_min_eigenvalue_ratio, &block);
     if (ok && s->options.same_focal_length) {
@@ -729,6 +815,9 @@ void ComputeCovariance(CalibrationState* s) {
       block.row(1) = block.row(0);
       block.col(1) = block.col(0);
     }
+  } else if (CameraModelIsSplinedModel<Model>()) {
+    // ceres::Covariance of one block only; the splined model has many.
+    ok = false;
   } else {
     ok = CeresCovariance<Model>(s, &block);
   }

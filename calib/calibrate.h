@@ -112,8 +112,9 @@ struct CalibrationOptions {
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-9;
   // The intrinsics' covariance is refused as singular when the smallest
-  // eigenvalue of their (Schur) information matrix is below this fraction of
-  // the largest. Default 1e-14. > 0.
+  // eigenvalue of their (Schur) information matrix, scaled to a unit
+  // diagonal (so that the parameters' units do not matter), is below this
+  // fraction of the largest. Default 1e-14. > 0.
   double covariance_min_eigenvalue_ratio = 1e-14;
   // Threads. With `deterministic` (the default) they evaluate the corners'
   // residuals and Jacobians ahead of a single-threaded Ceres solve, each

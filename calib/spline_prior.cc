@@ -56,37 +56,55 @@ std::vector<PriorRow> ComponentRows(double smoothness, double zero) {
   return rows;
 }
 
+// The prior over either one block holding a splined model's whole
+// intrinsics (`whole_block`) or the knots' (du, dv) blocks, one per knot in
+// row-major order.
 class SplinePriorCost : public ceres::CostFunction {
  public:
-  SplinePriorCost(int num_params, double fx, double fy,
+  SplinePriorCost(int num_params, bool whole_block, double fx, double fy,
                   const SplinePriorOptions& options)
       : num_params_(num_params),
+        whole_block_(whole_block),
         rows_(ComponentRows(options.smoothness_weight, options.zero_weight)),
         scale_{fx, fy} {
     set_num_residuals(SplinePriorResidualCount());
-    mutable_parameter_block_sizes()->push_back(num_params);
+    if (whole_block) {
+      mutable_parameter_block_sizes()->push_back(num_params);
+    } else {
+      mutable_parameter_block_sizes()->assign(kSplineValues, 2);
+    }
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    const double* spline =
-        parameters[0] + KannalaBrandtSplinedModel::kSplineBegin;
-    double* jacobian = jacobians != nullptr ? jacobians[0] : nullptr;
-    if (jacobian != nullptr) {
-      std::fill(jacobian, jacobian + num_residuals() * num_params_, 0.0);
+    constexpr int kBegin = KannalaBrandtSplinedModel::kSplineBegin;
+    // Where value `component` of knot `knot` lives: block and offset.
+    auto block_of = [&](int knot) { return whole_block_ ? 0 : knot; };
+    auto offset_of = [&](int knot, int component) {
+      return whole_block_ ? kBegin + 2 * knot + component : component;
+    };
+    const int block_width = whole_block_ ? num_params_ : 2;
+    if (jacobians != nullptr) {
+      for (int b = 0; b < static_cast<int>(parameter_block_sizes().size());
+           ++b) {
+        if (jacobians[b] != nullptr) {
+          std::fill(jacobians[b],
+                    jacobians[b] + num_residuals() * block_width, 0.0);
+        }
+      }
     }
     int out = 0;
     for (int component = 0; component < 2; ++component) {
-      const double* values = spline + component * kSplineValues;
-      const int column_begin =
-          KannalaBrandtSplinedModel::kSplineBegin + component * kSplineValues;
       for (const PriorRow& row : rows_) {
         double sum = 0;
         for (int k = 0; k < row.count; ++k) {
+          const int knot = row.index[k];
+          const int block = block_of(knot);
+          const int offset = offset_of(knot, component);
           const double w = scale_[component] * row.weight[k];
-          sum += w * values[row.index[k]];
-          if (jacobian != nullptr) {
-            jacobian[out * num_params_ + column_begin + row.index[k]] = w;
+          sum += w * parameters[block][offset];
+          if (jacobians != nullptr && jacobians[block] != nullptr) {
+            jacobians[block][out * block_width + offset] = w;
           }
         }
         residuals[out++] = sum;
@@ -97,6 +115,7 @@ class SplinePriorCost : public ceres::CostFunction {
 
  private:
   const int num_params_;
+  const bool whole_block_;
   const std::vector<PriorRow> rows_;
   const double scale_[2];
 };
@@ -115,9 +134,10 @@ int SplinePriorResidualCount() { return 2 * kPerComponent; }
 
 ceres::CostFunction* CreateSplinePriorCost(CameraModelId model, double fx,
                                            double fy,
-                                           const SplinePriorOptions& options) {
-  return new SplinePriorCost(CameraModelNumParams(model), std::abs(fx),
-                             std::abs(fy), options);
+                                           const SplinePriorOptions& options,
+                                           bool per_knot_blocks) {
+  return new SplinePriorCost(CameraModelNumParams(model), !per_knot_blocks,
+                             std::abs(fx), std::abs(fy), options);
 }
 
 void AddSplinePrior(CameraModelId model, double* intrinsics,
@@ -127,6 +147,20 @@ void AddSplinePrior(CameraModelId model, double* intrinsics,
   problem->AddResidualBlock(
       CreateSplinePriorCost(model, intrinsics[0], intrinsics[1], options),
       nullptr, intrinsics);
+}
+
+void AddSplinePriorOnKnots(CameraModelId model, double* intrinsics,
+                           const SplinePriorOptions& options,
+                           ceres::Problem* problem) {
+  if (!CameraModelIsSplined(model)) return;
+  std::vector<double*> knots(kSplineValues);
+  for (int k = 0; k < kSplineValues; ++k) {
+    knots[k] = intrinsics + KannalaBrandtSplinedModel::kSplineBegin + 2 * k;
+  }
+  problem->AddResidualBlock(
+      CreateSplinePriorCost(model, intrinsics[0], intrinsics[1], options,
+                            /*per_knot_blocks=*/true),
+      nullptr, knots);
 }
 
 }  // namespace puzzlecal

@@ -14,7 +14,8 @@
 //    that the solve has one answer and kannala-brandt's part stays the best
 //    kannala-brandt.
 // Residuals in pixels: the control values (radians of the equidistant
-// image) times fx (du) or fy (dv) at the prior's construction.
+// image) times fx (du) or fy (dv) at the prior's construction; all du rows,
+// then all dv rows.
 
 #include <ceres/cost_function.h>
 #include <ceres/problem.h>
@@ -48,15 +49,24 @@ struct SplinePriorOptions {
 int SplinePriorResidualCount();
 
 // The prior as a cost on a splined model's whole intrinsics block (only the
-// correction values' columns of its Jacobian are non-zero).
+// correction values' columns of its Jacobian are non-zero), or with
+// `per_knot_blocks` on the knots' (du, dv) blocks, one per knot in
+// row-major order (the single-camera solve's layout,
+// calib/splined_reprojection.h).
 ceres::CostFunction* CreateSplinePriorCost(CameraModelId model, double fx,
                                            double fy,
-                                           const SplinePriorOptions& options);
+                                           const SplinePriorOptions& options,
+                                           bool per_knot_blocks = false);
 
 // Adds the prior on `intrinsics` to `problem` when `model` is splined
 // (nothing otherwise), with fx fy read from `intrinsics` now.
 void AddSplinePrior(CameraModelId model, double* intrinsics,
                     const SplinePriorOptions& options, ceres::Problem* problem);
+// The same on the knots' blocks: intrinsics + kSplineBegin + 2 k, k the
+// knot (row-major), each a parameter block of 2 in `problem`.
+void AddSplinePriorOnKnots(CameraModelId model, double* intrinsics,
+                           const SplinePriorOptions& options,
+                           ceres::Problem* problem);
 
 }  // namespace puzzlecal
 

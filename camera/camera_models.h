@@ -383,45 +383,44 @@ struct KannalaBrandtNoncentralModel {
     return KannalaBrandtModel::MaxMonotonicRadius(params);
   }
 
+  // z0(theta) for the pupil terms `pupil` = (e1, e2).
   template <typename T>
-  static T PupilZ(const T* params, const T& theta) {
+  static T PupilZ(const T* pupil, const T& theta) {
     const T t2 = theta * theta;
-    return t2 * (params[kPupilBegin] + params[kPupilBegin + 1] * t2);
+    return t2 * (pupil[0] + pupil[1] * t2);
   }
 
   // d z0 / d theta.
   template <typename T>
-  static T PupilZSlope(const T* params, const T& theta) {
+  static T PupilZSlope(const T* pupil, const T& theta) {
     const T t2 = theta * theta;
-    return theta *
-           (T(2) * params[kPupilBegin] + T(4) * params[kPupilBegin + 1] * t2);
+    return theta * (T(2) * pupil[0] + T(4) * pupil[1] * t2);
   }
 
   // The angle theta of the ray that passes through a point at distance r > 0
-  // from the axis and height z: the root of h(theta) = theta -
-  // atan2(r, z - z0(theta)), by Newton steps on the plain values (see
-  // kThetaIterations) and one last step in T. For a ceres::Jet that last
-  // step, taken at the root, gives the derivative the implicit function
-  // theorem gives (d theta = -dh / h'), so the dual numbers go through one
-  // step instead of all of them. `residual` returns |h| and `slope` h' = 1 -
-  // r z0' / (r^2 + (z - z0)^2) at the end (plain values: they are only
-  // compared); slope <= 0 means the point lies inside the lens' caustic
-  // (nearer than any pupil position can be seen from), where no ray reaches
-  // it.
+  // from the axis and height z, for the pupil terms `pupil` = (e1, e2): the
+  // root of h(theta) = theta - atan2(r, z - z0(theta)), by Newton steps on
+  // the plain values (see kThetaIterations) and one last step in T. For a
+  // ceres::Jet that last step, taken at the root, gives the derivative the
+  // implicit function theorem gives (d theta = -dh / h'), so the dual
+  // numbers go through one step instead of all of them. `residual` returns
+  // |h| and `slope` h' = 1 - r z0' / (r^2 + (z - z0)^2) at the end (plain
+  // values: they are only compared); slope <= 0 means the point lies inside
+  // the lens' caustic (nearer than any pupil position can be seen from),
+  // where no ray reaches it.
   template <typename T>
-  static T SolveTheta(const T* params, const T& r, const T& z, double* residual,
+  static T SolveTheta(const T* pupil, const T& r, const T& z, double* residual,
                       double* slope) {
     using std::atan2;
-    double pupil[kNumParams] = {};  // PupilZ reads only the pupil terms
-    pupil[kPupilBegin] = internal::ScalarPart(params[kPupilBegin]);
-    pupil[kPupilBegin + 1] = internal::ScalarPart(params[kPupilBegin + 1]);
+    const double pupil_value[2] = {internal::ScalarPart(pupil[0]),
+                                   internal::ScalarPart(pupil[1])};
     const double r_value = internal::ScalarPart(r);
     const double z_value = internal::ScalarPart(z);
     double theta_value = std::atan2(r_value, z_value);
     for (int it = 0; it < kThetaIterations; ++it) {
-      const double w = z_value - PupilZ(pupil, theta_value);
+      const double w = z_value - PupilZ(pupil_value, theta_value);
       const double h = theta_value - std::atan2(r_value, w);
-      const double dh = 1.0 - r_value * PupilZSlope(pupil, theta_value) /
+      const double dh = 1.0 - r_value * PupilZSlope(pupil_value, theta_value) /
                                   (r_value * r_value + w * w);
       const double step = h / dh;
       theta_value -= step;
@@ -429,15 +428,15 @@ struct KannalaBrandtNoncentralModel {
     }
     T theta(theta_value);
     {
-      const T w = z - PupilZ(params, theta);
+      const T w = z - PupilZ(pupil, theta);
       const T h = theta - atan2(r, w);
-      const T dh = T(1) - r * PupilZSlope(params, theta) / (r * r + w * w);
+      const T dh = T(1) - r * PupilZSlope(pupil, theta) / (r * r + w * w);
       theta = theta - h / dh;
     }
     theta_value = internal::ScalarPart(theta);
-    const double w = z_value - PupilZ(pupil, theta_value);
+    const double w = z_value - PupilZ(pupil_value, theta_value);
     *residual = std::abs(theta_value - std::atan2(r_value, w));
-    *slope = 1.0 - r_value * PupilZSlope(pupil, theta_value) /
+    *slope = 1.0 - r_value * PupilZSlope(pupil_value, theta_value) /
                        (r_value * r_value + w * w);
     return theta;
   }
@@ -460,7 +459,8 @@ struct KannalaBrandtNoncentralModel {
       if (!(r2 > T(0))) return false;
       const T r = sqrt(r2);
       double residual, slope;
-      const T theta = SolveTheta(params, r, z, &residual, &slope);
+      const T theta =
+          SolveTheta(params + kPupilBegin, r, z, &residual, &slope);
       if (!(residual < 1e-9) || !(slope > 0)) return false;
       const T scale = KannalaBrandtModel::DistortTheta(params, theta) / r;
       mx = x * scale;
@@ -483,7 +483,7 @@ struct KannalaBrandtNoncentralModel {
     const double theta =
         std::atan2(std::hypot(direction[0], direction[1]), direction[2]);
     origin[0] = origin[1] = 0.0;
-    origin[2] = PupilZ(params, theta);
+    origin[2] = PupilZ(params + kPupilBegin, theta);
     return status;
   }
 };
@@ -519,6 +519,13 @@ static_assert(IdsFollowTheList(std::make_index_sequence<kNumCameraModels>()),
               "CameraModelList must list the models in CameraModelId order");
 
 }  // namespace internal
+
+// True for the splined model structs (compile-time CameraModelIsSplined).
+template <typename Model>
+constexpr bool CameraModelIsSplinedModel() {
+  return Model::kId == CameraModelId::kKannalaBrandtSplined ||
+         Model::kId == CameraModelId::kKannalaBrandtSplinedNoncentral;
+}
 
 // Calls fn(Model{}) with the model struct for `id`; the one dispatch point from
 // a runtime model id to the templates above. The switch has no default, so

@@ -40,16 +40,16 @@ inline constexpr int kSplineValues = kSplineKnots * kSplineKnots;
 
 namespace internal {
 
-// The names of the correction values: du_ROW_COL then dv_ROW_COL (row:
-// knot along y, col: knot along x), as text with static storage so that
-// kParamNames can point at it.
+// The names of the correction values, knot by knot: du_ROW_COL,
+// dv_ROW_COL (row: knot along y, col: knot along x), as text with static
+// storage so that kParamNames can point at it.
 struct SplineParamText {
   char text[2 * kSplineValues][10] = {};
   constexpr SplineParamText() {
     for (int c = 0; c < 2; ++c) {
       for (int row = 0; row < kSplineKnots; ++row) {
         for (int col = 0; col < kSplineKnots; ++col) {
-          char* s = text[c * kSplineValues + row * kSplineKnots + col];
+          char* s = text[2 * (row * kSplineKnots + col) + c];
           int n = 0;
           s[n++] = 'd';
           s[n++] = c == 0 ? 'u' : 'v';
@@ -80,29 +80,36 @@ void CubicBSplineWeights(const T& t, T* w) {
   w[3] = t3 / T(6);
 }
 
-// The cell and the local coordinate of e on a grid over [-R, R] with
-// kSplineKnots control points (clamped to the grid: constant beyond it).
+// The cell of the grid over [-R, R] (kSplineKnots control points per side)
+// that e falls in, clamped to the grid.
 template <typename T>
-int SplineCell(const T& e, const T& radius, T* t) {
-  const T s = (e + radius) * T(kSplineKnots - 3) / (T(2) * radius);
+int SplineCell(const T& e, const T& radius) {
+  const double s = ScalarPart((e + radius) * T(kSplineKnots - 3) /
+                              (T(2) * radius));
   constexpr int kLastCell = kSplineKnots - 4;
-  if (!(s > T(0))) {
-    *t = T(0);
-    return 0;
-  }
-  if (!(s < T(kLastCell + 1))) {
-    *t = T(1);
-    return kLastCell;
-  }
-  const int cell = std::min(kLastCell, static_cast<int>(ScalarPart(s)));
-  *t = s - T(cell);
-  return cell;
+  if (!(s > 0)) return 0;
+  if (!(s < kLastCell + 1)) return kLastCell;
+  return std::min(kLastCell, static_cast<int>(s));
+}
+
+// The local coordinate of e in `cell`: in [0, 1] inside it; beyond the
+// grid's first and last cell clamped to their edge (the surface keeps its
+// value there); elsewhere the cell's polynomial continues (a solve that
+// fixed the cell before e moved out of it; see calib/splined_reprojection.h).
+template <typename T>
+T SplineCellCoordinate(const T& e, const T& radius, int cell) {
+  const T s = (e + radius) * T(kSplineKnots - 3) / (T(2) * radius);
+  const T t = s - T(cell);
+  if (cell == 0 && !(t > T(0))) return T(0);
+  if (cell == kSplineKnots - 4 && !(t < T(1))) return T(1);
+  return t;
 }
 
 }  // namespace internal
 
 template <bool kPupil>
 struct KannalaBrandtSplinedModelT {
+  static constexpr bool kHasPupil = kPupil;
   static constexpr CameraFamily kFamily = CameraFamily::kFisheye;
   static constexpr bool kCentral = !kPupil;
   static constexpr CameraModelId kId =
@@ -145,77 +152,96 @@ struct KannalaBrandtSplinedModelT {
     return KannalaBrandtModel::MaxMonotonicRadius(params);
   }
 
-  // The correction (du, dv) at the equidistant point (ex, ey).
+  // The 4 x 4 control points around the cell (row, col): knot (row + a,
+  // col + b) has weight wy[a] * wx[b] at the equidistant point (ex, ey).
   template <typename T>
-  static void Correction(const T* params, const T& ex, const T& ey, T* du,
-                         T* dv) {
-    const T& radius = params[kGridRadiusIndex];
-    T tx, ty, wx[4], wy[4];
-    const int col = internal::SplineCell(ex, radius, &tx);
-    const int row = internal::SplineCell(ey, radius, &ty);
-    internal::CubicBSplineWeights(tx, wx);
-    internal::CubicBSplineWeights(ty, wy);
-    const T* u = params + kSplineBegin;
-    const T* v = u + kSplineValues;
+  static void CellWeights(const T& ex, const T& ey, const T& radius, int row,
+                          int col, T* wx, T* wy) {
+    internal::CubicBSplineWeights(
+        internal::SplineCellCoordinate(ex, radius, col), wx);
+    internal::CubicBSplineWeights(
+        internal::SplineCellCoordinate(ey, radius, row), wy);
+  }
+
+  // The correction of the cell (row, col) at (ex, ey); `knot(k)` returns
+  // the (du, dv) pair of knot k (row-major) as a pointer to two values.
+  template <typename T, typename KnotFn>
+  static void CorrectionInCell(const T& ex, const T& ey, const T& radius,
+                               int row, int col, KnotFn knot, T* du, T* dv) {
+    T wx[4], wy[4];
+    CellWeights(ex, ey, radius, row, col, wx, wy);
     *du = T(0);
     *dv = T(0);
     for (int a = 0; a < 4; ++a) {
       T row_u(0), row_v(0);
-      const int base = (row + a) * kSplineKnots + col;
       for (int b = 0; b < 4; ++b) {
-        row_u += wx[b] * u[base + b];
-        row_v += wx[b] * v[base + b];
+        const auto* value = knot((row + a) * kSplineKnots + col + b);
+        row_u += wx[b] * value[0];
+        row_v += wx[b] * value[1];
       }
       *du += wy[a] * row_u;
       *dv += wy[a] * row_v;
     }
   }
 
-  // The pupil parameters where KannalaBrandtNoncentralModel reads them
-  // (params[kPupilBegin], params[kPupilBegin + 1]).
+  // The correction (du, dv) at the equidistant point (ex, ey).
   template <typename T>
-  static const T* PupilView(const T* params) {
-    return params + (kPupilIndex - kPupilBegin);
+  static void Correction(const T* params, const T& ex, const T& ey, T* du,
+                         T* dv) {
+    const T& radius = params[kGridRadiusIndex];
+    const int col = internal::SplineCell(ex, radius);
+    const int row = internal::SplineCell(ey, radius);
+    const T* values = params + kSplineBegin;
+    CorrectionInCell(ex, ey, radius, row, col,
+                     [values](int k) { return values + 2 * k; }, du, dv);
   }
 
-  // The field angle of the ray through a point at distance r > 0 from the
-  // axis and height z; false where no ray reaches it.
+  // kannala-brandt's normalised image point (mx, my) of a camera-frame
+  // point and its equidistant point (ex, ey), the spline's argument. `params`
+  // holds at least fx..k4; `pupil` e1 e2 (the non-central form only).
+  // False where the model has no ray to the point.
   template <typename T>
-  static bool Theta(const T* params, const T& r, const T& z, T* theta) {
+  static bool KannalaBrandtPart(const T* params, const T* pupil,
+                                const T* point_cam, T* mx, T* my, T* ex,
+                                T* ey) {
     using std::atan2;
-    if constexpr (kPupil) {
-      double residual, slope;
-      *theta = KannalaBrandtNoncentralModel::SolveTheta(PupilView(params), r,
-                                                        z, &residual, &slope);
-      return residual < 1e-9 && slope > 0;
-    } else {
-      *theta = atan2(r, z);
-      return true;
-    }
-  }
-
-  template <typename T>
-  static bool Project(const T* params, const T* point_cam, T* pixel) {
     using std::sqrt;
     const T& x = point_cam[0];
     const T& y = point_cam[1];
     const T& z = point_cam[2];
     const T r2 = x * x + y * y;
-    T mx, my, ex, ey;
     if (r2 < T(1e-20) * z * z && z > T(0)) {
       // On the axis theta / r -> 1 / z for both the model and the grid.
-      mx = ex = x / z;
-      my = ey = y / z;
+      *mx = *ex = x / z;
+      *my = *ey = y / z;
+      return true;
+    }
+    if (!(r2 > T(0))) return false;
+    const T r = sqrt(r2);
+    T theta;
+    if constexpr (kPupil) {
+      double residual, slope;
+      theta = KannalaBrandtNoncentralModel::SolveTheta(pupil, r, z, &residual,
+                                                       &slope);
+      if (!(residual < 1e-9) || !(slope > 0)) return false;
     } else {
-      if (!(r2 > T(0))) return false;
-      const T r = sqrt(r2);
-      T theta;
-      if (!Theta(params, r, z, &theta)) return false;
-      const T scale = KannalaBrandtModel::DistortTheta(params, theta) / r;
-      mx = x * scale;
-      my = y * scale;
-      ex = x * (theta / r);
-      ey = y * (theta / r);
+      (void)pupil;
+      theta = atan2(r, z);
+    }
+    const T scale = KannalaBrandtModel::DistortTheta(params, theta) / r;
+    *mx = x * scale;
+    *my = y * scale;
+    *ex = x * (theta / r);
+    *ey = y * (theta / r);
+    return true;
+  }
+
+  template <typename T>
+  static bool Project(const T* params, const T* point_cam, T* pixel) {
+    T mx, my, ex, ey;
+    if (!KannalaBrandtPart(params, params + kPupilIndex, point_cam, &mx, &my,
+                           &ex, &ey)) {
+      return false;
     }
     T du, dv;
     Correction(params, ex, ey, &du, &dv);
@@ -275,7 +301,7 @@ struct KannalaBrandtSplinedModelT {
       const double theta =
           std::atan2(std::hypot(direction[0], direction[1]), direction[2]);
       origin[2] =
-          KannalaBrandtNoncentralModel::PupilZ(PupilView(params), theta);
+          KannalaBrandtNoncentralModel::PupilZ(params + kPupilIndex, theta);
     }
     return status;
   }

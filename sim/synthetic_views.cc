@@ -45,7 +45,6 @@ Camera TruthBumpyFisheye(double bump_px, double prism_px) {
   const double focal = camera.params[0];
   camera.params.push_back(kGridRadius);
   const double spacing = 2 * kGridRadius / (kSplineKnots - 3);
-  std::vector<double> du, dv;
   for (int row = 0; row < kSplineKnots; ++row) {
     for (int col = 0; col < kSplineKnots; ++col) {
       const double x = -kGridRadius + (col - 1) * spacing;
@@ -56,12 +55,10 @@ Camera TruthBumpyFisheye(double bump_px, double prism_px) {
           std::exp(-0.5 * std::pow((rho - kBumpAngle) / kBumpWidth, 2));
       const double prism =
           prism_px / focal * std::pow(rho / (0.5 * M_PI), 2);
-      du.push_back((rho > 0 ? bump * x / rho : 0.0) + prism);
-      dv.push_back((rho > 0 ? bump * y / rho : 0.0) - prism);
+      camera.params.push_back((rho > 0 ? bump * x / rho : 0.0) + prism);
+      camera.params.push_back((rho > 0 ? bump * y / rho : 0.0) - prism);
     }
   }
-  camera.params.insert(camera.params.end(), du.begin(), du.end());
-  camera.params.insert(camera.params.end(), dv.begin(), dv.end());
   return camera;
 }
 

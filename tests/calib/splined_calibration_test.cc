@@ -8,11 +8,13 @@
 
 #include <cmath>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "calib/calibrate.h"
 #include "calib/spline_prior.h"
+#include "calib/splined_reprojection.h"
 #include "sim/synthetic_views.h"
 
 namespace puzzlecal {
@@ -114,6 +116,75 @@ TEST(SplinedCalibration, OptionsAreChecked) {
   EXPECT_NE(why.find("grid_radius"), std::string::npos) << why;
 }
 
+// The split cost (kannala-brandt's part, pose, 16 knots, pupil) gives the
+// residual and Jacobians of the whole-block automatic differentiation of
+// the model's own Project, column for column, for corners in their cell.
+template <typename Model>
+void ExpectSplitCostMatchesAutoDiff(const std::vector<double>& intrinsics) {
+  constexpr int kN = Model::kNumParams;
+  ASSERT_EQ(static_cast<int>(intrinsics.size()), kN);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<double> params = intrinsics;
+  for (int trial = 0; trial < 30; ++trial) {
+    PoseBlock pose = {0.3 * uniform(rng), 0.3 * uniform(rng),
+                      0.3 * uniform(rng), 0.2 * uniform(rng),
+                      0.2 * uniform(rng), 0.3 + 0.1 * uniform(rng)};
+    const Eigen::Vector3d board(0.2 * uniform(rng), 0.2 * uniform(rng), 0);
+    const Eigen::Vector2d observed(700 + 50 * uniform(rng),
+                                   600 + 50 * uniform(rng));
+    const std::array<int, 2> cell = SplineCellOf<Model>(
+        params.data(), IsometryFromPoseBlock(pose.data()) * board);
+    SplinedReprojectionCost<Model> split(board, observed, cell);
+    std::unique_ptr<ceres::CostFunction> whole(
+        ReprojectionError<Model>::CreateAutoDiff(board, observed));
+    double whole_residual[2];
+    std::vector<double> whole_intrinsics(2 * kN), whole_pose(12);
+    const double* whole_parameters[2] = {params.data(), pose.data()};
+    double* whole_jacobians[2] = {whole_intrinsics.data(), whole_pose.data()};
+    ASSERT_TRUE(whole->Evaluate(whole_parameters, whole_residual,
+                                whole_jacobians));
+    const std::vector<double*> blocks = split.Blocks(params.data(), pose.data());
+    const auto& sizes = split.parameter_block_sizes();
+    std::vector<std::vector<double>> jacobian_storage(blocks.size());
+    std::vector<double*> jacobians(blocks.size());
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      jacobian_storage[b].assign(2 * sizes[b], 0.0);
+      jacobians[b] = jacobian_storage[b].data();
+    }
+    double residual[2];
+    ASSERT_TRUE(split.Evaluate(blocks.data(), residual, jacobians.data()));
+    for (int r = 0; r < 2; ++r) {
+      EXPECT_NEAR(residual[r], whole_residual[r], 1e-9);
+      for (int c = 0; c < 6; ++c) {
+        EXPECT_NEAR(jacobian_storage[1][r * 6 + c], whole_pose[r * 6 + c],
+                    1e-7 * std::max(1.0, std::abs(whole_pose[r * 6 + c])));
+      }
+      // Every intrinsic column: the split cost's block that holds it, or 0.
+      for (int k = 0; k < kN; ++k) {
+        double split_value = 0;
+        for (size_t b = 0; b < blocks.size(); ++b) {
+          if (b == 1) continue;
+          const int offset = static_cast<int>(blocks[b] - params.data());
+          if (k >= offset && k < offset + sizes[b]) {
+            split_value = jacobian_storage[b][r * sizes[b] + k - offset];
+          }
+        }
+        EXPECT_NEAR(split_value, whole_intrinsics[r * kN + k],
+                    1e-7 * std::max(1.0, std::abs(whole_intrinsics[r * kN + k])))
+            << "parameter " << k << " row " << r;
+      }
+    }
+  }
+}
+
+TEST(SplinedReprojectionCost, MatchesTheWholeBlockAutoDiff) {
+  std::vector<double> params = sim::TruthBumpyFisheye().params;
+  ExpectSplitCostMatchesAutoDiff<KannalaBrandtSplinedModel>(params);
+  params.insert(params.end(), {1.5e-3, 0.4e-3});
+  ExpectSplitCostMatchesAutoDiff<KannalaBrandtSplinedNoncentralModel>(params);
+}
+
 // The prior's Jacobian is its residuals' linear map: residual = J x.
 TEST(SplinePrior, ResidualsAreTheJacobianTimesTheValues) {
   const Camera truth = sim::TruthBumpyFisheye();
@@ -141,7 +212,7 @@ TEST(SplinePrior, ResidualsAreTheJacobianTimesTheValues) {
   std::vector<double> plane = truth.params;
   for (int c = 0; c < 2; ++c) {
     for (int i = 0; i < kSplineValues; ++i) {
-      plane[KannalaBrandtSplinedModel::kSplineBegin + c * kSplineValues + i] =
+      plane[KannalaBrandtSplinedModel::kSplineBegin + 2 * i + c] =
           0.001 * (i % kSplineKnots) - 0.002 * (i / kSplineKnots) + c;
     }
   }

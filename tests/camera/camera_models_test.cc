@@ -28,9 +28,9 @@ const std::vector<double> kNoncentral = {
 std::vector<double> SplinedParams(bool pupil) {
   std::vector<double> params = kFisheye;
   params.push_back(1.7);  // grid_radius
-  for (int c = 0; c < 2; ++c) {
-    for (int row = 0; row < kSplineKnots; ++row) {
-      for (int col = 0; col < kSplineKnots; ++col) {
+  for (int row = 0; row < kSplineKnots; ++row) {
+    for (int col = 0; col < kSplineKnots; ++col) {
+      for (int c = 0; c < 2; ++c) {
         params.push_back(0.004 * std::sin(0.9 * row + 1.3 * col + c));
       }
     }

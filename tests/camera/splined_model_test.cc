@@ -21,11 +21,9 @@ template <typename Fn>
 std::vector<double> SplinedParams(double radius, Fn value) {
   std::vector<double> params = {495.0, 494.2, 801.7, 598.4,
                                 0.02,  -0.005, 0.001, -0.0002, radius};
-  for (int c = 0; c < 2; ++c) {
-    for (int row = 0; row < kSplineKnots; ++row) {
-      for (int col = 0; col < kSplineKnots; ++col) {
-        params.push_back(value(c, row, col));
-      }
+  for (int row = 0; row < kSplineKnots; ++row) {
+    for (int col = 0; col < kSplineKnots; ++col) {
+      for (int c = 0; c < 2; ++c) params.push_back(value(c, row, col));
     }
   }
   return params;
@@ -117,7 +115,7 @@ TEST(SplinedModel, ZeroCorrectionIsKannalaBrandt) {
   }
 }
 
-// Names: unique, du_* then dv_*, grid_radius structural, e1 e2 last for the
+// Names: unique, du and dv knot by knot, grid_radius structural, e1 e2 last for the
 // non-central form, whose first parameters are the central one's.
 TEST(SplinedModel, ParameterLayout) {
   const std::vector<std::string> names =
@@ -126,9 +124,10 @@ TEST(SplinedModel, ParameterLayout) {
   EXPECT_EQ(std::set<std::string>(names.begin(), names.end()).size(),
             names.size());
   EXPECT_EQ(names[8], "grid_radius");
+  // Knot by knot: du, dv of knot (0, 0), then of (0, 1), ...
   EXPECT_EQ(names[9], "du_0_0");
-  EXPECT_EQ(names[9 + kSplineKnots + 2], "du_1_2");
-  EXPECT_EQ(names[9 + kSplineValues], "dv_0_0");
+  EXPECT_EQ(names[10], "dv_0_0");
+  EXPECT_EQ(names[9 + 2 * (kSplineKnots + 2)], "du_1_2");
   EXPECT_EQ(names.back(), "dv_9_9");
   EXPECT_TRUE(
       CameraModelParamIsStructural(CameraModelId::kKannalaBrandtSplined, 8));
