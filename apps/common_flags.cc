@@ -13,8 +13,9 @@ DEFINE_string(out, "",
               "missing). Files go into an existing, writable folder.");
 DEFINE_string(model, "pinhole-radtan",
               "Camera model: pinhole-radtan, pinhole-rational, "
-              "kannala-brandt, kannala-brandt-noncentral, or auto (calibrate: "
-              "chosen by held-out error).");
+              "kannala-brandt, kannala-brandt-noncentral, "
+              "kannala-brandt-splined, kannala-brandt-splined-noncentral, or "
+              "auto (calibrate: chosen by held-out error).");
 DEFINE_string(format, "puzzlecal",
               "Camera file format: puzzlecal, opencv, ros or kalibr.");
 DEFINE_string(report, "", "Folder for the calibration report (optional).");

@@ -532,23 +532,12 @@ void Solve(CalibrationState* s, const std::vector<bool>& fixed) {
     s->summary.message = "no corners left to fit";
     return;
   }
-  // A splined model's corners whose cell changed get new costs: at most a
-  // few rebuilds (the cells are 25 degrees wide; the poses settle early).
-  constexpr int kMaxSplineRebuilds = 3;
-  for (int rebuild = 0;; ++rebuild) {
-    ceres::Solve(SolverOptions(s->options, s->trust_region_radius, ordering),
-                 s->problem.get(), &s->summary);
-    s->iterations += static_cast<int>(s->summary.iterations.size());
-    if (!s->summary.iterations.empty()) {
-      s->trust_region_radius = ContinuedTrustRegionRadius(
-          s->summary.iterations.back().trust_region_radius, s->options);
-    }
-    if (rebuild == kMaxSplineRebuilds || !s->summary.IsSolutionUsable() ||
-        !SplineCellsChanged<Model>(*s)) {
-      break;
-    }
-    ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-    BuildProblem<Model>(s, fixed, ordering.get());
+  ceres::Solve(SolverOptions(s->options, s->trust_region_radius, ordering),
+               s->problem.get(), &s->summary);
+  s->iterations += static_cast<int>(s->summary.iterations.size());
+  if (!s->summary.iterations.empty()) {
+    s->trust_region_radius = ContinuedTrustRegionRadius(
+        s->summary.iterations.back().trust_region_radius, s->options);
   }
   s->result->trust_region_radius = s->trust_region_radius;
 }
@@ -673,6 +662,23 @@ void RejectOutliers(CalibrationState* s) {
     if (!SelectInliers(s, RejectionThreshold(s))) break;
     DropDepletedViews(s);
     ++s->rounds;
+    Solve<Model>(s, s->fixed);
+    ComputeResiduals(s);
+  }
+}
+
+// A splined model's corners whose ray left the cell their cost was made for
+// (the costs then continued the cell's polynomial) get new costs and the
+// problem is solved again, until every corner is in its cell: at most a few
+// times (the cells are 25 degrees wide and the poses settle early). Each
+// outlier round builds the problem afresh, so this runs once, at the end.
+template <typename Model>
+void SolveUntilSplineCellsHold(CalibrationState* s) {
+  constexpr int kMaxSplineRebuilds = 3;
+  for (int rebuild = 0; rebuild < kMaxSplineRebuilds &&
+                        s->summary.IsSolutionUsable() &&
+                        SplineCellsChanged<Model>(*s);
+       ++rebuild) {
     Solve<Model>(s, s->fixed);
     ComputeResiduals(s);
   }
@@ -894,6 +900,7 @@ bool CalibrateModel(CalibrationState* s) {
     return false;
   }
   RejectOutliers<Model>(s);
+  SolveUntilSplineCellsHold<Model>(s);
   FillResult(s);
   ComputeCovariance<Model>(s);
   s->result->solve_seconds = s->timer.Seconds();

@@ -57,8 +57,8 @@ std::vector<PriorRow> ComponentRows(double smoothness, double zero) {
 }
 
 // The prior over either one block holding a splined model's whole
-// intrinsics (`whole_block`) or the knots' (du, dv) blocks, one per knot in
-// row-major order.
+// intrinsics (`whole_block`) or the knot rows' blocks (each row's (du, dv)
+// pairs).
 class SplinePriorCost : public ceres::CostFunction {
  public:
   SplinePriorCost(int num_params, bool whole_block, double fx, double fy,
@@ -71,7 +71,7 @@ class SplinePriorCost : public ceres::CostFunction {
     if (whole_block) {
       mutable_parameter_block_sizes()->push_back(num_params);
     } else {
-      mutable_parameter_block_sizes()->assign(kSplineValues, 2);
+      mutable_parameter_block_sizes()->assign(kK, 2 * kK);
     }
   }
 
@@ -79,11 +79,12 @@ class SplinePriorCost : public ceres::CostFunction {
                 double** jacobians) const override {
     constexpr int kBegin = KannalaBrandtSplinedModel::kSplineBegin;
     // Where value `component` of knot `knot` lives: block and offset.
-    auto block_of = [&](int knot) { return whole_block_ ? 0 : knot; };
+    auto block_of = [&](int knot) { return whole_block_ ? 0 : knot / kK; };
     auto offset_of = [&](int knot, int component) {
-      return whole_block_ ? kBegin + 2 * knot + component : component;
+      return whole_block_ ? kBegin + 2 * knot + component
+                          : 2 * (knot % kK) + component;
     };
-    const int block_width = whole_block_ ? num_params_ : 2;
+    const int block_width = whole_block_ ? num_params_ : 2 * kK;
     if (jacobians != nullptr) {
       for (int b = 0; b < static_cast<int>(parameter_block_sizes().size());
            ++b) {
@@ -153,9 +154,10 @@ void AddSplinePriorOnKnots(CameraModelId model, double* intrinsics,
                            const SplinePriorOptions& options,
                            ceres::Problem* problem) {
   if (!CameraModelIsSplined(model)) return;
-  std::vector<double*> knots(kSplineValues);
-  for (int k = 0; k < kSplineValues; ++k) {
-    knots[k] = intrinsics + KannalaBrandtSplinedModel::kSplineBegin + 2 * k;
+  std::vector<double*> knots(kK);
+  for (int row = 0; row < kK; ++row) {
+    knots[row] =
+        intrinsics + KannalaBrandtSplinedModel::kSplineBegin + 2 * kK * row;
   }
   problem->AddResidualBlock(
       CreateSplinePriorCost(model, intrinsics[0], intrinsics[1], options,

@@ -50,9 +50,8 @@ int SplinePriorResidualCount();
 
 // The prior as a cost on a splined model's whole intrinsics block (only the
 // correction values' columns of its Jacobian are non-zero), or with
-// `per_knot_blocks` on the knots' (du, dv) blocks, one per knot in
-// row-major order (the single-camera solve's layout,
-// calib/splined_reprojection.h).
+// `per_knot_blocks` on the knot rows' blocks (each row's (du, dv) pairs: the
+// single-camera solve's layout, calib/splined_reprojection.h).
 ceres::CostFunction* CreateSplinePriorCost(CameraModelId model, double fx,
                                            double fy,
                                            const SplinePriorOptions& options,
@@ -62,8 +61,8 @@ ceres::CostFunction* CreateSplinePriorCost(CameraModelId model, double fx,
 // (nothing otherwise), with fx fy read from `intrinsics` now.
 void AddSplinePrior(CameraModelId model, double* intrinsics,
                     const SplinePriorOptions& options, ceres::Problem* problem);
-// The same on the knots' blocks: intrinsics + kSplineBegin + 2 k, k the
-// knot (row-major), each a parameter block of 2 in `problem`.
+// The same on the knot rows' blocks: intrinsics + kSplineBegin + 2 K row,
+// each a parameter block of 2 K values in `problem` (K = kSplineKnots).
 void AddSplinePriorOnKnots(CameraModelId model, double* intrinsics,
                            const SplinePriorOptions& options,
                            ceres::Problem* problem);

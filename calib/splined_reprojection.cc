@@ -7,8 +7,9 @@ std::vector<IntrinsicsBlock> IntrinsicsBlocks(CameraModelId model) {
   if (!CameraModelIsSplined(model)) return {{0, n}};
   using Splined = KannalaBrandtSplinedModel;
   std::vector<IntrinsicsBlock> blocks = {{0, Splined::kSplineBegin}};
-  for (int k = 0; k < kSplineValues; ++k) {
-    blocks.push_back({Splined::kSplineBegin + 2 * k, 2});
+  for (int row = 0; row < kSplineKnots; ++row) {
+    blocks.push_back({Splined::kSplineBegin + 2 * kSplineKnots * row,
+                      2 * kSplineKnots});
   }
   if (n > Splined::kPupilIndex) {
     blocks.push_back({Splined::kPupilIndex, n - Splined::kPupilIndex});

@@ -3,13 +3,16 @@
 
 // The reprojection error of one corner under a splined model
 // (camera/splined_model.h), with the intrinsics split into parameter blocks
-// so that a corner touches only the 16 knots around it: kannala-brandt's
-// part (fx fy cx cy k1..k4 grid_radius), the view's pose, the 16 knots'
-// (du, dv) blocks of the corner's cell, and (non-central form) the pupil
-// e1 e2. With one 209-value intrinsics block every corner would add a dense
-// 209 x 209 product to the reduced system and differentiate 212-wide dual
-// numbers; here it is 41 values and 14-wide dual numbers (the knots'
-// derivatives are the B-spline weights, exact and cheap). The cell is fixed
+// so that a corner touches only the 4 knot rows around it: kannala-brandt's
+// part (fx fy cx cy k1..k4 grid_radius), the view's pose, the 4 rows of
+// knots' (du, dv) values over the corner's cell, and (non-central form) the
+// pupil e1 e2. With one 209-value intrinsics block every corner would add a
+// dense 209 x 209 product to the reduced system and differentiate 212-wide
+// dual numbers; here it is 89 values in 6 or 7 blocks and 14-wide dual
+// numbers (the knots' derivatives are the B-spline weights, exact and
+// cheap). (One block per knot, 16 per corner, cost more: the solver's work
+// per pair of blocks outweighed the smaller products; deltille photos,
+// 0.55 -> see bench_lens_models.) The cell is fixed
 // when the cost is made (from the estimate then); should the corner's ray
 // leave it during the solve, the cell's polynomial continues, and the
 // solver rebuilds the problem and solves again (calib/calibrate.cc), so
@@ -31,8 +34,8 @@ namespace puzzlecal {
 
 // The parameter blocks of a model's intrinsics vector: [begin, begin + size)
 // each. One block for the models without a spline; for a splined model
-// kannala-brandt's part with the grid radius, then one (du, dv) block per
-// knot (row-major), then (non-central form) the pupil.
+// kannala-brandt's part with the grid radius, then one block per row of
+// knots (the row's (du, dv) pairs), then (non-central form) the pupil.
 struct IntrinsicsBlock {
   int begin = 0;
   int size = 0;
@@ -59,7 +62,8 @@ class SplinedReprojectionCost : public ceres::CostFunction {
   static constexpr int kBase = Model::kSplineBegin;
   static constexpr int kPupilSize = Model::kHasPupil ? 2 : 0;
   static constexpr int kFirstKnotBlock = 2;
-  static constexpr int kNumKnotBlocks = 16;
+  static constexpr int kNumKnotBlocks = 4;  // knot rows
+  static constexpr int kKnotRowSize = 2 * kSplineKnots;
   static constexpr int kPupilBlock = kFirstKnotBlock + kNumKnotBlocks;
   // Dual numbers over kannala-brandt's part, the pupil and the point.
   static constexpr int kJetWidth = kBase + kPupilSize + 3;
@@ -72,14 +76,10 @@ class SplinedReprojectionCost : public ceres::CostFunction {
     auto* sizes = mutable_parameter_block_sizes();
     sizes->push_back(kBase);
     sizes->push_back(kPoseBlockSize);
-    for (int j = 0; j < kNumKnotBlocks; ++j) sizes->push_back(2);
+    for (int j = 0; j < kNumKnotBlocks; ++j) sizes->push_back(kKnotRowSize);
     if (kPupilSize > 0) sizes->push_back(kPupilSize);
   }
 
-  // The knot (row-major index in the grid) of knot block j (0..15).
-  int KnotOfBlock(int j) const {
-    return (cell_[0] + j / 4) * kSplineKnots + cell_[1] + j % 4;
-  }
   const std::array<int, 2>& cell() const { return cell_; }
 
   // The parameter blocks of this cost within the intrinsics vector
@@ -87,7 +87,8 @@ class SplinedReprojectionCost : public ceres::CostFunction {
   std::vector<double*> Blocks(double* intrinsics, double* pose) const {
     std::vector<double*> blocks = {intrinsics, pose};
     for (int j = 0; j < kNumKnotBlocks; ++j) {
-      blocks.push_back(intrinsics + Model::kSplineBegin + 2 * KnotOfBlock(j));
+      blocks.push_back(intrinsics + Model::kSplineBegin +
+                       kKnotRowSize * (cell_[0] + j));
     }
     if (kPupilSize > 0) blocks.push_back(intrinsics + Model::kPupilIndex);
     return blocks;
@@ -164,21 +165,24 @@ class SplinedReprojectionCost : public ceres::CostFunction {
         }
       }
     }
-    // The knots: d u / d du = fx * weight, d v / d dv = fy * weight.
+    // The knots: d u / d du = fx * weight, d v / d dv = fy * weight, for the
+    // 4 x 4 knots of the cell in the 4 row blocks.
     double mx = 0, my = 0, ex = 0, ey = 0;
     const double plain_point[3] = {point[0].a, point[1].a, point[2].a};
     Model::KannalaBrandtPart(base, pupil, plain_point, &mx, &my, &ex, &ey);
     double wx[4], wy[4];
     Model::CellWeights(ex, ey, base[Model::kGridRadiusIndex], cell_[0],
                        cell_[1], wx, wy);
-    for (int j = 0; j < kNumKnotBlocks; ++j) {
-      double* jacobian = jacobians[kFirstKnotBlock + j];
+    for (int a = 0; a < kNumKnotBlocks; ++a) {
+      double* jacobian = jacobians[kFirstKnotBlock + a];
       if (jacobian == nullptr) continue;
-      const double weight = wy[j / 4] * wx[j % 4];
-      jacobian[0] = base[0] * weight;  // d u / d du
-      jacobian[1] = 0;                 // d u / d dv
-      jacobian[2] = 0;                 // d v / d du
-      jacobian[3] = base[1] * weight;  // d v / d dv
+      std::fill(jacobian, jacobian + 2 * kKnotRowSize, 0.0);
+      for (int b = 0; b < 4; ++b) {
+        const double weight = wy[a] * wx[b];
+        const int du = 2 * (cell_[1] + b);
+        jacobian[du] = base[0] * weight;                     // d u / d du
+        jacobian[kKnotRowSize + du + 1] = base[1] * weight;  // d v / d dv
+      }
     }
     return true;
   }
@@ -196,8 +200,8 @@ class SplinedReprojectionCost : public ceres::CostFunction {
     }
     const int row = cell_[0], col = cell_[1];
     auto knot = [&](int k) {
-      const int a = k / kSplineKnots - row, b = k % kSplineKnots - col;
-      return parameters[kFirstKnotBlock + 4 * a + b];
+      const int a = k / kSplineKnots - row;
+      return parameters[kFirstKnotBlock + a] + 2 * (k % kSplineKnots);
     };
     T du, dv;
     Model::CorrectionInCell(ex, ey, base[Model::kGridRadiusIndex], row, col,

@@ -383,6 +383,93 @@ const ModelCandidate* ModelSelection::Find(CameraModelId model) const {
   return nullptr;
 }
 
+// The splined form of a model (its richer shape), or the model itself.
+CameraModelId SplinedFormOf(CameraModelId model) {
+  if (model == CameraModelId::kKannalaBrandt) {
+    return CameraModelId::kKannalaBrandtSplined;
+  }
+  if (model == CameraModelId::kKannalaBrandtNoncentral) {
+    return CameraModelId::kKannalaBrandtSplinedNoncentral;
+  }
+  return model;
+}
+
+// What the folds of a selection share while candidates are fitted.
+struct SelectionRun {
+  const std::vector<CalibrationView>* views = nullptr;
+  int width = 0, height = 0;
+  const CalibrationOptions* calibration = nullptr;
+  const ModelSelectionOptions* options = nullptr;
+  std::vector<CameraModelId> models;
+  std::vector<CornerResiduals> residuals;  // per candidate
+  std::vector<double> fit_sum2;            // per candidate
+  double widest_deg = 0;
+  int usable = 0;
+};
+
+// Fits the candidates `which` (indices into run->models) on every fold; the
+// first call also counts the folds and views.
+void FitOverFolds(const std::vector<size_t>& which, bool count,
+                  SelectionRun* run, ModelSelection* selection) {
+  const ModelSelectionOptions& options = *run->options;
+  const int first_fold = options.all_folds ? 0 : options.holdout_offset;
+  const int last_fold =
+      options.all_folds ? options.holdout_every - 1 : options.holdout_offset;
+  int folds = 0;
+  for (int fold = first_fold; fold <= last_fold; ++fold) {
+    std::vector<CalibrationView> fit, holdout;
+    run->usable = SplitViews(*run->views, run->calibration->min_corners_per_view,
+                             options, fold, &fit, &holdout);
+    if (holdout.empty()) continue;
+    ++folds;
+    if (count) {
+      ++selection->folds;
+      selection->fit_views = static_cast<int>(fit.size());
+      selection->holdout_views += static_cast<int>(holdout.size());
+    }
+    for (size_t m : which) {
+      ModelCandidate& total = selection->candidates[m];
+      if (!total.ok) continue;
+      CornerResiduals fold_residuals;
+      const ModelCandidate c = FitCandidate(
+          run->models[m], fit, holdout, run->width, run->height,
+          *run->calibration, options, &run->widest_deg, &fold_residuals);
+      total.seconds += c.seconds;
+      total.holdout_views += c.holdout_views;
+      if (!c.ok) {
+        total.ok = false;
+        total.error = folds > 1 || options.all_folds
+                          ? StringPrintf("fold %d: ", fold + 1) + c.error
+                          : c.error;
+        if (c.error.rfind("skipped", 0) == 0) total.error = c.error;
+        continue;
+      }
+      run->fit_sum2[m] += c.fit_rms_px * c.fit_rms_px;
+      run->residuals[m].insert(run->residuals[m].end(), fold_residuals.begin(),
+                               fold_residuals.end());
+    }
+  }
+}
+
+// Compares the fitted candidates and chooses among them.
+void Choose(SelectionRun* run, ModelSelection* selection) {
+  for (size_t m = 0; m < run->models.size(); ++m) {
+    ModelCandidate& c = selection->candidates[m];
+    c.fit_rms_px = std::sqrt(run->fit_sum2[m] / std::max(1, selection->folds));
+    if (!c.ok) run->residuals[m].clear();
+  }
+  CompareOnTheSameCorners(run->residuals, *run->options, selection);
+  selection->widest_field_deg = run->widest_deg;
+  // Pinhole candidates do not report their field (a fisheye candidate's
+  // poses do); without a fisheye candidate the field is taken as
+  // conventional.
+  selection->pinhole_field =
+      run->widest_deg <= run->options->conventional_max_field_deg;
+  selection->chosen =
+      ChooseCandidate(selection->candidates, selection->pinhole_field,
+                      *run->options, &selection->reason);
+}
+
 bool SelectModel(const std::vector<CalibrationView>& views, int width,
                  int height, const CalibrationOptions& calibration,
                  const ModelSelectionOptions& options,
@@ -392,71 +479,60 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
   std::string why;
   if (!options.Check(&why))
     return Fail("model selection options: " + why, error);
-  const std::vector<CameraModelId> models = CandidateModels(options);
-  const int first_fold = options.all_folds ? 0 : options.holdout_offset;
-  const int last_fold =
-      options.all_folds ? options.holdout_every - 1 : options.holdout_offset;
-  double widest_deg = 0;
-  std::vector<CornerResiduals> residuals(models.size());
-  std::vector<double> fit_sum2(models.size(), 0.0);
-  for (size_t m = 0; m < models.size(); ++m) {
+  SelectionRun run;
+  run.views = &views;
+  run.width = width;
+  run.height = height;
+  run.calibration = &calibration;
+  run.options = &options;
+  run.models = CandidateModels(options);
+  run.residuals.resize(run.models.size());
+  run.fit_sum2.assign(run.models.size(), 0.0);
+  // The splined candidates refine the shape of kannala-brandt (or of its
+  // non-central form): each is fitted only when the model it refines leads
+  // after the others, and then has to beat it on the held-out views. (They
+  // cost 5 to 15 times a kannala-brandt fit; on a lens another model leads,
+  // a spline on kannala-brandt is not the way forward.)
+  std::vector<size_t> first, splined;
+  for (size_t m = 0; m < run.models.size(); ++m) {
     ModelCandidate candidate;
-    candidate.model = models[m];
-    candidate.num_params = CameraModelNumParams(models[m]);
+    candidate.model = run.models[m];
+    candidate.num_params = CameraModelNumParams(run.models[m]);
     candidate.ok = true;
     selection->candidates.push_back(candidate);
+    (CameraModelIsSplined(run.models[m]) ? splined : first).push_back(m);
   }
-  int usable = 0;
-  selection->folds = 0;
-  for (int fold = first_fold; fold <= last_fold; ++fold) {
-    std::vector<CalibrationView> fit, holdout;
-    usable = SplitViews(views, calibration.min_corners_per_view, options, fold,
-                        &fit, &holdout);
-    if (holdout.empty()) continue;
-    ++selection->folds;
-    selection->fit_views = static_cast<int>(fit.size());
-    selection->holdout_views += static_cast<int>(holdout.size());
-    for (size_t m = 0; m < models.size(); ++m) {
-      ModelCandidate& total = selection->candidates[m];
-      if (!total.ok) continue;
-      CornerResiduals fold_residuals;
-      const ModelCandidate c =
-          FitCandidate(models[m], fit, holdout, width, height, calibration,
-                       options, &widest_deg, &fold_residuals);
-      total.seconds += c.seconds;
-      total.holdout_views += c.holdout_views;
-      if (!c.ok) {
-        total.ok = false;
-        total.error = selection->folds > 1 || options.all_folds
-                          ? StringPrintf("fold %d: ", fold + 1) + c.error
-                          : c.error;
-        if (c.error.rfind("skipped", 0) == 0) total.error = c.error;
-        continue;
-      }
-      fit_sum2[m] += c.fit_rms_px * c.fit_rms_px;
-      residuals[m].insert(residuals[m].end(), fold_residuals.begin(),
-                          fold_residuals.end());
-    }
-  }
+  FitOverFolds(first, /*count=*/true, &run, selection);
   if (selection->holdout_views == 0) {
     return Fail("model selection: too few views to hold any out (" +
-                    std::to_string(usable) + ")",
+                    std::to_string(run.usable) + ")",
                 error);
   }
-  for (size_t m = 0; m < models.size(); ++m) {
+  Choose(&run, selection);
+  const CameraModelId leader =
+      selection->chosen >= 0 ? selection->candidates[selection->chosen].model
+                             : CameraModelId::kPinholeRadtan;
+  std::vector<size_t> refine;
+  for (size_t m : splined) {
+    if (first.empty() || SplinedFormOf(leader) == run.models[m]) {
+      refine.push_back(m);
+      continue;
+    }
     ModelCandidate& c = selection->candidates[m];
-    c.fit_rms_px = std::sqrt(fit_sum2[m] / std::max(1, selection->folds));
-    if (!c.ok) residuals[m].clear();
+    c.ok = false;
+    c.error = selection->chosen >= 0
+                  ? std::string("skipped: it refines ") +
+                        (run.models[m] == CameraModelId::kKannalaBrandtSplined
+                             ? "kannala-brandt"
+                             : "kannala-brandt-noncentral") +
+                        ", which does not lead (" + CameraModelName(leader) +
+                        " does)"
+                  : "skipped: no other candidate could be calibrated";
   }
-  CompareOnTheSameCorners(residuals, options, selection);
-  selection->widest_field_deg = widest_deg;
-  // Pinhole candidates do not report their field (a fisheye candidate's
-  // poses do); without a fisheye candidate the field is taken as
-  // conventional.
-  selection->pinhole_field = widest_deg <= options.conventional_max_field_deg;
-  selection->chosen =
-      ChooseCandidate(selection->candidates, selection->pinhole_field, options,
-                      &selection->reason);
+  if (!refine.empty()) {
+    FitOverFolds(refine, /*count=*/first.empty(), &run, selection);
+    Choose(&run, selection);
+  }
   if (selection->chosen < 0) {
     std::string reasons;
     for (const ModelCandidate& c : selection->candidates) {

@@ -17,6 +17,11 @@
 // chosen unless another beats it on held-out error by more than
 // min_relative_gain and by more than min_gain_z standard errors of the
 // per-view difference (noise); then the winner must be beaten in turn.
+//
+// The splined models refine kannala-brandt's shape (and its non-central
+// form's): each is fitted only when the model it refines leads after the
+// other candidates, and is then chosen only when it beats that model as
+// above. Otherwise it is listed as skipped, with the leader named.
 
 #include <string>
 #include <vector>

@@ -612,12 +612,18 @@ void SuggestModel(CameraModelId model, bool grows_with_closeness,
     return;
   }
   verdict->next_step = "calibrate with --model " + verdict->suggested_model;
-  if (verdict->suggested_model == "kannala-brandt-noncentral") {
+  if (verdict->suggested_model == "kannala-brandt-noncentral" ||
+      (verdict->suggested_model == "kannala-brandt-splined-noncentral" &&
+       grows_with_closeness)) {
     verdict->next_step +=
-        grows_with_closeness
-            ? " (a central model cannot follow a lens whose errors "
-              "change as the board comes closer)"
-            : " (the central model leaves structured residuals)";
+        " (a central model cannot follow a lens whose errors change as the "
+        "board comes closer)";
+  } else if (verdict->suggested_model == "kannala-brandt-splined" ||
+             verdict->suggested_model ==
+                 "kannala-brandt-splined-noncentral") {
+    verdict->next_step +=
+        " (kannala-brandt's polynomial leaves structured residuals; the "
+        "spline follows a shape it cannot take)";
   } else if (CameraModelIsPinhole(model) &&
              verdict->suggested_model == "kannala-brandt") {
     verdict->next_step += StringPrintf(
@@ -746,8 +752,6 @@ std::string Verdict::Line() const {
 
 std::string NextModel(CameraModelId model, bool grows_with_closeness,
                       double max_field_deg, const VerdictOptions& options) {
-  (void)grows_with_closeness;
-  const std::string name = CameraModelName(model);
   const bool conventional_field =
       max_field_deg <= options.pinhole_max_field_deg;
   if (CameraModelIsPinhole(model)) {
@@ -760,12 +764,22 @@ std::string NextModel(CameraModelId model, bool grows_with_closeness,
   // A fisheye model on a lens within the conventional field: the pinhole
   // family's richest model.
   if (conventional_field) return "pinhole-rational";
-  // The central fisheye model: what it cannot follow is a lens whose
-  // entrance pupil moves with the field angle, which shows most for close
-  // corners; the non-central variant models it. (It is also the only richer
-  // fisheye model there is for structured residuals at the rim.)
-  if (name == "kannala-brandt") return "kannala-brandt-noncentral";
-  return "";
+  // What a central fisheye model cannot follow: a lens whose entrance pupil
+  // moves with the field angle (errors that change as the board comes
+  // closer: the non-central form models it), or a projection kannala-brandt's
+  // odd polynomial cannot take (the splined form). A model that has one of
+  // the two gets the other on top.
+  switch (model) {
+    case CameraModelId::kKannalaBrandt:
+      return grows_with_closeness ? "kannala-brandt-noncentral"
+                                  : "kannala-brandt-splined";
+    case CameraModelId::kKannalaBrandtNoncentral:
+      return "kannala-brandt-splined-noncentral";
+    case CameraModelId::kKannalaBrandtSplined:
+      return grows_with_closeness ? "kannala-brandt-splined-noncentral" : "";
+    default:
+      return "";
+  }
 }
 
 Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
