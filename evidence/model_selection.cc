@@ -502,6 +502,7 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
     selection->candidates.push_back(candidate);
     (CameraModelIsSplined(run.models[m]) ? splined : first).push_back(m);
   }
+  selection->folds = 0;
   FitOverFolds(first, /*count=*/true, &run, selection);
   if (selection->holdout_views == 0) {
     return Fail("model selection: too few views to hold any out (" +
@@ -530,6 +531,7 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
                   : "skipped: no other candidate could be calibrated";
   }
   if (!refine.empty()) {
+    if (first.empty()) selection->folds = 0;
     FitOverFolds(refine, /*count=*/first.empty(), &run, selection);
     Choose(&run, selection);
   }

@@ -115,5 +115,38 @@ TEST(SplinedModelSelection, HeldOutViewsChooseTheSplineForTheBumpyLens) {
       << selection.Table();
 }
 
+// On a pinhole lens (radtan leads) the splined candidates are not fitted:
+// the table lists them as skipped and names the leader.
+TEST(SplinedModelSelection, SkippedWhenTheModelTheyRefineDoesNotLead) {
+  sim::SyntheticScene scene;
+  scene.camera = sim::TruthRadtan();
+  scene.num_views = 16;
+  scene.noise_px = 0.2;
+  scene.max_direction_deg = 40;
+  scene.min_visible_fraction = 0.5;
+  scene.seed = 16;
+  const sim::SyntheticData data = sim::MakeSyntheticData(scene);
+  ModelSelection selection;
+  std::string error;
+  ASSERT_TRUE(SelectModel(data.views, scene.camera.width, scene.camera.height,
+                          CalibrationOptions(), ModelSelectionOptions(),
+                          &selection, &error))
+      << error;
+  ASSERT_GE(selection.chosen, 0);
+  EXPECT_EQ(selection.candidates[selection.chosen].model,
+            CameraModelId::kPinholeRadtan);
+  int skipped = 0;
+  for (const ModelCandidate& c : selection.candidates) {
+    if (!CameraModelIsSplined(c.model)) continue;
+    EXPECT_FALSE(c.ok);
+    EXPECT_EQ(c.seconds, 0.0);
+    EXPECT_NE(c.error.find("pinhole-radtan does"), std::string::npos)
+        << c.error;
+    ++skipped;
+  }
+  EXPECT_EQ(skipped, 2);
+  EXPECT_NE(selection.Table().find("skipped"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace puzzlecal
