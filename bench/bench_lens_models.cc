@@ -10,7 +10,9 @@
 //  - the halves' agreement (evidence/evidence.h CrossValidate): the largest
 //    10-degree band median of the far-field difference between the two
 //    halves' calibrations, and what their uncertainty predicts there.
-// Then the model --model auto chooses among them. Prints JSON.
+// Then the model --model auto chooses among them, and why (a splined
+// model is fitted only when the model it refines leads; its held-out RMS is
+// null otherwise). Prints JSON.
 //
 // Usage: bench_lens_models IMAGES BOARD.yaml [threads]
 //   e.g. bench_lens_models ../shared/deltille/fisheye
@@ -26,6 +28,7 @@
 #include "formats/board_file.h"
 #include "formats/image_io.h"
 #include "pipeline/pipeline.h"
+#include "util/string_format.h"
 #include "util/timer.h"
 
 namespace puzzlecal {
@@ -121,19 +124,22 @@ int Run(int argc, char** argv) {
     std::printf(
         "    {\"model\": \"%s\", \"ok\": %s, \"seconds\": %.3f, "
         "\"covariance_seconds\": %.3f, \"iterations\": %d, \"rms_px\": %.4f, \"corners\": %d, "
-        "\"covariance\": %s, \"holdout_rms_px\": %.4f, "
+        "\"covariance\": %s, \"holdout_rms_px\": %s, "
         "\"halves_worst_band_median_px\": %.3f, "
         "\"halves_expected_px\": %.3f, \"halves_band_deg\": [%.0f, %.0f]%s}%s\n",
         CameraModelName(models[m]), ok ? "true" : "false", seconds,
         result.covariance_seconds, result.iterations, result.rms_px, result.num_corners_used,
         result.covariance_ok ? "true" : "false",
-        candidate != nullptr ? candidate->holdout_rms_px : 0.0,
+        candidate != nullptr
+            ? StringPrintf("%.4f", candidate->holdout_rms_px).c_str()
+            : "null",
         halves.worst_median_px, halves.expected_px, halves.band_lo_deg,
         halves.band_hi_deg,
         ok ? "" : (", \"error\": \"" + why + "\"").c_str(),
         m + 1 < models.size() ? "," : "");
   }
-  std::printf("  ],\n  \"auto_chooses\": \"%s\",\n  \"auto_seconds\": %.2f\n}\n",
+  std::printf("  ],\n  \"auto_reason\": \"%s\",\n", selection.reason.c_str());
+  std::printf("  \"auto_chooses\": \"%s\",\n  \"auto_seconds\": %.2f\n}\n",
               selected && selection.chosen >= 0
                   ? CameraModelName(selection.candidates[selection.chosen].model)
                   : "none",

@@ -21,7 +21,10 @@
 // The splined models refine kannala-brandt's shape (and its non-central
 // form's): each is fitted only when the model it refines leads after the
 // other candidates, and is then chosen only when it beats that model as
-// above. Otherwise it is listed as skipped, with the leader named.
+// above and the halves of the views (CrossValidate) agree no worse under it
+// than under that model. Otherwise it is listed as skipped, with the leader
+// named, or the model it refines is chosen with the halves' figures as the
+// reason.
 
 #include <string>
 #include <vector>
@@ -94,6 +97,10 @@ struct ModelCandidate {
   // holdout_rms_px), in held-out order: the paired comparison's samples.
   std::vector<double> holdout_view_sse;
   double seconds = 0;
+  // A splined candidate chosen over the model it refines, and that model:
+  // the largest band median of their halves' far-field difference
+  // (CrossValidate on all views), pixels; -1 when not computed.
+  double halves_worst_px = -1;
 };
 
 struct ModelSelection {
