@@ -51,8 +51,8 @@ HalvesFigures Halves(const std::vector<CalibrationView>& views,
     if (!result.view_used[v]) continue;
     for (const Eigen::Vector3d& point : views[v].board_points) {
       const Eigen::Vector3d p = result.cam_from_board[v] * point;
-      field_deg = std::max(
-          field_deg, std::atan2(p.head<2>().norm(), p.z()) * 180 / M_PI);
+      field_deg = std::max(field_deg,
+                           std::atan2(p.head<2>().norm(), p.z()) * 180 / M_PI);
     }
   }
   const CrossValidation halves =
@@ -74,7 +74,8 @@ HalvesFigures Halves(const std::vector<CalibrationView>& views,
 
 int Run(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: bench_lens_models IMAGES BOARD.yaml [threads]\n");
+    std::fprintf(stderr,
+                 "usage: bench_lens_models IMAGES BOARD.yaml [threads]\n");
     return 2;
   }
   const int threads = argc > 3 ? std::atoi(argv[3]) : 2;
@@ -123,27 +124,29 @@ int Run(int argc, char** argv) {
     }
     std::printf(
         "    {\"model\": \"%s\", \"ok\": %s, \"seconds\": %.3f, "
-        "\"covariance_seconds\": %.3f, \"iterations\": %d, \"rms_px\": %.4f, \"corners\": %d, "
+        "\"covariance_seconds\": %.3f, \"iterations\": %d, \"rms_px\": %.4f, "
+        "\"corners\": %d, "
         "\"covariance\": %s, \"holdout_rms_px\": %s, "
         "\"halves_worst_band_median_px\": %.3f, "
-        "\"halves_expected_px\": %.3f, \"halves_band_deg\": [%.0f, %.0f]%s}%s\n",
+        "\"halves_expected_px\": %.3f, \"halves_band_deg\": [%.0f, "
+        "%.0f]%s}%s\n",
         CameraModelName(models[m]), ok ? "true" : "false", seconds,
-        result.covariance_seconds, result.iterations, result.rms_px, result.num_corners_used,
-        result.covariance_ok ? "true" : "false",
+        result.covariance_seconds, result.iterations, result.rms_px,
+        result.num_corners_used, result.covariance_ok ? "true" : "false",
         candidate != nullptr
             ? StringPrintf("%.4f", candidate->holdout_rms_px).c_str()
             : "null",
         halves.worst_median_px, halves.expected_px, halves.band_lo_deg,
-        halves.band_hi_deg,
-        ok ? "" : (", \"error\": \"" + why + "\"").c_str(),
+        halves.band_hi_deg, ok ? "" : (", \"error\": \"" + why + "\"").c_str(),
         m + 1 < models.size() ? "," : "");
   }
   std::printf("  ],\n  \"auto_reason\": \"%s\",\n", selection.reason.c_str());
-  std::printf("  \"auto_chooses\": \"%s\",\n  \"auto_seconds\": %.2f\n}\n",
-              selected && selection.chosen >= 0
-                  ? CameraModelName(selection.candidates[selection.chosen].model)
-                  : "none",
-              selection_seconds);
+  std::printf(
+      "  \"auto_chooses\": \"%s\",\n  \"auto_seconds\": %.2f\n}\n",
+      selected && selection.chosen >= 0
+          ? CameraModelName(selection.candidates[selection.chosen].model)
+          : "none",
+      selection_seconds);
   return 0;
 }
 

@@ -384,8 +384,8 @@ void AddCornerCost(CalibrationState* s, size_t v, size_t i,
     const std::array<int, 2> cell =
         SplineCellOf<Model>(s->params.data(), point_cam);
     s->spline_cells.push_back(cell);
-    auto* cost = new SplinedReprojectionCost<Model>(
-        view.board_points[i], view.image_points[i], cell);
+    auto* cost = new SplinedReprojectionCost<Model>(view.board_points[i],
+                                                    view.image_points[i], cell);
     s->problem->AddResidualBlock(cost, s->loss.get(),
                                  cost->Blocks(s->params.data(), pose));
   } else {
@@ -675,9 +675,9 @@ void RejectOutliers(CalibrationState* s) {
 template <typename Model>
 void SolveUntilSplineCellsHold(CalibrationState* s) {
   constexpr int kMaxSplineRebuilds = 3;
-  for (int rebuild = 0; rebuild < kMaxSplineRebuilds &&
-                        s->summary.IsSolutionUsable() &&
-                        SplineCellsChanged<Model>(*s);
+  for (int rebuild = 0;
+       rebuild < kMaxSplineRebuilds && s->summary.IsSolutionUsable() &&
+       SplineCellsChanged<Model>(*s);
        ++rebuild) {
     Solve<Model>(s, s->fixed);
     ComputeResiduals(s);
@@ -979,8 +979,8 @@ double SplineGridRadius(const Camera& camera,
       const double r = ray.head<2>().norm();
       if (!(r > 0)) continue;
       const double theta = std::atan2(r, ray.z());
-      widest = std::max(widest, theta * std::max(std::abs(ray.x()),
-                                                 std::abs(ray.y())) / r);
+      widest = std::max(
+          widest, theta * std::max(std::abs(ray.x()), std::abs(ray.y())) / r);
     }
   }
   return margin * widest;
@@ -1034,17 +1034,20 @@ bool StartFromSimplerModel(const std::vector<CalibrationView>& views,
     const auto found =
         std::find(start_names.begin(), start_names.end(), names[k]);
     if (found != start_names.end()) {
-      options->initial_params[k] = result.camera.params[found - start_names.begin()];
+      options->initial_params[k] =
+          result.camera.params[found - start_names.begin()];
     }
   }
   std::string what_else;
   if (CameraModelIsSplined(model)) {
-    const double radius = SplineGridRadius(
-        FarFieldCamera(result.camera), views, options->spline_grid_margin);
+    const double radius = SplineGridRadius(FarFieldCamera(result.camera), views,
+                                           options->spline_grid_margin);
     if (!(radius > 0)) {
       return Fail(std::string("no corner unprojects through the ") +
-                      CameraModelName(start_model) + " calibration that "
-                      "starts " + CameraModelName(model) +
+                      CameraModelName(start_model) +
+                      " calibration that "
+                      "starts " +
+                      CameraModelName(model) +
                       ", so its spline grid has no field to cover",
                   error);
     }
@@ -1068,8 +1071,7 @@ bool StartFromSimplerModel(const std::vector<CalibrationView>& views,
             (spread.empty() ? std::string("all views")
                             : std::to_string(spread.size()) + " of " +
                                   std::to_string(views.size()) + " views") +
-            ", RMS " + StringPrintf("%.3f", result.rms_px) + " px)" +
-            what_else;
+            ", RMS " + StringPrintf("%.3f", result.rms_px) + " px)" + what_else;
   return true;
 }
 
@@ -1230,8 +1232,8 @@ bool Calibrate(const std::vector<CalibrationView>& views, CameraModelId model,
   }
   CalibrationOptions start = options;
   std::string start_method;
-  if (!StartFromSimplerModel(views, model, width, height, &start,
-                              &start_method, error)) {
+  if (!StartFromSimplerModel(views, model, width, height, &start, &start_method,
+                             error)) {
     return false;
   }
   CalibrationState state(views, model, width, height, start, result, error);

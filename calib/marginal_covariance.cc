@@ -34,7 +34,8 @@ bool SchurComplement(const ceres::CRSMatrix& jacobian, int n, int num_poses,
     for (int e = jacobian.rows[row]; e < jacobian.rows[row + 1]; ++e) {
       const int col = jacobian.cols[e];
       if (col < n) {
-        if (jacobian.values[e] != 0) j_int.emplace_back(col, jacobian.values[e]);
+        if (jacobian.values[e] != 0)
+          j_int.emplace_back(col, jacobian.values[e]);
       } else {
         pose = (col - n) / kPoseSize;
         j_pose((col - n) % kPoseSize) = jacobian.values[e];
@@ -84,8 +85,8 @@ bool InverseIfRegular(const Eigen::MatrixXd& s, double min_eigenvalue_ratio,
   if (!(values(0) > min_eigenvalue_ratio * values(n - 1))) return false;
   const Eigen::LLT<Eigen::MatrixXd> llt(scaled);
   if (llt.info() != Eigen::Success) return false;
-  *inverse = d.asDiagonal() *
-             llt.solve(Eigen::MatrixXd::Identity(n, n)) * d.asDiagonal();
+  *inverse = d.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(n, n)) *
+             d.asDiagonal();
   return true;
 }
 

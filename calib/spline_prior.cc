@@ -89,8 +89,8 @@ class SplinePriorCost : public ceres::CostFunction {
       for (int b = 0; b < static_cast<int>(parameter_block_sizes().size());
            ++b) {
         if (jacobians[b] != nullptr) {
-          std::fill(jacobians[b],
-                    jacobians[b] + num_residuals() * block_width, 0.0);
+          std::fill(jacobians[b], jacobians[b] + num_residuals() * block_width,
+                    0.0);
         }
       }
     }

@@ -8,8 +8,8 @@ std::vector<IntrinsicsBlock> IntrinsicsBlocks(CameraModelId model) {
   using Splined = KannalaBrandtSplinedModel;
   std::vector<IntrinsicsBlock> blocks = {{0, Splined::kSplineBegin}};
   for (int row = 0; row < kSplineKnots; ++row) {
-    blocks.push_back({Splined::kSplineBegin + 2 * kSplineKnots * row,
-                      2 * kSplineKnots});
+    blocks.push_back(
+        {Splined::kSplineBegin + 2 * kSplineKnots * row, 2 * kSplineKnots});
   }
   if (n > Splined::kPupilIndex) {
     blocks.push_back({Splined::kPupilIndex, n - Splined::kPupilIndex});

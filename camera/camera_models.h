@@ -459,8 +459,7 @@ struct KannalaBrandtNoncentralModel {
       if (!(r2 > T(0))) return false;
       const T r = sqrt(r2);
       double residual, slope;
-      const T theta =
-          SolveTheta(params + kPupilBegin, r, z, &residual, &slope);
+      const T theta = SolveTheta(params + kPupilBegin, r, z, &residual, &slope);
       if (!(residual < 1e-9) || !(slope > 0)) return false;
       const T scale = KannalaBrandtModel::DistortTheta(params, theta) / r;
       mx = x * scale;

@@ -28,7 +28,7 @@ struct CameraFitOptions {
 
 struct CameraFitReport {
   bool ok = false;
-  std::string error;  // why not, when !ok
+  std::string error;   // why not, when !ok
   int num_pixels = 0;  // pixels compared
   // |fit(ray) - source pixel| over the compared pixels.
   double rms_px = 0;
@@ -43,8 +43,7 @@ struct CameraFitReport {
 // names (0 for the rest). `report` says how well it fits; the returned
 // camera is the start when the fit fails.
 Camera FitCameraModel(const Camera& source, CameraModelId target,
-                      const CameraFitOptions& options,
-                      CameraFitReport* report);
+                      const CameraFitOptions& options, CameraFitReport* report);
 
 }  // namespace puzzlecal
 

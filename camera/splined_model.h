@@ -84,8 +84,8 @@ void CubicBSplineWeights(const T& t, T* w) {
 // that e falls in, clamped to the grid.
 template <typename T>
 int SplineCell(const T& e, const T& radius) {
-  const double s = ScalarPart((e + radius) * T(kSplineKnots - 3) /
-                              (T(2) * radius));
+  const double s =
+      ScalarPart((e + radius) * T(kSplineKnots - 3) / (T(2) * radius));
   constexpr int kLastCell = kSplineKnots - 4;
   if (!(s > 0)) return 0;
   if (!(s < kLastCell + 1)) return kLastCell;
@@ -192,8 +192,9 @@ struct KannalaBrandtSplinedModelT {
     const int col = internal::SplineCell(ex, radius);
     const int row = internal::SplineCell(ey, radius);
     const T* values = params + kSplineBegin;
-    CorrectionInCell(ex, ey, radius, row, col,
-                     [values](int k) { return values + 2 * k; }, du, dv);
+    CorrectionInCell(
+        ex, ey, radius, row, col, [values](int k) { return values + 2 * k; },
+        du, dv);
   }
 
   // kannala-brandt's normalised image point (mx, my) of a camera-frame

@@ -420,8 +420,9 @@ void FitOverFolds(const std::vector<size_t>& which, bool count,
   int folds = 0;
   for (int fold = first_fold; fold <= last_fold; ++fold) {
     std::vector<CalibrationView> fit, holdout;
-    run->usable = SplitViews(*run->views, run->calibration->min_corners_per_view,
-                             options, fold, &fit, &holdout);
+    run->usable =
+        SplitViews(*run->views, run->calibration->min_corners_per_view, options,
+                   fold, &fit, &holdout);
     if (holdout.empty()) continue;
     ++folds;
     if (count) {
@@ -489,12 +490,12 @@ bool WorstHalvesBandPx(const std::vector<CalibrationView>& views,
     if (!result.view_used[v]) continue;
     for (const Eigen::Vector3d& point : views[v].board_points) {
       const Eigen::Vector3d p = result.cam_from_board[v] * point;
-      field_deg = std::max(field_deg, std::atan2(p.head<2>().norm(), p.z()) /
-                                          kDegree);
+      field_deg =
+          std::max(field_deg, std::atan2(p.head<2>().norm(), p.z()) / kDegree);
     }
   }
-  const CrossValidation halves = CrossValidate(views, result, calibration,
-                                               field_deg, EvidenceOptions());
+  const CrossValidation halves =
+      CrossValidate(views, result, calibration, field_deg, EvidenceOptions());
   if (!halves.ok) return false;
   *worst = 0;
   for (const AngleBand& band : halves.difference_bands) {
@@ -537,8 +538,8 @@ void CheckSplinedChoiceOnHalves(const std::vector<CalibrationView>& views,
       "%s fits the held-out views better (%.4f against %.4f px) but its "
       "halves agree worse (largest band median %.3f px against %.3f px): "
       "the views do not determine its extra shape well enough",
-      CameraModelName(spline.model), spline.holdout_rms_px,
-      base.holdout_rms_px, spline.halves_worst_px, base.halves_worst_px);
+      CameraModelName(spline.model), spline.holdout_rms_px, base.holdout_rms_px,
+      spline.halves_worst_px, base.halves_worst_px);
   selection->chosen = leader;
 }
 
@@ -637,8 +638,9 @@ std::string ModelSelection::Table() const {
              "errors";
   }
   table << "\n";
-  table << "  model                             params  fit RMS   held-out RMS  "
-           "corners  time\n";
+  table
+      << "  model                             params  fit RMS   held-out RMS  "
+         "corners  time\n";
   for (size_t k = 0; k < candidates.size(); ++k) {
     const ModelCandidate& c = candidates[k];
     if (c.ok) {
@@ -648,11 +650,11 @@ std::string ModelSelection::Table() const {
                             c.fit_rms_px, c.holdout_rms_px, c.holdout_corners,
                             c.seconds);
     } else {
-      table << StringPrintf("  %-33s %6d  %s (%.1f s): ",
-                            CameraModelName(c.model), c.num_params,
-                            c.error.rfind("skipped", 0) == 0 ? "not fitted"
-                                                              : "failed",
-                            c.seconds)
+      table << StringPrintf(
+                   "  %-33s %6d  %s (%.1f s): ", CameraModelName(c.model),
+                   c.num_params,
+                   c.error.rfind("skipped", 0) == 0 ? "not fitted" : "failed",
+                   c.seconds)
             << c.error << "\n";
     }
   }

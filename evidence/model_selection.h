@@ -105,7 +105,7 @@ struct ModelCandidate {
 
 struct ModelSelection {
   std::vector<ModelCandidate> candidates;
-  int chosen = -1;  // index into candidates, -1 when none succeeded
+  int chosen = -1;        // index into candidates, -1 when none succeeded
   int fit_views = 0;      // per fold
   int holdout_views = 0;  // over all folds
   int folds = 1;

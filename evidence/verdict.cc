@@ -619,8 +619,7 @@ void SuggestModel(CameraModelId model, bool grows_with_closeness,
         " (a central model cannot follow a lens whose errors change as the "
         "board comes closer)";
   } else if (verdict->suggested_model == "kannala-brandt-splined" ||
-             verdict->suggested_model ==
-                 "kannala-brandt-splined-noncentral") {
+             verdict->suggested_model == "kannala-brandt-splined-noncentral") {
     verdict->next_step +=
         " (kannala-brandt's polynomial leaves structured residuals; the "
         "spline follows a shape it cannot take)";

@@ -237,8 +237,8 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
     }
     note += ", and";
   } else {
-    note += std::string("the far-field part (") + CameraModelName(far.model) +
-            ")";
+    note +=
+        std::string("the far-field part (") + CameraModelName(far.model) + ")";
   }
   note += " without the entrance pupil shift " + omission.left_out;
   if (omission.distance_m > 0) {
@@ -273,8 +273,8 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
     // The far-field part in the format, and a comment that says what is
     // missing (after OpenCV's "%YAML:1.0" line, which must come first).
     std::string body;
-    if (!FormatCameraFile(CameraForFormat(camera, format, stats), stats,
-                          format, &body, error, names)) {
+    if (!FormatCameraFile(CameraForFormat(camera, format, stats), stats, format,
+                          &body, error, names)) {
       return false;
     }
     const std::string comment = "# " + omission.note + "\n";

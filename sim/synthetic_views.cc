@@ -53,8 +53,7 @@ Camera TruthBumpyFisheye(double bump_px, double prism_px) {
       const double bump =
           bump_px / focal *
           std::exp(-0.5 * std::pow((rho - kBumpAngle) / kBumpWidth, 2));
-      const double prism =
-          prism_px / focal * std::pow(rho / (0.5 * M_PI), 2);
+      const double prism = prism_px / focal * std::pow(rho / (0.5 * M_PI), 2);
       camera.params.push_back((rho > 0 ? bump * x / rho : 0.0) + prism);
       camera.params.push_back((rho > 0 ? bump * y / rho : 0.0) - prism);
     }

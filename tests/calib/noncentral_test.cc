@@ -53,7 +53,8 @@ double BisectTheta(const double* params, double r, double z) {
   double lo = 0, hi = M_PI;
   for (int it = 0; it < 200; ++it) {
     const double mid = 0.5 * (lo + hi);
-    const double h = mid - std::atan2(r, z - Model::PupilZ(params + kPupilBegin, mid));
+    const double h =
+        mid - std::atan2(r, z - Model::PupilZ(params + kPupilBegin, mid));
     (h > 0 ? hi : lo) = mid;
   }
   return 0.5 * (lo + hi);
@@ -70,8 +71,8 @@ TEST(NoncentralTest, FixedNewtonCountConvergesCloseUpTo110Degrees) {
       const double r = distance * std::sin(deg * kDegree);
       const double z = distance * std::cos(deg * kDegree);
       double residual, slope;
-      const double theta =
-          Model::SolveTheta(params.data() + kPupilBegin, r, z, &residual, &slope);
+      const double theta = Model::SolveTheta(params.data() + kPupilBegin, r, z,
+                                             &residual, &slope);
       ASSERT_GT(slope, 0) << distance << " m, " << deg << " deg";
       EXPECT_LT(residual, 1e-13) << distance << " m, " << deg << " deg";
       worst =
@@ -85,8 +86,8 @@ TEST(NoncentralTest, FixedNewtonCountConvergesCloseUpTo110Degrees) {
     const double r = 0.02 * std::sin(deg * kDegree);
     const double z = 0.02 * std::cos(deg * kDegree);
     double residual, slope;
-    const double theta =
-        Model::SolveTheta(kParams.data() + kPupilBegin, r, z, &residual, &slope);
+    const double theta = Model::SolveTheta(kParams.data() + kPupilBegin, r, z,
+                                           &residual, &slope);
     ASSERT_GT(slope, 0) << deg << " deg";
     EXPECT_LT(residual, 1e-13) << deg << " deg";
     EXPECT_LT(std::abs(theta - BisectTheta(kParams.data(), r, z)), 1e-13);
@@ -154,9 +155,9 @@ TEST(NoncentralTest, EqualsKannalaBrandtWithoutPupilShiftAndInTheFarField) {
       (KannalaBrandtModel::DistortTheta(kParams.data(), theta + h) -
        KannalaBrandtModel::DistortTheta(kParams.data(), theta - h)) /
       (2 * h);
-  const double first_order = kParams[0] * slope *
-                             Model::PupilZ(kParams.data() + kPupilBegin, theta) *
-                             std::sin(theta);
+  const double first_order =
+      kParams[0] * slope * Model::PupilZ(kParams.data() + kPupilBegin, theta) *
+      std::sin(theta);
   double previous = 0;
   for (double distance : {1e5, 1e3, 10.0, 0.3}) {
     Eigen::Vector2d a, b;

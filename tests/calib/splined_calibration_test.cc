@@ -56,7 +56,8 @@ TEST(SplinedCalibration, GridCoversTheObservedFieldAndIsNotEstimated) {
       ASSERT_TRUE(truth.Unproject(pixel, &ray).converged);
       const double r = ray.head<2>().norm();
       const double theta = std::atan2(r, ray.z());
-      widest = std::max(widest, theta * ray.head<2>().cwiseAbs().maxCoeff() / r);
+      widest =
+          std::max(widest, theta * ray.head<2>().cwiseAbs().maxCoeff() / r);
     }
   }
   // 1.05 times the widest corner, up to the kannala-brandt start's error.
@@ -82,8 +83,8 @@ TEST(SplinedCalibration, UnseenCellsStayBoundedAndTheCovarianceExists) {
   scene.max_direction_deg = 25;
   scene.seed = 13;
   const sim::SyntheticData data = sim::MakeSyntheticData(scene);
-  const CalibrationResult result = CalibrateOrDie(
-      data, CameraModelId::kKannalaBrandtSplined, scene.camera);
+  const CalibrationResult result =
+      CalibrateOrDie(data, CameraModelId::kKannalaBrandtSplined, scene.camera);
   // Every value finite and the correction below a few pixels everywhere.
   const double fx = result.camera.params[0];
   for (int k = KannalaBrandtSplinedModel::kSplineBegin;
@@ -142,9 +143,10 @@ void ExpectSplitCostMatchesAutoDiff(const std::vector<double>& intrinsics) {
     std::vector<double> whole_intrinsics(2 * kN), whole_pose(12);
     const double* whole_parameters[2] = {params.data(), pose.data()};
     double* whole_jacobians[2] = {whole_intrinsics.data(), whole_pose.data()};
-    ASSERT_TRUE(whole->Evaluate(whole_parameters, whole_residual,
-                                whole_jacobians));
-    const std::vector<double*> blocks = split.Blocks(params.data(), pose.data());
+    ASSERT_TRUE(
+        whole->Evaluate(whole_parameters, whole_residual, whole_jacobians));
+    const std::vector<double*> blocks =
+        split.Blocks(params.data(), pose.data());
     const auto& sizes = split.parameter_block_sizes();
     std::vector<std::vector<double>> jacobian_storage(blocks.size());
     std::vector<double*> jacobians(blocks.size());
@@ -170,8 +172,9 @@ void ExpectSplitCostMatchesAutoDiff(const std::vector<double>& intrinsics) {
             split_value = jacobian_storage[b][r * sizes[b] + k - offset];
           }
         }
-        EXPECT_NEAR(split_value, whole_intrinsics[r * kN + k],
-                    1e-7 * std::max(1.0, std::abs(whole_intrinsics[r * kN + k])))
+        EXPECT_NEAR(
+            split_value, whole_intrinsics[r * kN + k],
+            1e-7 * std::max(1.0, std::abs(whole_intrinsics[r * kN + k])))
             << "parameter " << k << " row " << r;
       }
     }

@@ -160,11 +160,11 @@ TEST(CameraModelsTest, UnprojectRoundTripsOverTheWholeImage) {
     CameraModelId id;
     int width, height;
   };
-  for (const Case& c : {Case{CameraModelId::kPinholeRadtan, 1280, 960},
-                        Case{CameraModelId::kPinholeRational, 1280, 960},
-                        Case{CameraModelId::kKannalaBrandt, 1600, 1200},
-                        Case{CameraModelId::kKannalaBrandtSplined, 1600,
-                             1200}}) {
+  for (const Case& c :
+       {Case{CameraModelId::kPinholeRadtan, 1280, 960},
+        Case{CameraModelId::kPinholeRational, 1280, 960},
+        Case{CameraModelId::kKannalaBrandt, 1600, 1200},
+        Case{CameraModelId::kKannalaBrandtSplined, 1600, 1200}}) {
     SCOPED_TRACE(CameraModelName(c.id));
     const std::vector<double>& params = ParamsFor(c.id);
     double max_error = 0;

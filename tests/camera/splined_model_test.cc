@@ -19,8 +19,8 @@ using Splined = KannalaBrandtSplinedModel;
 // `value(component, row, col)`.
 template <typename Fn>
 std::vector<double> SplinedParams(double radius, Fn value) {
-  std::vector<double> params = {495.0, 494.2, 801.7, 598.4,
-                                0.02,  -0.005, 0.001, -0.0002, radius};
+  std::vector<double> params = {495.0,  494.2, 801.7,   598.4, 0.02,
+                                -0.005, 0.001, -0.0002, radius};
   for (int row = 0; row < kSplineKnots; ++row) {
     for (int col = 0; col < kSplineKnots; ++col) {
       for (int c = 0; c < 2; ++c) params.push_back(value(c, row, col));
@@ -76,8 +76,7 @@ TEST(SplinedModel, ControlValuesActLocallyAndSmoothly) {
   EXPECT_NEAR(du, 4.0 / 9.0, 1e-12);
   EXPECT_EQ(dv, 0.0);
   // Two cells away and beyond: nothing.
-  Splined::Correction(params.data(), knot_x + 2.01 * spacing, knot_y, &du,
-                      &dv);
+  Splined::Correction(params.data(), knot_x + 2.01 * spacing, knot_y, &du, &dv);
   EXPECT_EQ(du, 0.0);
   // Across a cell border the value is continuous.
   const double border = -kRadius + 4 * spacing;
@@ -103,20 +102,18 @@ TEST(SplinedModel, ZeroCorrectionIsKannalaBrandt) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   for (int i = 0; i < 100; ++i) {
-    const Eigen::Vector3d point(uniform(rng), uniform(rng),
-                                0.3 + uniform(rng));
+    const Eigen::Vector3d point(uniform(rng), uniform(rng), 0.3 + uniform(rng));
     Eigen::Vector2d splined, kb;
+    ASSERT_TRUE(ProjectPoint(CameraModelId::kKannalaBrandtSplined,
+                             params.data(), point, &splined));
     ASSERT_TRUE(
-        ProjectPoint(CameraModelId::kKannalaBrandtSplined, params.data(), point,
-                     &splined));
-    ASSERT_TRUE(ProjectPoint(CameraModelId::kKannalaBrandt, params.data(),
-                             point, &kb));
+        ProjectPoint(CameraModelId::kKannalaBrandt, params.data(), point, &kb));
     EXPECT_LT((splined - kb).norm(), 1e-12);
   }
 }
 
-// Names: unique, du and dv knot by knot, grid_radius structural, e1 e2 last for the
-// non-central form, whose first parameters are the central one's.
+// Names: unique, du and dv knot by knot, grid_radius structural, e1 e2 last for
+// the non-central form, whose first parameters are the central one's.
 TEST(SplinedModel, ParameterLayout) {
   const std::vector<std::string> names =
       CameraModelParamNames(CameraModelId::kKannalaBrandtSplined);
@@ -149,10 +146,9 @@ TEST(SplinedModel, ParameterLayout) {
 // Unproject inverts Project for rays up to 100 degrees (the correction a
 // few pixels), and the non-central form's ray passes through the point.
 TEST(SplinedModel, UnprojectInvertsProject) {
-  std::vector<double> params =
-      SplinedParams(1.75, [](int c, int row, int col) {
-        return 0.006 * std::cos(0.7 * row - 1.1 * col + 2 * c);
-      });
+  std::vector<double> params = SplinedParams(1.75, [](int c, int row, int col) {
+    return 0.006 * std::cos(0.7 * row - 1.1 * col + 2 * c);
+  });
   std::vector<double> pupil = params;
   pupil.insert(pupil.end(), {2e-3, 0.5e-3});
   std::mt19937 rng(7);
@@ -182,8 +178,8 @@ TEST(SplinedModel, UnprojectInvertsProject) {
             .converged);
     const Eigen::Vector3d to_point = point - full.origin;
     worst_miss = std::max(
-        worst_miss, (to_point - to_point.dot(full.direction) * full.direction)
-                        .norm());
+        worst_miss,
+        (to_point - to_point.dot(full.direction) * full.direction).norm());
   }
   EXPECT_LT(worst_direction, 1e-9);
   EXPECT_LT(worst_miss, 1e-9);

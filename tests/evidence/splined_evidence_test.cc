@@ -90,9 +90,9 @@ TEST(SplinedCalibration, RecoversALensKannalaBrandtCannotFollow) {
     SCOPED_TRACE(std::to_string(error.lo_deg) + "-" +
                  std::to_string(error.hi_deg) + " deg");
     EXPECT_LT(error.median, 2 * expected.median);
-    kb_worst_ratio = std::max(kb_worst_ratio,
-                              kb_diff.difference_bands[b].median /
-                                  kb_diff.expected_bands[b].median);
+    kb_worst_ratio =
+        std::max(kb_worst_ratio, kb_diff.difference_bands[b].median /
+                                     kb_diff.expected_bands[b].median);
   }
   EXPECT_GT(kb_worst_ratio, 5.0);
 }

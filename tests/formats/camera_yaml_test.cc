@@ -267,7 +267,8 @@ TEST_F(CameraYamlTest, NoncentralCameraIntoOtherFormatsSaysWhatIsLeftOut) {
 // the note say how far that is off, and that figure is what the camera read
 // back shows against the splined one (the truth: a lens with a bump and a
 // prism term, sim::TruthBumpyFisheye).
-TEST_F(CameraYamlTest, SplinedCameraIntoOtherFormatsIsTheBestFittingKannalaBrandt) {
+TEST_F(CameraYamlTest,
+       SplinedCameraIntoOtherFormatsIsTheBestFittingKannalaBrandt) {
   Camera camera = sim::TruthBumpyFisheye();
   CameraFileStats stats;
   stats.max_field_angle_deg = 80;
@@ -283,11 +284,10 @@ TEST_F(CameraYamlTest, SplinedCameraIntoOtherFormatsIsTheBestFittingKannalaBrand
               std::string::npos)
         << omission.note;
     EXPECT_NE(omission.note.find("up to 80 deg"), std::string::npos);
-    const std::string path = Path(std::string("splined.") +
-                                  CameraFileFormatName(format) + ".yaml");
+    const std::string path =
+        Path(std::string("splined.") + CameraFileFormatName(format) + ".yaml");
     std::string error, note;
-    ASSERT_TRUE(
-        WriteCameraFile(path, format, camera, stats, &error, &note))
+    ASSERT_TRUE(WriteCameraFile(path, format, camera, stats, &error, &note))
         << error;
     EXPECT_EQ(note, omission.note);
     std::ifstream in(path);
