@@ -27,8 +27,6 @@ template class ReprojectionCost<PinholeRadtanModel>;
 template class ReprojectionCost<PinholeRationalModel>;
 template class ReprojectionCost<KannalaBrandtModel>;
 template class ReprojectionCost<KannalaBrandtNoncentralModel>;
-template class ReprojectionCost<KannalaBrandtSplinedModel>;
-template class ReprojectionCost<KannalaBrandtSplinedNoncentralModel>;
 
 bool ReprojectionJacobians(CameraModelId model, const double* intrinsics,
                            const double* pose,

@@ -62,9 +62,20 @@ TEST(NextModel, NamesTheModelToTry) {
   EXPECT_EQ(NextModel(CameraModelId::kPinholeRational, false, 45, options), "");
   EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandt, false, 30, options),
             "pinhole-rational");
+  // The non-central form, then the spline on top; structured residuals
+  // that do not grow with closeness: the spline.
   EXPECT_EQ(
       NextModel(CameraModelId::kKannalaBrandtNoncentral, true, 80, options),
-      "");
+      "kannala-brandt-splined-noncentral");
+  EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandt, false, 80, options),
+            "kannala-brandt-splined");
+  EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandtSplined, true, 80, options),
+            "kannala-brandt-splined-noncentral");
+  EXPECT_EQ(
+      NextModel(CameraModelId::kKannalaBrandtSplined, false, 80, options), "");
+  EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandtSplinedNoncentral, true,
+                      80, options),
+            "");
 }
 
 // The right model on clean data of several lenses: good.
