@@ -73,6 +73,16 @@ bool ParseCameraNode(const YAML::Node& node, const std::string& path,
                   "ros, kalibr): no 'parameters', 'camera_matrix' or 'cam0'");
   }
   if (!ok) return false;
+  if (CameraModelIsSplined(parsed.model) &&
+      static_cast<int>(parsed.params.size()) ==
+          CameraModelNumParams(parsed.model) &&
+      !(parsed.params[KannalaBrandtSplinedModel::kGridRadiusIndex] > 0 &&
+        std::isfinite(
+            parsed.params[KannalaBrandtSplinedModel::kGridRadiusIndex]))) {
+    return r.Fail(path + ".parameters.grid_radius",
+                  "must be a positive number (the spline grid's half width, "
+                  "radians)");
+  }
   *camera = parsed;
   if (format != nullptr) *format = found;
   return true;

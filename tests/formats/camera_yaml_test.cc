@@ -317,6 +317,30 @@ TEST_F(CameraYamlTest,
   }
 }
 
+// A splined camera file whose grid radius is not a positive number is
+// refused, naming the file and the field.
+TEST_F(CameraYamlTest, SplinedFileWithoutAGridRadiusIsRefused) {
+  Camera camera = sim::TruthBumpyFisheye();
+  const std::string path = Path("bad_grid.yaml");
+  std::string error;
+  ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kPuzzlecal, camera,
+                              CameraFileStats(), &error))
+      << error;
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
+  in.close();
+  const size_t at = text.find("grid_radius:");
+  ASSERT_NE(at, std::string::npos);
+  const size_t end = text.find('\n', at);
+  text.replace(at, end - at, "grid_radius: 0");
+  std::ofstream(path) << text;
+  Camera read;
+  EXPECT_FALSE(ReadCameraFile(path, &read, &error));
+  EXPECT_NE(error.find("bad_grid.yaml"), std::string::npos) << error;
+  EXPECT_NE(error.find("grid_radius"), std::string::npos) << error;
+}
+
 TEST_F(CameraYamlTest, ReadsFilesWrittenByOpenCv) {
   const std::string path = Path("written_by_opencv.yaml");
   {
