@@ -1,7 +1,5 @@
 #include "evidence/evidence.h"
 
-#include <ceres/jet.h>
-
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <Eigen/SVD>
@@ -11,7 +9,9 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <vector>
 
+#include "calib/reprojection_error.h"
 #include "util/angles.h"
 #include "util/failure.h"
 #include "util/parallel_for.h"
@@ -53,28 +53,28 @@ double FieldAngleDeg(const Eigen::Vector3d& ray) {
   return std::atan2(ray.head<2>().norm(), ray.z()) / kDegree;
 }
 
-// d pixel / d intrinsics (jacobian, 2 x n) and d pixel / d point (point, 2 x
-// 3, by the ray) of Model::Project of the far point along `ray`, by
-// automatic differentiation.
-template <typename Model>
-bool ProjectionJacobians(const double* params, const Eigen::Vector3d& ray,
-                         Eigen::MatrixXd* jacobian,
+// d pixel / d intrinsics (jacobian, 2 x n) and d pixel / d ray (point, 2 x
+// 3) of the projection of the far point along `ray`: the solvers' own
+// Jacobians (calib/reprojection_error.h) for the board point kFarDistanceM
+// along the ray seen from the identity pose, whose translation derivative
+// is the derivative by the point (compiled once there, for every model).
+bool ProjectionJacobians(CameraModelId model, const double* params,
+                         const Eigen::Vector3d& ray, Eigen::MatrixXd* jacobian,
                          Eigen::Matrix<double, 2, 3>* point) {
-  constexpr int kN = Model::kNumParams;
-  using JetT = ceres::Jet<double, kN + 3>;
-  JetT p[kN];
-  for (int k = 0; k < kN; ++k) p[k] = JetT(params[k], k);
-  // The far point along the ray (see kFarDistanceM), differentiated by the
-  // ray itself.
-  const JetT x[3] = {kFarDistanceM * JetT(ray.x(), kN),
-                     kFarDistanceM * JetT(ray.y(), kN + 1),
-                     kFarDistanceM * JetT(ray.z(), kN + 2)};
-  JetT pixel[2];
-  if (!Model::Project(p, x, pixel)) return false;
-  jacobian->resize(2, kN);
+  const int n = CameraModelNumParams(model);
+  std::vector<double> d_intrinsics(2 * n);
+  double d_pose[2 * kPoseBlockSize];
+  const double identity[kPoseBlockSize] = {0, 0, 0, 0, 0, 0};
+  if (!ReprojectionJacobians(model, params, identity, kFarDistanceM * ray,
+                             d_intrinsics.data(), d_pose)) {
+    return false;
+  }
+  jacobian->resize(2, n);
   for (int r = 0; r < 2; ++r) {
-    for (int k = 0; k < kN; ++k) (*jacobian)(r, k) = pixel[r].v[k];
-    for (int k = 0; k < 3; ++k) (*point)(r, k) = pixel[r].v[kN + k];
+    for (int k = 0; k < n; ++k) (*jacobian)(r, k) = d_intrinsics[r * n + k];
+    for (int k = 0; k < 3; ++k) {
+      (*point)(r, k) = kFarDistanceM * d_pose[r * kPoseBlockSize + 3 + k];
+    }
   }
   return jacobian->allFinite() && point->allFinite();
 }
@@ -86,11 +86,10 @@ bool PixelJacobians(const Camera& camera, const Eigen::Vector2d& pixel,
   Eigen::Vector3d ray;
   if (!camera.Unproject(pixel, &ray).converged) return false;
   Eigen::Matrix<double, 2, 3> point;
-  const bool ok = DispatchCameraModel(camera.model, [&](auto model) {
-    return ProjectionJacobians<decltype(model)>(camera.params.data(), ray,
-                                                jacobian, &point);
-  });
-  if (!ok) return false;
+  if (!ProjectionJacobians(camera.model, camera.params.data(), ray, jacobian,
+                           &point)) {
+    return false;
+  }
   Eigen::Matrix3d cross;  // omega x ray = -[ray]_x omega
   cross << 0, ray.z(), -ray.y(), -ray.z(), 0, ray.x(), ray.y(), -ray.x(), 0;
   *g = point * cross;
