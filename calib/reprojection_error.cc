@@ -28,19 +28,30 @@ template class ReprojectionCost<PinholeRationalModel>;
 template class ReprojectionCost<KannalaBrandtModel>;
 template class ReprojectionCost<KannalaBrandtNoncentralModel>;
 
+bool EvaluateReprojection(CameraModelId model, const double* intrinsics,
+                          const double* pose,
+                          const Eigen::Vector3d& board_point,
+                          const Eigen::Vector2d& observed, double* residual,
+                          double* d_intrinsics, double* d_pose) {
+  return DispatchCameraModel(model, [&](auto m) {
+    using Model = decltype(m);
+    const ReprojectionCost<Model> cost(board_point, observed);
+    const double* parameters[2] = {intrinsics, pose};
+    double* jacobians[2] = {d_intrinsics, d_pose};
+    const bool any = d_intrinsics != nullptr || d_pose != nullptr;
+    return cost.Evaluate(parameters, residual, any ? jacobians : nullptr);
+  });
+}
+
 bool ReprojectionJacobians(CameraModelId model, const double* intrinsics,
                            const double* pose,
                            const Eigen::Vector3d& board_point,
                            double* d_intrinsics, double* d_pose) {
-  return DispatchCameraModel(model, [&](auto m) {
-    using Model = decltype(m);
-    // The observed pixel does not change the Jacobians.
-    const ReprojectionCost<Model> cost(board_point, Eigen::Vector2d::Zero());
-    const double* parameters[2] = {intrinsics, pose};
-    double* jacobians[2] = {d_intrinsics, d_pose};
-    double residual[2];
-    return cost.Evaluate(parameters, residual, jacobians);
-  });
+  // The observed pixel does not change the Jacobians.
+  double residual[2];
+  return EvaluateReprojection(model, intrinsics, pose, board_point,
+                              Eigen::Vector2d::Zero(), residual, d_intrinsics,
+                              d_pose);
 }
 
 }  // namespace puzzlecal

@@ -178,6 +178,15 @@ bool ReprojectionJacobians(CameraModelId model, const double* intrinsics,
                            const Eigen::Vector3d& board_point,
                            double* d_intrinsics, double* d_pose);
 
+// The same cost evaluated at a runtime model: the residual (projected minus
+// `observed`) and, where the pointers are not null, the two Jacobians. For
+// costs built on it (the rig's). False when the point does not project.
+bool EvaluateReprojection(CameraModelId model, const double* intrinsics,
+                          const double* pose,
+                          const Eigen::Vector3d& board_point,
+                          const Eigen::Vector2d& observed, double* residual,
+                          double* d_intrinsics, double* d_pose);
+
 }  // namespace puzzlecal
 
 #endif  // PUZZLECAL_CALIB_REPROJECTION_ERROR_H_

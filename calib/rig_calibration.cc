@@ -28,41 +28,94 @@ using Pose = PoseBlock;
 
 // The pixel error of one board corner seen by a camera that is not the
 // reference: intrinsics, cam_from_rig and the frame's rig_from_board (both
-// angle-axis + translation).
-template <typename Model>
-class RigReprojectionError {
+// angle-axis + translation). The corner's rig-frame point p = R_f X + t_f
+// is the board point of the single-camera cost (ReprojectionCost, compiled
+// once per model in calib/reprojection_error*.cc) seen from cam_from_rig:
+// the residual and its derivatives by the intrinsics and by cam_from_rig
+// are that cost's, and the frame's pose enters by the chain rule through p
+// (d pixel / d p = d pixel / d t_c R_c). No model's projection is
+// differentiated here, so the rig adds no dual-number code per model.
+class RigReprojectionCost : public ceres::CostFunction {
  public:
-  RigReprojectionError(const Eigen::Vector3d& board_point,
-                       const Eigen::Vector2d& observed_pixel)
-      : board_point_(board_point), observed_pixel_(observed_pixel) {}
+  RigReprojectionCost(CameraModelId model, const Eigen::Vector3d& board_point,
+                      const Eigen::Vector2d& observed_pixel)
+      : model_(model),
+        num_params_(CameraModelNumParams(model)),
+        board_point_(board_point),
+        observed_pixel_(observed_pixel) {
+    set_num_residuals(2);
+    auto* sizes = mutable_parameter_block_sizes();
+    sizes->push_back(num_params_);
+    sizes->push_back(kPoseBlockSize);
+    sizes->push_back(kPoseBlockSize);
+  }
 
-  template <typename T>
-  bool operator()(const T* intrinsics, const T* cam_from_rig,
-                  const T* rig_from_board, T* residuals) const {
-    const T point_board[3] = {T(board_point_.x()), T(board_point_.y()),
-                              T(board_point_.z())};
-    T point_rig[3];
-    ceres::AngleAxisRotatePoint(rig_from_board, point_board, point_rig);
-    for (int k = 0; k < 3; ++k) point_rig[k] += rig_from_board[3 + k];
-    T point_cam[3];
-    ceres::AngleAxisRotatePoint(cam_from_rig, point_rig, point_cam);
-    for (int k = 0; k < 3; ++k) point_cam[k] += cam_from_rig[3 + k];
-    T pixel[2];
-    if (!Model::Project(intrinsics, point_cam, pixel)) return false;
-    residuals[0] = pixel[0] - T(observed_pixel_.x());
-    residuals[1] = pixel[1] - T(observed_pixel_.y());
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* intrinsics = parameters[0];
+    const double* cam_from_rig = parameters[1];
+    const double* rig_from_board = parameters[2];
+    // p and d p / d w_f, 3 wide.
+    using RotationJet = ceres::Jet<double, 3>;
+    const RotationJet w[3] = {RotationJet(rig_from_board[0], 0),
+                              RotationJet(rig_from_board[1], 1),
+                              RotationJet(rig_from_board[2], 2)};
+    const RotationJet x[3] = {RotationJet(board_point_.x()),
+                              RotationJet(board_point_.y()),
+                              RotationJet(board_point_.z())};
+    RotationJet rotated[3];
+    ceres::AngleAxisRotatePoint(w, x, rotated);
+    const Eigen::Vector3d point_rig(rotated[0].a + rig_from_board[3],
+                                    rotated[1].a + rig_from_board[4],
+                                    rotated[2].a + rig_from_board[5]);
+    const bool want = jacobians != nullptr &&
+                      (jacobians[0] != nullptr || jacobians[1] != nullptr ||
+                       jacobians[2] != nullptr);
+    if (!want) {
+      return EvaluateReprojection(model_, intrinsics, cam_from_rig, point_rig,
+                                  observed_pixel_, residuals, nullptr, nullptr);
+    }
+    std::vector<double> d_intrinsics(2 * num_params_);
+    double d_cam[2 * kPoseBlockSize];
+    if (!EvaluateReprojection(model_, intrinsics, cam_from_rig, point_rig,
+                              observed_pixel_, residuals, d_intrinsics.data(),
+                              d_cam)) {
+      return false;
+    }
+    if (jacobians[0] != nullptr) {
+      std::copy(d_intrinsics.begin(), d_intrinsics.end(), jacobians[0]);
+    }
+    if (jacobians[1] != nullptr) {
+      std::copy(d_cam, d_cam + 2 * kPoseBlockSize, jacobians[1]);
+    }
+    if (jacobians[2] != nullptr) {
+      // d pixel / d p = d pixel / d t_c * R_c (ceres's matrices are
+      // column-major).
+      double r_c[9];
+      ceres::AngleAxisToRotationMatrix(cam_from_rig, r_c);
+      for (int r = 0; r < 2; ++r) {
+        double d_point[3];
+        for (int j = 0; j < 3; ++j) {
+          d_point[j] = 0;
+          for (int k = 0; k < 3; ++k) {
+            d_point[j] += d_cam[r * kPoseBlockSize + 3 + k] * r_c[j * 3 + k];
+          }
+        }
+        double* row = jacobians[2] + r * kPoseBlockSize;
+        for (int c = 0; c < 3; ++c) {
+          double sum = 0;
+          for (int j = 0; j < 3; ++j) sum += d_point[j] * rotated[j].v[c];
+          row[c] = sum;
+          row[3 + c] = d_point[c];
+        }
+      }
+    }
     return true;
   }
 
-  static ceres::CostFunction* Create(const Eigen::Vector3d& board_point,
-                                     const Eigen::Vector2d& observed_pixel) {
-    return new ceres::AutoDiffCostFunction<RigReprojectionError, 2,
-                                           Model::kNumParams, kPoseBlockSize,
-                                           kPoseBlockSize>(
-        new RigReprojectionError(board_point, observed_pixel));
-  }
-
  private:
+  const CameraModelId model_;
+  const int num_params_;
   Eigen::Vector3d board_point_;
   Eigen::Vector2d observed_pixel_;
 };
@@ -172,8 +225,8 @@ void SolveJoint(JointState* state, const CalibrationOptions& options,
                 loss->get(), state->params(c), state->rig_from_board[f].data());
           } else {
             problem.AddResidualBlock(
-                RigReprojectionError<Model>::Create(view.board_points[i],
-                                                    view.image_points[i]),
+                new RigReprojectionCost(camera.model, view.board_points[i],
+                                        view.image_points[i]),
                 loss->get(), state->params(c), state->cam_from_rig(c),
                 state->rig_from_board[f].data());
             extrinsics_in_problem[c] = true;
