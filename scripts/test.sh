@@ -4,7 +4,7 @@
 #   scripts/test.sh          install the dependencies, Release build (build/,
 #                            without the bench/ programs), every ctest test
 #                            but five slow ones (named below). About 8 min
-#                            50 s from a fresh clone on 2 cores.
+#                            25 s from a fresh clone on 2 cores.
 #   scripts/test.sh --full   the above (with bench/ and every test), then an AddressSanitizer + UBSan build
 #                            (build-asan/) with every ctest test (any finding
 #                            fails), then the libFuzzer targets (build-fuzz/,
