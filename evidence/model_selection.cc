@@ -571,7 +571,9 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
     ModelCandidate candidate;
     candidate.model = run.models[m];
     candidate.num_params = CameraModelNumParams(run.models[m]);
-    candidate.ok = true;
+    // A splined candidate takes part only once it has been fitted (below):
+    // until then it must not enter the comparison of the others.
+    candidate.ok = !CameraModelIsSplined(run.models[m]);
     selection->candidates.push_back(candidate);
     (CameraModelIsSplined(run.models[m]) ? splined : first).push_back(m);
   }
@@ -589,6 +591,7 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
   std::vector<size_t> refine;
   for (size_t m : splined) {
     if (first.empty() || SplinedFormOf(leader) == run.models[m]) {
+      selection->candidates[m].ok = true;
       refine.push_back(m);
       continue;
     }

@@ -146,6 +146,9 @@ TEST(SplinedModelSelection, SkippedWhenTheModelTheyRefineDoesNotLead) {
   }
   EXPECT_EQ(skipped, 2);
   EXPECT_NE(selection.Table().find("skipped"), std::string::npos);
+  // Candidates never fitted take no part in the comparison of the others.
+  EXPECT_EQ(selection.reason.find("splined"), std::string::npos)
+      << selection.reason;
 }
 
 }  // namespace
