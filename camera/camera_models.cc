@@ -69,8 +69,9 @@ double MaxMonotonicRadius(const Camera& camera) {
 }
 
 bool CameraModelIsSplined(CameraModelId id) {
-  return id == CameraModelId::kKannalaBrandtSplined ||
-         id == CameraModelId::kKannalaBrandtSplinedNoncentral;
+  return DispatchCameraModel(id, [](auto model) {
+    return CameraModelIsSplinedModel<decltype(model)>();
+  });
 }
 
 bool CameraModelParamIsStructural(CameraModelId id, int k) {

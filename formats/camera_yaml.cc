@@ -220,7 +220,7 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
                      " model: it holds ";
   if (CameraModelIsSplined(camera.model)) {
     CameraFitReport fit;
-    CameraForFormat(camera, format, stats, &fit);
+    omission.held = CameraForFormat(camera, format, stats, &fit);
     omission.fitted = fit.ok;
     omission.fit_rms_px = fit.rms_px;
     omission.fit_max_px = fit.max_px;
@@ -247,6 +247,7 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
     }
     note += ", and";
   } else {
+    omission.held = far;
     note +=
         std::string("the far-field part (") + CameraModelName(far.model) + ")";
   }
@@ -273,18 +274,20 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
   return omission;
 }
 
-bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
-                      CameraFileFormat format, std::string* text,
-                      std::string* error, const CameraFileNames& names) {
-  if (!CheckCamera(camera, error)) return false;
-  const CameraFileOmission omission =
-      DescribeCameraFileOmission(camera, format, stats);
+namespace {
+
+// The file's text for `camera` whose omission in `format` is `omission`
+// (DescribeCameraFileOmission, computed once: a splined camera's costs a
+// fit), a camera CheckCamera accepts: when lossy, the camera the format holds
+// (omission.held) and a comment that says what is missing (after OpenCV's
+// "%YAML:1.0" line, which must come first).
+bool FormatWithOmission(const Camera& camera, const CameraFileStats& stats,
+                        CameraFileFormat format,
+                        const CameraFileOmission& omission, std::string* text,
+                        std::string* error, const CameraFileNames& names) {
   if (omission.lossy) {
-    // The far-field part in the format, and a comment that says what is
-    // missing (after OpenCV's "%YAML:1.0" line, which must come first).
     std::string body;
-    if (!FormatCameraFile(CameraForFormat(camera, format, stats), stats, format,
-                          &body, error, names)) {
+    if (!FormatCameraFile(omission.held, stats, format, &body, error, names)) {
       return false;
     }
     const std::string comment = "# " + omission.note + "\n";
@@ -314,20 +317,34 @@ bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
   return Fail("unknown camera file format", error);
 }
 
+}  // namespace
+
+bool FormatCameraFile(const Camera& camera, const CameraFileStats& stats,
+                      CameraFileFormat format, std::string* text,
+                      std::string* error, const CameraFileNames& names) {
+  if (!CheckCamera(camera, error)) return false;
+  return FormatWithOmission(camera, stats, format,
+                            DescribeCameraFileOmission(camera, format, stats),
+                            text, error, names);
+}
+
 bool WriteCameraFile(const std::string& path, CameraFileFormat format,
                      const Camera& camera, const CameraFileStats& stats,
                      std::string* error, std::string* note,
                      const CameraFileNames& names) {
   std::string text, why;
-  if (!FormatCameraFile(camera, stats, format, &text, &why, names)) {
+  const bool valid = CheckCamera(camera, &why);
+  const CameraFileOmission omission =
+      valid ? DescribeCameraFileOmission(camera, format, stats)
+            : CameraFileOmission();
+  if (!valid || !FormatWithOmission(camera, stats, format, omission, &text,
+                                    &why, names)) {
     return Fail("cannot write '" + path + "' (" + CameraFileFormatName(format) +
                     " format): " + why,
                 error);
   }
   if (!WriteFileAtomically(path, text, error)) return false;
-  if (note != nullptr) {
-    *note = DescribeCameraFileOmission(camera, format, stats).note;
-  }
+  if (note != nullptr) *note = omission.note;
   return true;
 }
 

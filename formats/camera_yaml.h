@@ -116,6 +116,8 @@ struct CameraFileOmission {
   bool fitted = false;
   double fit_rms_px = 0;
   double fit_max_px = 0;
+  // What the file holds when lossy (CameraForFormat's camera).
+  Camera held;
   std::string note;  // one line for the user; empty when !lossy
 };
 // The camera a file in `format` holds for `camera`: the camera itself in

@@ -26,6 +26,20 @@ inline sim::SyntheticScene Fisheye190Scene(int num_views) {
   return scene;
 }
 
+// `num_views` boards seen through sim::TruthBumpyFisheye() (a lens
+// kannala-brandt cannot follow): board directions up to 70 degrees off the
+// axis, at least half of each board inside the image, 0.1 px corner noise.
+inline sim::SyntheticScene BumpyFisheyeScene(unsigned seed, int num_views) {
+  sim::SyntheticScene scene;
+  scene.camera = sim::TruthBumpyFisheye();
+  scene.num_views = num_views;
+  scene.noise_px = 0.1;
+  scene.max_direction_deg = 70;
+  scene.min_visible_fraction = 0.5;
+  scene.seed = seed;
+  return scene;
+}
+
 }  // namespace testing_scenes
 }  // namespace puzzlecal
 

@@ -16,19 +16,14 @@
 #include "calib/spline_prior.h"
 #include "calib/splined_reprojection.h"
 #include "sim/synthetic_views.h"
+#include "tests/calib/scenes.h"
 
 namespace puzzlecal {
 namespace {
 
 sim::SyntheticData BumpyData(unsigned seed, int num_views = 30) {
-  sim::SyntheticScene scene;
-  scene.camera = sim::TruthBumpyFisheye();
-  scene.num_views = num_views;
-  scene.noise_px = 0.1;
-  scene.max_direction_deg = 70;
-  scene.min_visible_fraction = 0.5;
-  scene.seed = seed;
-  return sim::MakeSyntheticData(scene);
+  return sim::MakeSyntheticData(
+      testing_scenes::BumpyFisheyeScene(seed, num_views));
 }
 
 CalibrationResult CalibrateOrDie(const sim::SyntheticData& data,
