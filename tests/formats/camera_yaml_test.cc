@@ -14,6 +14,7 @@
 #include <string>
 
 #include "sim/synthetic_views.h"
+#include "tests/support/files.h"
 #include "util/atomic_file.h"
 
 namespace puzzlecal {
@@ -290,9 +291,7 @@ TEST_F(CameraYamlTest,
     ASSERT_TRUE(WriteCameraFile(path, format, camera, stats, &error, &note))
         << error;
     EXPECT_EQ(note, omission.note);
-    std::ifstream in(path);
-    const std::string text((std::istreambuf_iterator<char>(in)),
-                           std::istreambuf_iterator<char>());
+    const std::string text = testing_files::ReadFile(path);
     EXPECT_NE(text.find(omission.note), std::string::npos);
     Camera read;
     ASSERT_TRUE(ReadCameraFile(path, &read, &error)) << error;
@@ -326,15 +325,12 @@ TEST_F(CameraYamlTest, SplinedFileWithoutAGridRadiusIsRefused) {
   ASSERT_TRUE(WriteCameraFile(path, CameraFileFormat::kPuzzlecal, camera,
                               CameraFileStats(), &error))
       << error;
-  std::ifstream in(path);
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
-  in.close();
+  std::string text = testing_files::ReadFile(path);
   const size_t at = text.find("grid_radius:");
   ASSERT_NE(at, std::string::npos);
   const size_t end = text.find('\n', at);
   text.replace(at, end - at, "grid_radius: 0");
-  std::ofstream(path) << text;
+  testing_files::WriteFile(path, text);
   Camera read;
   EXPECT_FALSE(ReadCameraFile(path, &read, &error));
   EXPECT_NE(error.find("bad_grid.yaml"), std::string::npos) << error;
