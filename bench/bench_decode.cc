@@ -183,7 +183,13 @@ void WindowTrials(const Board& board, const cv::Mat& image,
     const int x0 = px(*rng), y0 = py(*rng);
     const Eigen::Matrix2i l = RandomSignedPermutation(rng);
     TruthGrid grid = OneComponentFromTruth(
-        truth, l, Eigen::Vector2i((*rng)() % 50, (*rng)() % 50),
+        truth, l,
+        [rng] {
+          // One draw per statement (y first): as two arguments of one call
+          // they come in an order each compiler picks.
+          const int y = static_cast<int>((*rng)() % 50);
+          return Eigen::Vector2i(static_cast<int>((*rng)() % 50), y);
+        }(),
         Window(x0, y0, k));
     if (static_cast<int>(grid.corners.size()) != (k + 1) * (k + 1)) continue;
     DecodeAndCount(board, image, grid, flip_rate, rng, tally, truth_known);

@@ -107,7 +107,10 @@ Scene MakeScene(int cols, int rows, double tile_px, unsigned seed) {
                                            ? Eigen::Vector2d(du + dv)
                                            : Eigen::Vector2d(du - dv);
       Corner corner;
-      corner.xy = p + Eigen::Vector2d(noise(rng), noise(rng));
+      // One draw per statement (y first): as two arguments of one call they
+      // come in an order each compiler picks.
+      const double noise_y = noise(rng);
+      corner.xy = p + Eigen::Vector2d(noise(rng), noise_y);
       corner.orientation = std::atan2(bisector.y(), bisector.x());
       corner.response = 1;
       scene.corners.push_back(corner);

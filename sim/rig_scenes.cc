@@ -167,7 +167,11 @@ Eigen::Isometry3d RigFramePoseSeenBy(
   std::normal_distribution<double> normal(0.0, 1.0);
   Eigen::Vector3d direction;
   do {
-    direction = Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    // One draw per statement, z first (see DrawViewPose in sim/scenes.h).
+    const double z = normal(rng);
+    const double y = normal(rng);
+    const double x = normal(rng);
+    direction = Eigen::Vector3d(x, y, z);
   } while (!(direction.norm() > 1e-6));
   pose.translation() += scene.moved_by_m * direction.normalized();
   return pose;

@@ -45,23 +45,26 @@ Eigen::Isometry3d PoseFromView(const Board& board, const ViewPose& view);
 // seed draws the same views everywhere).
 double UniformDraw(std::mt19937_64* rng, double lo, double hi);
 
-// A random ViewPose of `board`, drawn from `rng` in a fixed order: the
-// target within the printed area grown by ranges.target_margin_tiles, the
-// distance, view angle, tilt direction, roll, and an off-axis angle uniform
-// over the image disc of directions (not clustered at the axis). `Ranges`
-// is RandomViews or RigRandomFrames (sim/rig_scenes.h): both name these
-// fields alike.
+// A random ViewPose of `board`, drawn from `rng` in a fixed order (on every
+// compiler): the target (row, then column) within the printed area grown by
+// ranges.target_margin_tiles, the distance, view angle, tilt direction, roll,
+// and an off-axis angle uniform over the image disc of directions (not
+// clustered at the axis). `Ranges` is RandomViews or RigRandomFrames
+// (sim/rig_scenes.h): both name these fields alike.
 template <typename Ranges>
 ViewPose DrawViewPose(const Board& board, const Ranges& ranges,
                       std::mt19937_64* rng) {
   ViewPose view;
-  view.target = Eigen::Vector2d(
-      UniformDraw(
-          rng, board.origin.x() - ranges.target_margin_tiles,
-          board.origin.x() + board.cols - 1 + ranges.target_margin_tiles),
-      UniformDraw(
-          rng, board.origin.y() - ranges.target_margin_tiles,
-          board.origin.y() + board.rows - 1 + ranges.target_margin_tiles));
+  // One draw per statement: two draws as one call's arguments come in an
+  // order each compiler picks. The row is drawn before the column, the
+  // order the built-in scenes have always been drawn in.
+  const double target_y = UniformDraw(
+      rng, board.origin.y() - ranges.target_margin_tiles,
+      board.origin.y() + board.rows - 1 + ranges.target_margin_tiles);
+  const double target_x = UniformDraw(
+      rng, board.origin.x() - ranges.target_margin_tiles,
+      board.origin.x() + board.cols - 1 + ranges.target_margin_tiles);
+  view.target = Eigen::Vector2d(target_x, target_y);
   view.distance_m =
       UniformDraw(rng, ranges.min_distance_m, ranges.max_distance_m);
   view.view_angle_deg =

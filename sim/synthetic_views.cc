@@ -139,8 +139,11 @@ SyntheticData MakeSyntheticData(const SyntheticScene& scene) {
     }
     std::vector<bool> outlier(exact.size(), false);
     for (size_t i = 0; i < exact.size(); ++i) {
+      // One draw per statement, y first (see DrawViewPose).
+      const double noise_y = normal(rng);
+      const double noise_x = normal(rng);
       Eigen::Vector2d observed =
-          exact[i] + scene.noise_px * Eigen::Vector2d(normal(rng), normal(rng));
+          exact[i] + scene.noise_px * Eigen::Vector2d(noise_x, noise_y);
       if (uniform(rng) < scene.outlier_fraction) {
         // A gross error: 5 to 50 px away in a random direction.
         const double angle = 2 * M_PI * uniform(rng);
@@ -180,8 +183,9 @@ std::vector<Eigen::Isometry3d> CentredFrontalPoses(const Camera& camera,
     const Eigen::Vector3d axis(-std::sin(direction), std::cos(direction), 0);
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.linear() = Eigen::AngleAxisd(tilt, axis).toRotationMatrix();
-    const Eigen::Vector3d shift(0.05 * (uniform(rng) - 0.5),
-                                0.05 * (uniform(rng) - 0.5), 1.0);
+    const double shift_y = 0.05 * (uniform(rng) - 0.5);  // y first, as above
+    const double shift_x = 0.05 * (uniform(rng) - 0.5);
+    const Eigen::Vector3d shift(shift_x, shift_y, 1.0);
     pose.translation() = distance * shift.normalized() - pose.linear() * centre;
     poses.push_back(pose);
   }
@@ -209,7 +213,9 @@ CalibrationView ProjectBoardView(const Camera& camera, const Board& board,
                       camera.Project(cam, &pixel) && pixel.x() >= 0 &&
                       pixel.y() >= 0 && pixel.x() <= camera.width - 1 &&
                       pixel.y() <= camera.height - 1;
-    const Eigen::Vector2d noise(normal(*rng), normal(*rng));
+    const double noise_y = normal(*rng);  // y first, as above
+    const double noise_x = normal(*rng);
+    const Eigen::Vector2d noise(noise_x, noise_y);
     if (!seen) continue;
     view.board_points.push_back(point);
     view.image_points.push_back(pixel + noise_px * noise);

@@ -16,6 +16,7 @@
 #include "sim/synthetic_views.h"
 #include "tests/calib/opencv_reference.h"
 #include "tests/calib/scenes.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace {
@@ -237,7 +238,8 @@ void AddHeavyTailedNoise(SyntheticData* data) {
       const double u = uniform(rng);
       const double sigma = u < 0.01 ? 0.4 : u < 0.11 ? 0.15 : 0.03;
       data->views[v].image_points[i] =
-          data->exact[v][i] + sigma * Eigen::Vector2d(normal(rng), normal(rng));
+          data->exact[v][i] +
+          sigma * testing_draws::DrawVector2d([&] { return normal(rng); });
     }
   }
 }

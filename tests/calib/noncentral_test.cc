@@ -16,6 +16,7 @@
 #include "camera/camera_models.h"
 #include "sim/render.h"
 #include "sim/scenes.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace {
@@ -286,8 +287,8 @@ Observed ObserveScene(const SceneSpec& scene, double noise_px, unsigned seed) {
       const Eigen::Vector3d board_point = scene.board.Point(corner.id);
       const Eigen::Vector3d p = spec.cam_from_board * board_point;
       view.board_points.push_back(board_point);
-      view.image_points.push_back(corner.xy +
-                                  Eigen::Vector2d(noise(rng), noise(rng)));
+      view.image_points.push_back(
+          corner.xy + testing_draws::DrawVector2d([&] { return noise(rng); }));
       distance.push_back(p.norm());
       angle.push_back(std::atan2(p.head<2>().norm(), p.z()) / kDegree);
     }

@@ -16,6 +16,7 @@
 
 #include "camera/camera_models.h"
 #include "sim/synthetic_views.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace {
@@ -56,14 +57,16 @@ void ExpectSameAsAutoDiff(const std::vector<double>& intrinsics) {
     // Board points up to 0.3 m from the board origin, the board 0.2-1 m
     // away, turned up to about 70 degrees and shifted sideways so that some
     // corners lie far off the axis.
-    const Eigen::Vector3d board_point(0.3 * uniform(rng), 0.3 * uniform(rng),
-                                      0.0);
+    const Eigen::Vector2d on_board =
+        0.3 * testing_draws::DrawVector2d([&] { return uniform(rng); });
+    const Eigen::Vector3d board_point(on_board.x(), on_board.y(), 0.0);
     double pose[kPoseBlockSize] = {
         1.2 * uniform(rng), 1.2 * uniform(rng), 1.2 * uniform(rng),
         0.4 * uniform(rng), 0.4 * uniform(rng), 0.6 + 0.4 * uniform(rng)};
     if (trial == 0) std::fill(pose, pose + 3, 0.0);  // the identity rotation
-    const Eigen::Vector2d observed(600 + 300 * uniform(rng),
-                                   450 + 300 * uniform(rng));
+    const Eigen::Vector2d observed =
+        Eigen::Vector2d(600, 450) +
+        300 * testing_draws::DrawVector2d([&] { return uniform(rng); });
     std::unique_ptr<ceres::CostFunction> fast(
         ReprojectionError<Model>::Create(board_point, observed));
     std::unique_ptr<ceres::CostFunction> reference(

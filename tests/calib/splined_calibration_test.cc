@@ -17,6 +17,7 @@
 #include "calib/splined_reprojection.h"
 #include "sim/synthetic_views.h"
 #include "tests/calib/scenes.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace {
@@ -126,9 +127,12 @@ void ExpectSplitCostMatchesAutoDiff(const std::vector<double>& intrinsics) {
     PoseBlock pose = {0.3 * uniform(rng), 0.3 * uniform(rng),
                       0.3 * uniform(rng), 0.2 * uniform(rng),
                       0.2 * uniform(rng), 0.3 + 0.1 * uniform(rng)};
-    const Eigen::Vector3d board(0.2 * uniform(rng), 0.2 * uniform(rng), 0);
-    const Eigen::Vector2d observed(700 + 50 * uniform(rng),
-                                   600 + 50 * uniform(rng));
+    const Eigen::Vector2d on_board =
+        0.2 * testing_draws::DrawVector2d([&] { return uniform(rng); });
+    const Eigen::Vector3d board(on_board.x(), on_board.y(), 0);
+    const Eigen::Vector2d observed =
+        Eigen::Vector2d(700, 600) +
+        50 * testing_draws::DrawVector2d([&] { return uniform(rng); });
     const std::array<int, 2> cell = SplineCellOf<Model>(
         params.data(), IsometryFromPoseBlock(pose.data()) * board);
     SplinedReprojectionCost<Model> split(board, observed, cell);

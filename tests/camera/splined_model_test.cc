@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "camera/camera_models.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace {
@@ -102,7 +103,9 @@ TEST(SplinedModel, ZeroCorrectionIsKannalaBrandt) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   for (int i = 0; i < 100; ++i) {
-    const Eigen::Vector3d point(uniform(rng), uniform(rng), 0.3 + uniform(rng));
+    const Eigen::Vector3d point =
+        testing_draws::DrawVector3d([&] { return uniform(rng); }) +
+        Eigen::Vector3d(0, 0, 0.3);
     Eigen::Vector2d splined, kb;
     ASSERT_TRUE(ProjectPoint(CameraModelId::kKannalaBrandtSplined,
                              params.data(), point, &splined));

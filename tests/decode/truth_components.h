@@ -18,6 +18,7 @@
 #include "grid/grid_component.h"
 #include "sim/render.h"
 #include "target/board.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace decode_testing {
@@ -108,7 +109,7 @@ inline TruthGrid OneComponentFromTruth(
     Corner corner;
     corner.xy = c.xy;
     if (position_noise_px > 0)
-      corner.xy += Eigen::Vector2d(noise(rng), noise(rng));
+      corner.xy += testing_draws::DrawVector2d([&] { return noise(rng); });
     grid.components[0].corner.push_back(static_cast<int>(grid.corners.size()));
     grid.components[0].ij.push_back(label_from_id * c.id + label_offset);
     grid.corners.push_back(corner);

@@ -8,6 +8,7 @@
 
 #include "calib/calibrate.h"
 #include "sim/synthetic_views.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace {
@@ -46,7 +47,8 @@ std::vector<CalibrationView> Redraw(const SyntheticData& data, double noise_px,
   for (size_t v = 0; v < views.size(); ++v) {
     for (size_t i = 0; i < views[v].image_points.size(); ++i) {
       views[v].image_points[i] =
-          data.exact[v][i] + Eigen::Vector2d(normal(rng), normal(rng));
+          data.exact[v][i] +
+          testing_draws::DrawVector2d([&] { return normal(rng); });
     }
   }
   return views;

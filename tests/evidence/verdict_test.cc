@@ -10,6 +10,7 @@
 #include "evidence/evidence.h"
 #include "sim/synthetic_views.h"
 #include "tests/evidence/judge.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace {
@@ -71,10 +72,10 @@ TEST(NextModel, NamesTheModelToTry) {
             "kannala-brandt-splined");
   EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandtSplined, true, 80, options),
             "kannala-brandt-splined-noncentral");
-  EXPECT_EQ(
-      NextModel(CameraModelId::kKannalaBrandtSplined, false, 80, options), "");
-  EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandtSplinedNoncentral, true,
-                      80, options),
+  EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandtSplined, false, 80, options),
+            "");
+  EXPECT_EQ(NextModel(CameraModelId::kKannalaBrandtSplinedNoncentral, true, 80,
+                      options),
             "");
 }
 
@@ -152,7 +153,8 @@ TEST(Verdict, CentralModelOnNoncentralLensNamesNoncentral) {
       Eigen::Vector2d pixel;
       ASSERT_TRUE(ProjectNoncentral(
           truth, kE1, data.cam_from_board[v] * view.board_points[i], &pixel));
-      view.image_points[i] = pixel + Eigen::Vector2d(normal(rng), normal(rng));
+      view.image_points[i] =
+          pixel + testing_draws::DrawVector2d([&] { return normal(rng); });
     }
   }
   const Judged judged = Judge(data.views, CameraModelId::kKannalaBrandt,

@@ -14,6 +14,7 @@
 #include "grid/edge_intensity.h"
 #include "grid/label_table.h"
 #include "grid/nearest_neighbors.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace {
@@ -38,7 +39,11 @@ TEST(NearestNeighborsTest, MatchesBruteForce) {
   std::uniform_real_distribution<double> u(0, 500);
   for (int trial = 0; trial < 4; ++trial) {
     std::vector<Eigen::Vector2d> points;
-    for (int i = 0; i < 300; ++i) points.emplace_back(u(rng), u(rng) * 0.3);
+    for (int i = 0; i < 300; ++i) {
+      const Eigen::Vector2d p =
+          testing_draws::DrawVector2d([&] { return u(rng); });
+      points.emplace_back(p.x(), p.y() * 0.3);
+    }
     if (trial == 1) points.emplace_back(9e5, -9e5);  // one far outlier
     if (trial == 2)  // a lattice with exact ties
       for (int i = 0; i < 100; ++i) points.emplace_back(i % 10, i / 10);
@@ -56,7 +61,8 @@ TEST(LabelTableTest, MatchesMap) {
   std::uniform_int_distribution<int> tree(0, 5), coord(-20, 20), op(0, 2);
   for (int step = 0; step < 20000; ++step) {
     const int t = tree(rng);
-    const Eigen::Vector2i label(coord(rng), coord(rng));
+    const Eigen::Vector2i label =
+        testing_draws::DrawVector2d([&] { return coord(rng); }).cast<int>();
     const auto key = std::make_tuple(t, label.x(), label.y());
     const int o = op(rng);
     if (o == 0 && reference.size() < 1900) {

@@ -17,6 +17,7 @@
 #include "detection/corner.h"
 #include "grid/grid_component.h"
 #include "target/board.h"
+#include "tests/support/draws.h"
 
 namespace puzzlecal {
 namespace grid_test {
@@ -153,8 +154,9 @@ inline SyntheticCorners ProjectBoards(const Camera& camera,
                                              ? Eigen::Vector2d(du + dv)
                                              : Eigen::Vector2d(du - dv);
         Corner corner;
-        corner.xy = p + options.position_noise_px *
-                            Eigen::Vector2d(gauss(rng), gauss(rng));
+        corner.xy =
+            p + options.position_noise_px *
+                    testing_draws::DrawVector2d([&] { return gauss(rng); });
         corner.orientation =
             std::atan2(bisector.y(), bisector.x()) +
             options.orientation_noise_deg * M_PI / 180 * gauss(rng);
@@ -170,7 +172,8 @@ inline SyntheticCorners ProjectBoards(const Camera& camera,
   int added = 0;
   for (int attempt = 0; added < options.num_clutter && attempt < 100000;
        ++attempt) {
-    const Eigen::Vector2d p(ux(rng), uy(rng));
+    const double y = uy(rng);  // y first (tests/support/draws.h)
+    const Eigen::Vector2d p(ux(rng), y);
     bool near_board = false;
     for (const SyntheticBoard& board : boards) {
       Eigen::Vector2d id;
