@@ -233,7 +233,10 @@ int ParseRigRequest(RigRequest* request) {
       code != kExitOk) {
     return code;
   }
-  for (const auto& [name, camera] : request->initial) {
+  for (const auto& named_camera : request->initial) {
+    // (A structured binding cannot be captured by a lambda in C++17.)
+    const std::string& name = named_camera.first;
+    const Camera& camera = named_camera.second;
     const auto folder = std::find_if(
         request->folders.begin(), request->folders.end(),
         [&](const fs::path& f) { return f.filename().string() == name; });

@@ -4,6 +4,7 @@
 #include <libdeflate.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
@@ -35,8 +36,9 @@ cv::Mat TestImage(int depth, int channels, int seed) {
         if (depth == CV_8U) {
           image.ptr<uint8_t>(y)[index] = static_cast<uint8_t>(value);
         } else {
+          // Clamped: 255 * 257 + 6 does not fit 16 bits.
           image.ptr<uint16_t>(y)[index] =
-              static_cast<uint16_t>(value * scale + (x % 7));
+              static_cast<uint16_t>(std::min(65535.0, value * scale + (x % 7)));
         }
       }
     }
