@@ -2,6 +2,8 @@
 
 #include <ceres/rotation.h>
 
+#include "calib/reprojection_cost_impl.h"
+
 namespace puzzlecal {
 
 PoseBlock PoseBlockFromIsometry(const Eigen::Isometry3d& transform) {

@@ -4,6 +4,7 @@
 // models' (calib/reprojection_error.cc), its 212-wide dual numbers are the
 // heaviest code of the folder.
 
+#include "calib/reprojection_cost_impl.h"
 #include "calib/reprojection_error.h"
 
 namespace puzzlecal {

@@ -1,0 +1,73 @@
+#ifndef PUZZLECAL_CALIB_REPROJECTION_COST_IMPL_H_
+#define PUZZLECAL_CALIB_REPROJECTION_COST_IMPL_H_
+
+// ReprojectionCost<Model>::Evaluate, for the files that instantiate each
+// model's cost (calib/reprojection_error.cc, reprojection_error_splined.cc)
+// and nothing else: every other file links those instances.
+
+#include <ceres/jet.h>
+#include <ceres/rotation.h>
+
+#include "calib/reprojection_error.h"
+
+namespace puzzlecal {
+
+template <typename Model>
+bool ReprojectionCost<Model>::Evaluate(double const* const* parameters,
+                                       double* residuals,
+                                       double** jacobians) const {
+  const double* intrinsics = parameters[0];
+  const double* pose = parameters[1];
+  if (jacobians == nullptr ||
+      (jacobians[0] == nullptr && jacobians[1] == nullptr)) {
+    return functor_(intrinsics, pose, residuals);
+  }
+  // d p / d w, 3 wide.
+  using RotationJet = ceres::Jet<double, 3>;
+  const RotationJet w[3] = {RotationJet(pose[0], 0), RotationJet(pose[1], 1),
+                            RotationJet(pose[2], 2)};
+  const Eigen::Vector3d& board_point = functor_.board_point();
+  const RotationJet x[3] = {RotationJet(board_point.x()),
+                            RotationJet(board_point.y()),
+                            RotationJet(board_point.z())};
+  RotationJet rotated[3];
+  ceres::AngleAxisRotatePoint(w, x, rotated);
+  // d pixel / d (intrinsics, p), N + 3 wide.
+  using ProjectionJet = ceres::Jet<double, kNumParams + 3>;
+  ProjectionJet params[kNumParams];
+  for (int k = 0; k < kNumParams; ++k) {
+    params[k] = ProjectionJet(intrinsics[k], k);
+  }
+  ProjectionJet point_cam[3];
+  for (int j = 0; j < 3; ++j) {
+    point_cam[j] = ProjectionJet(rotated[j].a + pose[3 + j], kNumParams + j);
+  }
+  ProjectionJet pixel[2];
+  if (!Model::Project(params, point_cam, pixel)) return false;
+  const Eigen::Vector2d& observed = functor_.observed_pixel();
+  residuals[0] = pixel[0].a - observed.x();
+  residuals[1] = pixel[1].a - observed.y();
+  for (int r = 0; r < 2; ++r) {
+    if (jacobians[0] != nullptr) {
+      for (int k = 0; k < kNumParams; ++k) {
+        jacobians[0][r * kNumParams + k] = pixel[r].v[k];
+      }
+    }
+    if (jacobians[1] != nullptr) {
+      double* row = jacobians[1] + r * kPoseBlockSize;
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0;
+        for (int j = 0; j < 3; ++j) {
+          sum += pixel[r].v[kNumParams + j] * rotated[j].v[c];
+        }
+        row[c] = sum;
+        row[3 + c] = pixel[r].v[kNumParams + c];
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace puzzlecal
+
+#endif  // PUZZLECAL_CALIB_REPROJECTION_COST_IMPL_H_
