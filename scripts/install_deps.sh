@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages that puzzlecal's build and tests need;
-# with --full also those of the benchmarks and the fuzzers (clang with its
-# libFuzzer runtime, Google Benchmark) and Debian's chromium (a test opens the
+# Installs the Debian 12 packages that puzzlecal's build and tests need
+# (clang among them: scripts/test.sh compiles with it); with --full also
+# those of the benchmarks, the sanitizers and the fuzzers (clang's runtimes,
+# Google Benchmark) and Debian's chromium (a test opens the
 # report's web page in it; without it that test is skipped), which only
 # `scripts/test.sh --full` needs. Idempotent: does nothing when all are present.
 set -euo pipefail
@@ -23,10 +24,11 @@ packages=(
   libdeflate-dev zlib1g-dev
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
   python3-setuptools python3-pip python3-venv python3-yaml
+  clang
 )
 if [ "$full" = 1 ]; then
   # chromium: the report's web page is opened in a real headless browser.
-  packages+=(libbenchmark-dev clang libclang-rt-14-dev chromium)
+  packages+=(libbenchmark-dev libclang-rt-14-dev chromium)
 fi
 
 missing=()
