@@ -124,14 +124,16 @@ int Run(int argc, char** argv) {
     }
     std::printf(
         "    {\"model\": \"%s\", \"ok\": %s, \"seconds\": %.3f, "
-        "\"covariance_seconds\": %.3f, \"iterations\": %d, \"rms_px\": %.4f, "
+        "\"covariance_seconds\": %.3f, \"iterations\": %d, "
+        "\"outlier_rounds\": %d, \"rms_px\": %.4f, "
         "\"corners\": %d, "
         "\"covariance\": %s, \"holdout_rms_px\": %s, "
         "\"halves_worst_band_median_px\": %.3f, "
         "\"halves_expected_px\": %.3f, \"halves_band_deg\": [%.0f, "
         "%.0f]%s}%s\n",
         CameraModelName(models[m]), ok ? "true" : "false", seconds,
-        result.covariance_seconds, result.iterations, result.rms_px,
+        result.covariance_seconds, result.iterations, result.outlier_rounds,
+        result.rms_px,
         result.num_corners_used, result.covariance_ok ? "true" : "false",
         candidate != nullptr
             ? StringPrintf("%.4f", candidate->holdout_rms_px).c_str()

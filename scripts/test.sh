@@ -4,7 +4,7 @@
 #   scripts/test.sh          install the dependencies, Release build with
 #                            clang (build/, without the bench/ programs),
 #                            every ctest test but five slow ones (named
-#                            below). About 6 min 30 s from a fresh clone on
+#                            below). About 6 min 50 s from a fresh clone on
 #                            2 cores.
 #   scripts/test.sh --full   the above with g++ (with bench/ and every test),
 #                            then an AddressSanitizer + UBSan build with clang
