@@ -12,8 +12,8 @@
 #                            fails), then the libFuzzer targets (build-fuzz/,
 #                            clang), each for a bounded time from its seed
 #                            corpus (scripts/fuzz.sh; PUZZLECAL_FUZZ_SECONDS per
-#                            target, default 12; 0 skips fuzzing). About half
-#                            an hour on 2 cores.
+#                            target, default 12; 0 skips fuzzing). About 40
+#                            minutes on 2 cores.
 # Prints the time of each phase at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
