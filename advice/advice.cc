@@ -567,6 +567,7 @@ int BestCandidate(const std::vector<Candidate>& candidates,
 
 bool AdviceOptions::Check(std::string* why) const {
   if (count < 1) return Fail("count must be >= 1", why);
+  if (!spline_prior.Check(why)) return false;
   if (!(field_deg >= 0 && field_deg < 180)) {
     return Fail("field_deg must lie in [0, 180)", why);
   }
@@ -747,8 +748,13 @@ Advice AdviseViews(const std::vector<CalibrationView>& views,
   }
   // Information in units of the corner noise.
   const double precision = 1.0 / (noise * noise);
-  Eigen::MatrixXd information = precision * TakenInformation(views, result) +
-                                PriorInformation(camera, free_index, options);
+  Eigen::MatrixXd information =
+      precision * (TakenInformation(views, result) +
+                   FreeBlock(SplinePriorInformation(
+                                 camera.model, camera.params[0],
+                                 camera.params[1], options.spline_prior),
+                             free_index)) +
+      PriorInformation(camera, free_index, options);
   Eigen::MatrixXd covariance;
   if (!CovarianceOf(information, &covariance)) {
     advice.error = "the information of the views taken is not usable";

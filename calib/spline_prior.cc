@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "util/failure.h"
@@ -163,6 +164,28 @@ void AddSplinePriorOnKnots(CameraModelId model, double* intrinsics,
       CreateSplinePriorCost(model, intrinsics[0], intrinsics[1], options,
                             /*per_knot_blocks=*/true),
       nullptr, knots);
+}
+
+Eigen::MatrixXd SplinePriorInformation(CameraModelId model, double fx,
+                                       double fy,
+                                       const SplinePriorOptions& options) {
+  const int n = CameraModelNumParams(model);
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(n, n);
+  if (!CameraModelIsSplined(model)) return information;
+  const std::unique_ptr<ceres::CostFunction> cost(
+      CreateSplinePriorCost(model, fx, fy, options));
+  const int m = cost->num_residuals();
+  const std::vector<double> params(n, 0.0);
+  std::vector<double> residuals(m);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>
+      jacobian(m, n);
+  const double* parameters[1] = {params.data()};
+  double* jacobians[1] = {jacobian.data()};
+  if (!cost->Evaluate(parameters, residuals.data(), jacobians)) {
+    return information;
+  }
+  information = jacobian.transpose() * jacobian;
+  return information;
 }
 
 }  // namespace puzzlecal

@@ -20,6 +20,7 @@
 #include <ceres/cost_function.h>
 #include <ceres/problem.h>
 
+#include <Eigen/Core>
 #include <string>
 
 #include "camera/camera_models.h"
@@ -66,6 +67,16 @@ void AddSplinePrior(CameraModelId model, double* intrinsics,
 void AddSplinePriorOnKnots(CameraModelId model, double* intrinsics,
                            const SplinePriorOptions& options,
                            ceres::Problem* problem);
+
+// The prior's information on the whole intrinsics vector of `model` (n x n,
+// n its parameter count): W' W, W the prior's Jacobian (the prior is linear
+// in the control values, so W is the same everywhere), in the units of the
+// corners' residuals (pixels), as a solve's normal equations hold it. Zero
+// for a model without a spline. For code that predicts a calibration's
+// uncertainty without a solve (the capture advice).
+Eigen::MatrixXd SplinePriorInformation(CameraModelId model, double fx,
+                                       double fy,
+                                       const SplinePriorOptions& options);
 
 }  // namespace puzzlecal
 
