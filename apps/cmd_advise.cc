@@ -70,6 +70,7 @@ int ParseAdviseRequest(AdviseRequest* request) {
   advice.num_threads = request->threads;
   advice.target_uncertainty_px = request->options.verdict.max_uncertainty_px;
   advice.target_min_views = request->options.verdict.min_views;
+  advice.spline_prior = request->options.calibration.spline_prior;
   if (!advice.Check(&error)) {
     std::cerr << "puzzlecal advise: " << error << "\n";
     return kExitUsage;

@@ -637,6 +637,7 @@ int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
     advice.num_threads = request.threads;
     advice.target_uncertainty_px = request.options.verdict.max_uncertainty_px;
     advice.target_min_views = request.options.verdict.min_views;
+    advice.spline_prior = request.calibration_options.spline_prior;
     run->advice = AdviseViews(run->views, run->result, request.board, advice);
   }
   return kExitOk;

@@ -396,7 +396,8 @@ template <>
 struct Fields<AdviceOptions> {
   // Not here: count (--count), field_deg (--field-deg), num_threads
   // (--threads), target_uncertainty_px and target_min_views (the verdict
-  // section's max_uncertainty_px and min_views).
+  // section's max_uncertainty_px and min_views), spline_prior (the
+  // calibration section's: the prior the calibration used).
   template <typename V, typename O>
   static void Visit(V& v, O& o) {
     v.Field("field_radius_px", o.field_radius_px);
