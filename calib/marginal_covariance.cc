@@ -1,9 +1,11 @@
 #include "calib/marginal_covariance.h"
 
-#include <ceres/crs_matrix.h>
+#include <ceres/cost_function.h>
+#include <ceres/problem.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -12,54 +14,160 @@ namespace {
 
 constexpr int kPoseSize = 6;
 
-// S = A - sum_v B_v C_v^-1 B_v' from the Jacobian, whose first n columns are
-// the free intrinsics and the rest the poses, 6 columns each. False when a
-// C_v is singular.
-bool SchurComplement(const ceres::CRSMatrix& jacobian, int n, int num_poses,
-                     Eigen::MatrixXd* s) {
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
-  std::vector<Eigen::MatrixXd> b(num_poses, Eigen::MatrixXd::Zero(n, 6));
-  std::vector<Eigen::Matrix<double, 6, 6>> c(
-      num_poses, Eigen::Matrix<double, 6, 6>::Zero());
-  // A row's intrinsics entries as (column, value) pairs: a splined model's
-  // row touches about 40 of its 210 intrinsics, and the products of the
-  // zeros would cost 25 times the rest.
-  std::vector<std::pair<int, double>> j_int;
-  j_int.reserve(n);
-  Eigen::Matrix<double, 6, 1> j_pose;
-  for (int row = 0; row < jacobian.num_rows; ++row) {
-    j_int.clear();
-    j_pose.setZero();
+// Where a parameter block's Jacobian columns go: the free intrinsics'
+// columns from `column` on, or pose `pose`'s 6 columns; neither for a block
+// outside both (the problem's other blocks, held as they are).
+struct BlockColumns {
+  int column = -1;
+  int pose = -1;
+  int tangent_size = 0;
+};
+
+// The accumulation of S = A - sum_v B_v C_v^-1 B_v' over the residual
+// blocks, in the order the problem holds them.
+class SchurAccumulator {
+ public:
+  SchurAccumulator(int n, int num_poses)
+      : a_(Eigen::MatrixXd::Zero(n, n)),
+        b_(num_poses, Eigen::MatrixXd::Zero(n, kPoseSize)),
+        c_(num_poses, Eigen::Matrix<double, kPoseSize, kPoseSize>::Zero()) {
+    j_intrinsics_.reserve(n);
+  }
+
+  // Residual `row` of a residual block: its Jacobian blocks `jacobians`
+  // (row-major, num_residuals rows, nullptr for blocks without columns).
+  void AddRow(const std::vector<BlockColumns>& blocks,
+              const std::vector<double*>& jacobians, int row) {
+    j_intrinsics_.clear();
+    Eigen::Matrix<double, kPoseSize, 1> j_pose =
+        Eigen::Matrix<double, kPoseSize, 1>::Zero();
     int pose = -1;
-    for (int e = jacobian.rows[row]; e < jacobian.rows[row + 1]; ++e) {
-      const int col = jacobian.cols[e];
-      if (col < n) {
-        if (jacobian.values[e] != 0)
-          j_int.emplace_back(col, jacobian.values[e]);
-      } else {
-        pose = (col - n) / kPoseSize;
-        j_pose((col - n) % kPoseSize) = jacobian.values[e];
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      if (jacobians[b] == nullptr) continue;
+      const BlockColumns& block = blocks[b];
+      const double* values = jacobians[b] + row * block.tangent_size;
+      if (block.pose >= 0) {
+        pose = block.pose;
+        for (int k = 0; k < kPoseSize; ++k) j_pose(k) += values[k];
+        continue;
+      }
+      // Only the non-zero entries: a splined model's row touches about 40
+      // of its 210 intrinsics, and the products of the zeros would cost 25
+      // times the rest.
+      for (int k = 0; k < block.tangent_size; ++k) {
+        if (values[k] != 0) {
+          j_intrinsics_.emplace_back(block.column + k, values[k]);
+        }
       }
     }
-    for (const auto& [i, value_i] : j_int) {
-      for (const auto& [j, value_j] : j_int) a(i, j) += value_i * value_j;
+    for (const auto& [i, value_i] : j_intrinsics_) {
+      for (const auto& [j, value_j] : j_intrinsics_) {
+        a_(i, j) += value_i * value_j;
+      }
     }
     if (pose >= 0) {
-      for (const auto& [i, value_i] : j_int) {
-        b[pose].row(i) += value_i * j_pose.transpose();
+      for (const auto& [i, value_i] : j_intrinsics_) {
+        b_[pose].row(i) += value_i * j_pose.transpose();
       }
-      c[pose].noalias() += j_pose * j_pose.transpose();
+      c_[pose].noalias() += j_pose * j_pose.transpose();
     }
   }
-  for (int v = 0; v < num_poses; ++v) {
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(c[v]);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
-      return false;
+
+  // S; false when a C_v is singular.
+  bool Finish(Eigen::MatrixXd* s) {
+    for (size_t v = 0; v < c_.size(); ++v) {
+      const Eigen::LDLT<Eigen::Matrix<double, kPoseSize, kPoseSize>> ldlt(
+          c_[v]);
+      if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
+        return false;
+      }
+      a_.noalias() -= b_[v] * ldlt.solve(b_[v].transpose());
     }
-    a.noalias() -= b[v] * ldlt.solve(b[v].transpose());
+    *s = a_;
+    return true;
   }
-  *s = a;
-  return true;
+
+ private:
+  Eigen::MatrixXd a_;
+  std::vector<Eigen::MatrixXd> b_;
+  std::vector<Eigen::Matrix<double, kPoseSize, kPoseSize>> c_;
+  std::vector<std::pair<int, double>> j_intrinsics_;
+};
+
+// S from the Jacobian of every residual block at the current values (after
+// the loss function and in the blocks' tangent spaces, as the solver sees
+// it), evaluated block by block: a compressed Jacobian of the whole problem
+// (ceres::Problem::Evaluate) cost more to build than the rest of the
+// covariance. n: the intrinsics' free columns. False when a residual block
+// cannot be evaluated or a C_v is singular.
+bool SchurComplement(ceres::Problem* problem,
+                     const std::vector<double*>& intrinsics,
+                     const std::vector<double*>& poses, int n,
+                     Eigen::MatrixXd* s) {
+  std::unordered_map<const double*, BlockColumns> columns;
+  int column = 0;
+  for (double* block : intrinsics) {
+    BlockColumns& entry = columns[block];
+    entry.column = column;
+    entry.tangent_size = problem->ParameterBlockTangentSize(block);
+    column += entry.tangent_size;
+  }
+  if (column != n) return false;
+  for (size_t v = 0; v < poses.size(); ++v) {
+    BlockColumns& entry = columns[poses[v]];
+    entry.pose = static_cast<int>(v);
+    entry.tangent_size = problem->ParameterBlockTangentSize(poses[v]);
+    if (entry.tangent_size != kPoseSize) return false;
+  }
+  std::vector<ceres::ResidualBlockId> residual_blocks;
+  problem->GetResidualBlocks(&residual_blocks);
+  SchurAccumulator accumulator(n, static_cast<int>(poses.size()));
+  std::vector<double*> parameter_blocks;
+  std::vector<BlockColumns> blocks;
+  std::vector<double*> jacobians;
+  std::vector<double> storage, residuals;
+  bool first = true;
+  for (ceres::ResidualBlockId id : residual_blocks) {
+    problem->GetParameterBlocksForResidualBlock(id, &parameter_blocks);
+    const int num_residuals =
+        problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+    blocks.assign(parameter_blocks.size(), BlockColumns());
+    size_t size = 0;
+    for (size_t b = 0; b < parameter_blocks.size(); ++b) {
+      const auto found = columns.find(parameter_blocks[b]);
+      if (found == columns.end() ||
+          problem->IsParameterBlockConstant(parameter_blocks[b])) {
+        continue;
+      }
+      blocks[b] = found->second;
+      size += static_cast<size_t>(num_residuals) * blocks[b].tangent_size;
+    }
+    storage.resize(size);
+    residuals.resize(num_residuals);
+    jacobians.assign(parameter_blocks.size(), nullptr);
+    size_t offset = 0;
+    for (size_t b = 0; b < parameter_blocks.size(); ++b) {
+      if (blocks[b].tangent_size == 0) continue;
+      jacobians[b] = storage.data() + offset;
+      offset += static_cast<size_t>(num_residuals) * blocks[b].tangent_size;
+    }
+    double cost = 0;
+    // The first evaluation tells an evaluation callback that the values are
+    // new (it then evaluates every corner ahead); the rest read them.
+    const bool ok =
+        first ? problem->EvaluateResidualBlock(id, /*apply_loss_function=*/true,
+                                               &cost, residuals.data(),
+                                               jacobians.data())
+              : problem->EvaluateResidualBlockAssumingParametersUnchanged(
+                    id, /*apply_loss_function=*/true, &cost,
+                    residuals.data(), jacobians.data());
+    first = false;
+    if (!ok) return false;
+    for (int row = 0; row < num_residuals; ++row) {
+      accumulator.AddRow(blocks, jacobians, row);
+    }
+  }
+  return accumulator.Finish(s);
 }
 
 // S^-1 unless S is (numerically) singular: S is symmetric positive definite
@@ -103,18 +211,8 @@ bool MarginalCovariance(ceres::Problem* problem,
     if (!fixed[k]) free_index.push_back(k);
   }
   const int n = static_cast<int>(free_index.size());
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks = intrinsics;
-  for (double* pose : poses) evaluate.parameter_blocks.push_back(pose);
-  evaluate.num_threads = 1;
-  ceres::CRSMatrix jacobian;
-  if (!problem->Evaluate(evaluate, nullptr, nullptr, nullptr, &jacobian)) {
-    return false;
-  }
-  const int num_poses = static_cast<int>(poses.size());
-  if (jacobian.num_cols != n + kPoseSize * num_poses) return false;
   Eigen::MatrixXd s, inverse;
-  if (!SchurComplement(jacobian, n, num_poses, &s) ||
+  if (!SchurComplement(problem, intrinsics, poses, n, &s) ||
       !InverseIfRegular(s, min_eigenvalue_ratio, &inverse)) {
     return false;
   }

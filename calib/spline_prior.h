@@ -50,20 +50,19 @@ struct SplinePriorOptions {
 int SplinePriorResidualCount();
 
 // The prior as a cost on a splined model's whole intrinsics block (only the
-// correction values' columns of its Jacobian are non-zero), or with
-// `per_knot_blocks` on the knot rows' blocks (each row's (du, dv) pairs: the
-// single-camera solve's layout, calib/splined_reprojection.h).
+// correction values' columns of its Jacobian are non-zero).
 ceres::CostFunction* CreateSplinePriorCost(CameraModelId model, double fx,
                                            double fy,
-                                           const SplinePriorOptions& options,
-                                           bool per_knot_blocks = false);
+                                           const SplinePriorOptions& options);
 
 // Adds the prior on `intrinsics` to `problem` when `model` is splined
 // (nothing otherwise), with fx fy read from `intrinsics` now.
 void AddSplinePrior(CameraModelId model, double* intrinsics,
                     const SplinePriorOptions& options, ceres::Problem* problem);
 // The same on the knot rows' blocks: intrinsics + kSplineBegin + 2 K row,
-// each a parameter block of 2 K values in `problem` (K = kSplineKnots).
+// each a parameter block of 2 K values in `problem` (K = kSplineKnots), the
+// single-camera solve's layout (calib/splined_reprojection.h): the same
+// residuals, split into small residual blocks along the rows.
 void AddSplinePriorOnKnots(CameraModelId model, double* intrinsics,
                            const SplinePriorOptions& options,
                            ceres::Problem* problem);

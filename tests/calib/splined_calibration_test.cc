@@ -4,8 +4,11 @@
 // (tests/evidence/splined_evidence_test.cc: the lens kannala-brandt cannot
 // follow, recovered and chosen.)
 
+#include <ceres/crs_matrix.h>
+#include <ceres/problem.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -185,6 +188,60 @@ TEST(SplinedReprojectionCost, MatchesTheWholeBlockAutoDiff) {
   ExpectSplitCostMatchesAutoDiff<KannalaBrandtSplinedModel>(params);
   params.insert(params.end(), {1.5e-3, 0.4e-3});
   ExpectSplitCostMatchesAutoDiff<KannalaBrandtSplinedNoncentralModel>(params);
+}
+
+// The prior split over the knot rows' blocks (the solver's layout) is the
+// same prior: the same cost at any values, and the same information W'W on
+// the control values as the whole-block form.
+TEST(SplinePrior, OnKnotRowsItIsTheWholeBlocksPrior) {
+  using Model = KannalaBrandtSplinedModel;
+  const Camera truth = sim::TruthBumpyFisheye();
+  std::vector<double> params = truth.params;
+  SplinePriorOptions options;
+  options.smoothness_weight = 0.3;
+  options.zero_weight = 0.02;
+  const Eigen::MatrixXd whole_information = SplinePriorInformation(
+      CameraModelId::kKannalaBrandtSplined, params[0], params[1], options);
+
+  ceres::Problem::Options problem_options;
+  ceres::Problem problem(problem_options);
+  AddSplinePriorOnKnots(CameraModelId::kKannalaBrandtSplined, params.data(),
+                        options, &problem);
+  std::vector<double*> blocks;
+  for (int row = 0; row < kSplineKnots; ++row) {
+    blocks.push_back(params.data() + Model::kSplineBegin +
+                     2 * kSplineKnots * row);
+  }
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  double cost = 0;
+  ceres::CRSMatrix crs;
+  ASSERT_TRUE(problem.Evaluate(evaluate, &cost, nullptr, nullptr, &crs));
+  ASSERT_EQ(crs.num_rows, SplinePriorResidualCount());
+  ASSERT_EQ(crs.num_cols, 2 * kSplineValues);
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int r = 0; r < crs.num_rows; ++r) {
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
+      jacobian(r, crs.cols[k]) = crs.values[k];
+    }
+  }
+  const Eigen::MatrixXd information = jacobian.transpose() * jacobian;
+  const Eigen::MatrixXd expected = whole_information.block(
+      Model::kSplineBegin, Model::kSplineBegin, 2 * kSplineValues,
+      2 * kSplineValues);
+  EXPECT_LT((information - expected).norm(), 1e-9 * expected.norm());
+  EXPECT_GT(expected.norm(), 0.0);
+
+  // The cost of the truth's (bumpy) control values, against the whole form.
+  std::unique_ptr<ceres::CostFunction> whole(CreateSplinePriorCost(
+      CameraModelId::kKannalaBrandtSplined, params[0], params[1], options));
+  std::vector<double> residuals(SplinePriorResidualCount());
+  const double* parameters[1] = {params.data()};
+  ASSERT_TRUE(whole->Evaluate(parameters, residuals.data(), nullptr));
+  double whole_cost = 0;
+  for (double r : residuals) whole_cost += 0.5 * r * r;
+  EXPECT_GT(whole_cost, 0.0);
+  EXPECT_NEAR(cost, whole_cost, 1e-12 * whole_cost);
 }
 
 // The prior's Jacobian is its residuals' linear map: residual = J x.
