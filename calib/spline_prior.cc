@@ -45,7 +45,7 @@ PriorRow PullToZero(int component, int knot, double zero) {
   return row;
 }
 
-// The second differences along knot row r (both components' in `rows`).
+// Appends component `component`'s second differences along knot row r.
 void AppendAlongRow(int component, int r, double smoothness,
                     std::vector<PriorRow>* rows) {
   for (int c = 1; c + 1 < kK; ++c) {
@@ -54,7 +54,8 @@ void AppendAlongRow(int component, int r, double smoothness,
   }
 }
 
-// The second differences down the columns across knot rows r - 1, r, r + 1.
+// Appends its second differences down the columns across knot rows r - 1,
+// r, r + 1.
 void AppendAcrossRows(int component, int r, double smoothness,
                       std::vector<PriorRow>* rows) {
   for (int c = 0; c < kK; ++c) {
@@ -63,6 +64,7 @@ void AppendAcrossRows(int component, int r, double smoothness,
   }
 }
 
+// Appends its pulls towards zero of knot row r's values.
 void AppendPullsOfRow(int component, int r, double zero,
                       std::vector<PriorRow>* rows) {
   for (int c = 0; c < kK; ++c) {
@@ -71,8 +73,8 @@ void AppendPullsOfRow(int component, int r, double zero,
 }
 
 // Every row of the prior, in the order of SplinePriorResidualCount: per
-// component the second differences along each knot row, then down each
-// column, then the pulls towards zero.
+// component the second differences along each knot row, then down the
+// columns (triple of rows by triple), then the pulls towards zero.
 std::vector<PriorRow> AllRows(const SplinePriorOptions& options) {
   std::vector<PriorRow> rows;
   rows.reserve(SplinePriorResidualCount());
@@ -80,15 +82,11 @@ std::vector<PriorRow> AllRows(const SplinePriorOptions& options) {
     for (int r = 0; r < kK; ++r) {
       AppendAlongRow(component, r, options.smoothness_weight, &rows);
     }
-    for (int c = 0; c < kK; ++c) {
-      for (int r = 1; r + 1 < kK; ++r) {
-        rows.push_back(SecondDifference(component, (r - 1) * kK + c,
-                                        r * kK + c, (r + 1) * kK + c,
-                                        options.smoothness_weight));
-      }
+    for (int r = 1; r + 1 < kK; ++r) {
+      AppendAcrossRows(component, r, options.smoothness_weight, &rows);
     }
-    for (int i = 0; i < kSplineValues; ++i) {
-      rows.push_back(PullToZero(component, i, options.zero_weight));
+    for (int r = 0; r < kK; ++r) {
+      AppendPullsOfRow(component, r, options.zero_weight, &rows);
     }
   }
   return rows;
