@@ -97,14 +97,13 @@ bool TimedCalibrate(const std::vector<CalibrationView>& views,
 }
 
 // One model's calibration time alone, as JSON.
-int TimeOneModel(const std::vector<CalibrationView>& views,
-                 CameraModelId model, int width, int height,
-                 const CalibrationOptions& options) {
+int TimeOneModel(const std::vector<CalibrationView>& views, CameraModelId model,
+                 int width, int height, const CalibrationOptions& options) {
   CalibrationResult result;
   std::string why;
   double seconds = 0;
-  const bool ok = TimedCalibrate(views, model, width, height, options,
-                                 &result, &why, &seconds);
+  const bool ok = TimedCalibrate(views, model, width, height, options, &result,
+                                 &why, &seconds);
   std::printf(
       "{\"model\": \"%s\", \"ok\": %s, \"seconds\": %.3f, "
       "\"covariance_seconds\": %.3f, \"iterations\": %d, "
@@ -116,8 +115,9 @@ int TimeOneModel(const std::vector<CalibrationView>& views,
 
 int Run(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr,
-                 "usage: bench_lens_models IMAGES BOARD.yaml [threads [MODEL]]\n");
+    std::fprintf(
+        stderr,
+        "usage: bench_lens_models IMAGES BOARD.yaml [threads [MODEL]]\n");
     return 2;
   }
   const int threads = argc > 3 ? std::atoi(argv[3]) : 2;
@@ -136,7 +136,7 @@ int Run(int argc, char** argv) {
       MakeCalibrationViews(board, &images, &width, &height);
   CalibrationOptions options;
   options.num_threads = threads;
-  std::vector<CameraModelId> models = {
+  const std::vector<CameraModelId> models = {
       CameraModelId::kKannalaBrandt, CameraModelId::kKannalaBrandtNoncentral,
       CameraModelId::kKannalaBrandtSplined,
       CameraModelId::kKannalaBrandtSplinedNoncentral};
@@ -182,8 +182,8 @@ int Run(int argc, char** argv) {
         "%.0f]%s}%s\n",
         CameraModelName(models[m]), ok ? "true" : "false", seconds,
         result.covariance_seconds, result.iterations, result.outlier_rounds,
-        result.rms_px,
-        result.num_corners_used, result.covariance_ok ? "true" : "false",
+        result.rms_px, result.num_corners_used,
+        result.covariance_ok ? "true" : "false",
         candidate != nullptr
             ? StringPrintf("%.4f", candidate->holdout_rms_px).c_str()
             : "null",

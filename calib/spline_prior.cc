@@ -212,8 +212,8 @@ void AddSplinePriorOnKnots(CameraModelId model, double* intrinsics,
       AppendPullsOfRow(component, r, options.zero_weight, &rows);
     }
     problem->AddResidualBlock(
-        new SplinePriorCost(num_params, r, 1, std::move(rows), fx, fy),
-        nullptr, knot_row(r));
+        new SplinePriorCost(num_params, r, 1, std::move(rows), fx, fy), nullptr,
+        knot_row(r));
   }
   for (int r = 1; r + 1 < kK; ++r) {
     std::vector<PriorRow> rows;
