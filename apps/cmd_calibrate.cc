@@ -76,6 +76,7 @@ constexpr char kUsage[] =
     "[--quiet | --verbose]\n"
     "                    [--options FILE]  (`puzzlecal options` writes one)\n"
     "                    [--fix NAMES] [--initial camera.yaml] [--same-focal]\n"
+    "                    [--knot-spacing-deg D]  (splined models)\n"
     "puzzlecal calibrate --watch DIR --board BOARD.yaml --out camera.yaml "
     "[--watch-idle S] [...]\n\n"
     "Calibrates a camera from every image in DIR (png, jpg, tif, bmp; 8 or 16 "
@@ -428,6 +429,15 @@ int ParseRequest(CalibrateRequest* request) {
   }
   request->calibration_options = request->options.calibration;
   if (FLAGS_same_focal) request->calibration_options.same_focal_length = true;
+  if (FLAGS_knot_spacing_deg != 0) {
+    request->calibration_options.spline_knot_spacing_deg =
+        FLAGS_knot_spacing_deg;
+    if (!request->calibration_options.Check(&error)) {
+      std::cerr << "puzzlecal calibrate: --knot-spacing-deg: " << error
+                << ".\n";
+      return kExitUsage;
+    }
+  }
   request->user_fixed = request->calibration_options.fixed_params;
   request->calibration_options.fixed_params.clear();
   if (const int code = ParseInitialCamera(request); code != kExitOk) {
@@ -945,7 +955,7 @@ PUZZLECAL_REGISTER_SUBCOMMAND(calibrate, "calibrate",
                               {"images", "board", "model", "out", "format",
                                "report", "threads", "rostopic", "camera_name",
                                "options", "fix", "initial", "same_focal",
-                               "watch", "watch_idle"},
+                               "knot_spacing_deg", "watch", "watch_idle"},
                               &RunCalibrate);
 
 }  // namespace

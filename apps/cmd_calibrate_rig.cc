@@ -52,7 +52,7 @@ constexpr char kUsage[] =
     "[--report DIR] [--threads N]\n"
     "                        [--options FILE] [--match_by_order] "
     "[--fix NAMES] [--initial NAME=FILE,...]\n"
-    "                        [--same-focal]\n\n"
+    "                        [--same-focal] [--knot-spacing-deg D]\n\n"
     "Calibrates a rig of cameras. DIR holds one subfolder per camera; sorted "
     "by name, the first\nis the reference camera (the rig frame). The same "
     "file name in different subfolders is the\nsame instant; a camera "
@@ -194,6 +194,16 @@ int ParseRigRequest(RigRequest* request) {
   if (FLAGS_same_focal) {
     request->options.calibration.same_focal_length = true;
     request->options.rig.camera.same_focal_length = true;
+  }
+  if (FLAGS_knot_spacing_deg != 0) {
+    request->options.calibration.spline_knot_spacing_deg =
+        FLAGS_knot_spacing_deg;
+    request->options.rig.camera.spline_knot_spacing_deg =
+        FLAGS_knot_spacing_deg;
+    if (!request->options.calibration.Check(&error)) {
+      std::cerr << kName << ": --knot-spacing-deg: " << error << ".\n";
+      return kExitUsage;
+    }
   }
   request->user_fixed = request->options.calibration.fixed_params;
   request->options.calibration.fixed_params.clear();
@@ -737,7 +747,8 @@ PUZZLECAL_REGISTER_SUBCOMMAND(
     calibrate_rig, "calibrate-rig",
     "calibrate a multi-camera rig from one photo folder per camera", kUsage,
     {"images", "board", "model", "out", "format", "report", "threads",
-     "options", "match_by_order", "quiet", "fix", "initial", "same_focal"},
+     "options", "match_by_order", "quiet", "fix", "initial", "same_focal",
+     "knot_spacing_deg"},
     &RunCalibrateRig);
 
 }  // namespace

@@ -48,6 +48,13 @@ DEFINE_bool(same_focal, false,
             "CALIB_FIX_ASPECT_RATIO with an aspect of 1); the options "
             "file's calibration.same_focal_length. calibrate-rig: every "
             "camera.");
+DEFINE_double(knot_spacing_deg, 0,
+              "A splined model's knot spacing, degrees of the equidistant "
+              "image: the 10x10 grid then reaches 3.5 times as far. 0: "
+              "from the data (the grid just covers the corners' field). "
+              "Wider is smoother; a spacing whose grid would not reach the "
+              "widest corner is refused. The options file's "
+              "calibration.spline_knot_spacing_deg.");
 DEFINE_bool(quiet, false, "Print only errors and what was written.");
 DEFINE_bool(verbose, false,
             "Print every image's outcome and the timings as well.");

@@ -22,6 +22,7 @@ DECLARE_string(options);
 DECLARE_string(fix);
 DECLARE_string(initial);
 DECLARE_bool(same_focal);
+DECLARE_double(knot_spacing_deg);
 
 DECLARE_bool(quiet);
 DECLARE_bool(verbose);

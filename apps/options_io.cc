@@ -235,7 +235,19 @@ struct Fields<CalibrationOptions> {
     v.Field("far_field_start_outlier_iterations",
             o.far_field_start_outlier_iterations);
     v.Field("far_field_start_max_views", o.far_field_start_max_views);
+    v.Group("spline_prior", o.spline_prior);
+    v.Field("spline_grid_margin", o.spline_grid_margin);
+    v.Field("spline_knot_spacing_deg", o.spline_knot_spacing_deg);
     v.Group("initialization", o.initialization);
+  }
+};
+
+template <>
+struct Fields<SplinePriorOptions> {
+  template <typename V, typename O>
+  static void Visit(V& v, O& o) {
+    v.Field("smoothness_weight", o.smoothness_weight);
+    v.Field("zero_weight", o.zero_weight);
   }
 };
 

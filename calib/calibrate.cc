@@ -12,7 +12,7 @@
 
 #include "calib/intrinsics_manifold.h"
 #include "calib/marginal_covariance.h"
-#include "calib/parallel_reprojection.h"
+#include "calib/parallel_costs.h"
 #include "calib/reprojection_error.h"
 #include "calib/splined_reprojection.h"
 #include "util/angles.h"
@@ -375,27 +375,28 @@ void ResetLoss(const CalibrationOptions& options,
 // `s->spline_cells` records).
 template <typename Model>
 void AddCornerCost(CalibrationState* s, size_t v, size_t i,
-                   ParallelReprojection<Model>* parallel) {
+                   ParallelCosts* parallel) {
   const CalibrationView& view = s->views[v];
   double* pose = s->poses[v].data();
+  ceres::CostFunction* cost = nullptr;
+  std::vector<double*> blocks;
   if constexpr (CameraModelIsSplinedModel<Model>()) {
     const Eigen::Vector3d point_cam =
         IsometryFromPoseBlock(pose) * view.board_points[i];
     const std::array<int, 2> cell =
         SplineCellOf<Model>(s->params.data(), point_cam);
     s->spline_cells.push_back(cell);
-    auto* cost = new SplinedReprojectionCost<Model>(view.board_points[i],
-                                                    view.image_points[i], cell);
-    s->problem->AddResidualBlock(cost, s->loss.get(),
-                                 cost->Blocks(s->params.data(), pose));
+    auto* splined = new SplinedReprojectionCost<Model>(
+        view.board_points[i], view.image_points[i], cell);
+    blocks = splined->Blocks(s->params.data(), pose);
+    cost = splined;
   } else {
-    ceres::CostFunction* cost =
-        parallel != nullptr
-            ? parallel->Add(view.board_points[i], view.image_points[i], pose)
-            : ReprojectionError<Model>::Create(view.board_points[i],
-                                               view.image_points[i]);
-    s->problem->AddResidualBlock(cost, s->loss.get(), s->params.data(), pose);
+    cost = ReprojectionError<Model>::Create(view.board_points[i],
+                                            view.image_points[i]);
+    blocks = {s->params.data(), pose};
   }
+  if (parallel != nullptr) cost = parallel->Add(cost, blocks);
+  s->problem->AddResidualBlock(cost, s->loss.get(), blocks);
 }
 
 // Holds the intrinsics `fixed` marks: per intrinsics block (IntrinsicsBlocks)
@@ -439,12 +440,9 @@ int BuildProblem(CalibrationState* s, const std::vector<bool>& fixed,
   s->evaluation.reset();
   s->spline_cells.clear();
   ResetLoss(s->options, &s->loss);
-  ParallelReprojection<Model>* parallel = nullptr;
-  // (A splined model's costs are already cheap; they are not cached.)
-  if (s->options.deterministic && s->options.num_threads > 1 &&
-      !CameraModelIsSplinedModel<Model>()) {
-    parallel = new ParallelReprojection<Model>(s->params.data(),
-                                               s->options.num_threads);
+  ParallelCosts* parallel = nullptr;
+  if (s->options.deterministic && s->options.num_threads > 1) {
+    parallel = new ParallelCosts(s->options.num_threads);
     s->evaluation.reset(parallel);
   }
   ceres::Problem::Options problem_options;
@@ -986,6 +984,42 @@ double SplineGridRadius(const Camera& camera,
   return margin * widest;
 }
 
+// The grid radius of a splined model over the views' corners as `camera`
+// (the start's far field) sees them: from the data (spline_grid_margin), or
+// from the asked knot spacing when the grid then reaches every corner.
+bool SplineGridFromOptions(const Camera& camera,
+                           const std::vector<CalibrationView>& views,
+                           const CalibrationOptions& options,
+                           CameraModelId start_model, CameraModelId model,
+                           double* radius, std::string* error) {
+  const double widest = SplineGridRadius(camera, views, 1.0);
+  if (!(widest > 0)) {
+    return Fail(std::string("no corner unprojects through the ") +
+                    CameraModelName(start_model) + " calibration that starts " +
+                    CameraModelName(model) +
+                    ", so its spline grid has no field to cover",
+                error);
+  }
+  const double cells = kSplineKnots - 3;
+  if (options.spline_knot_spacing_deg == 0) {
+    *radius = options.spline_grid_margin * widest;
+    return true;
+  }
+  *radius = options.spline_knot_spacing_deg * kDegree * cells / 2;
+  if (*radius < widest) {
+    return Fail(
+        StringPrintf("a knot spacing of %.1f deg gives the %dx%d spline grid "
+                     "a reach of +-%.1f deg, short of the corners seen out to "
+                     "%.1f deg (equidistant image): a spacing of at least "
+                     "%.1f deg covers them",
+                     options.spline_knot_spacing_deg, kSplineKnots,
+                     kSplineKnots, *radius / kDegree, widest / kDegree,
+                     2 * widest / cells / kDegree),
+        error);
+  }
+  return true;
+}
+
 // A model that StartModel gives another model for, without initial_params,
 // starts from that model's calibration: `options` gets initial_params (the
 // start's parameters by name, 0 for the rest, and a splined model's grid
@@ -1040,21 +1074,17 @@ bool StartFromSimplerModel(const std::vector<CalibrationView>& views,
   }
   std::string what_else;
   if (CameraModelIsSplined(model)) {
-    const double radius = SplineGridRadius(FarFieldCamera(result.camera), views,
-                                           options->spline_grid_margin);
-    if (!(radius > 0)) {
-      return Fail(std::string("no corner unprojects through the ") +
-                      CameraModelName(start_model) +
-                      " calibration that "
-                      "starts " +
-                      CameraModelName(model) +
-                      ", so its spline grid has no field to cover",
-                  error);
+    double radius = 0;
+    if (!SplineGridFromOptions(FarFieldCamera(result.camera), views, *options,
+                               start_model, model, &radius, error)) {
+      return false;
     }
     options->initial_params[KannalaBrandtSplinedModel::kGridRadiusIndex] =
         radius;
-    what_else += StringPrintf(", correction 0 on a grid over +-%.0f deg",
-                              radius / kDegree);
+    what_else += StringPrintf(
+        ", correction 0 on a grid over +-%.0f deg (knots %.1f deg apart%s)",
+        radius / kDegree, 2 * radius / (kSplineKnots - 3) / kDegree,
+        options->spline_knot_spacing_deg > 0 ? ", as asked" : "");
   }
   if (!CameraModelIsCentral(model) && CameraModelIsCentral(start_model)) {
     what_else += ", pupil shift 0";
@@ -1183,6 +1213,15 @@ bool CalibrationOptions::Check(std::string* why) const {
   if (!(max_rms_px > 0)) return Fail("max_rms_px must be > 0", why);
   if (!(spline_grid_margin >= 1)) {
     return Fail("spline_grid_margin must be >= 1", why);
+  }
+  const double widest_spacing_deg = 360.0 / (kSplineKnots - 3);
+  if (!(spline_knot_spacing_deg == 0 ||
+        (spline_knot_spacing_deg >= 1 &&
+         spline_knot_spacing_deg <= widest_spacing_deg))) {
+    return Fail(StringPrintf("spline_knot_spacing_deg must be 0 (from the "
+                             "data) or in [1, %.1f] degrees",
+                             widest_spacing_deg),
+                why);
   }
   if (!spline_prior.Check(why)) return false;
   return initialization.Check(why);

@@ -118,7 +118,7 @@ struct CalibrationOptions {
   double covariance_min_eigenvalue_ratio = 1e-14;
   // Threads. With `deterministic` (the default) they evaluate the corners'
   // residuals and Jacobians ahead of a single-threaded Ceres solve, each
-  // corner into its own slot (calib/parallel_reprojection.h), so the result
+  // corner into its own slot (calib/parallel_costs.h), so the result
   // is bit for bit the same for any count. Without it they go to Ceres's
   // solve and ceres::Covariance, which sum in the order the threads finish
   // and change the last bits from run to run. Default 1. >= 1.
@@ -176,6 +176,16 @@ struct CalibrationOptions {
   // the outermost corners are inside the grid rather than on its edge.
   // Unused when initial_params gives grid_radius. Default 1.05. >= 1.
   double spline_grid_margin = 1.05;
+  // The knot spacing of a splined model, in degrees of the equidistant image
+  // (0: from the data, as spline_grid_margin says). The grid has a fixed
+  // count of knots (kSplineKnots per side, kSplineKnots - 3 cells), so a
+  // spacing sets its radius, (kSplineKnots - 3) / 2 times the spacing. A
+  // spacing wider than the data's makes the correction smoother, its outer
+  // cells then seen by fewer corners (the prior decides there); one so fine
+  // that the grid would not reach the widest corner is refused (the grid
+  // holds its edge value beyond). Unused when initial_params gives
+  // grid_radius. Default 0. 0, or in [1, 360 / (kSplineKnots - 3)].
+  double spline_knot_spacing_deg = 0;
 
   InitializationOptions initialization;
 

@@ -914,6 +914,20 @@ TEST_F(BadInputTest, BadFlagsExitTwoAndNameTheFlag) {
   }
 }
 
+// A knot spacing out of range is a usage error that names the flag and the
+// range, before any photo is read.
+TEST_F(BadInputTest, KnotSpacingOutOfRangeIsAUsageError) {
+  const fs::path out = case_dir_ / "camera.yaml";
+  for (const char* spacing : {"0.5", "60"}) {
+    const ProgramRun run = Calibrate(
+        *root_ / "good", out, std::string("--knot-spacing-deg ") + spacing);
+    EXPECT_EQ(run.exit_code, kExitUsage) << run.all();
+    EXPECT_NE(run.err.find("--knot-spacing-deg"), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find("[1, 51.4]"), std::string::npos) << run.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 // The output goes to a missing folder, below a regular file, or (when not
 // root) into a read-only folder: output error, nothing half-written.
 TEST_F(BadInputTest, UnwritableOutput) {

@@ -399,7 +399,7 @@ std::string ReadAll(const std::string& path) {
 }
 
 // Threads that evaluate the corners ahead of the solve
-// (calib/parallel_reprojection.h) leave every output bit unchanged: the
+// (calib/parallel_costs.h) leave every output bit unchanged: the
 // camera file, the residuals and the inlier flags of a scene with gross
 // outliers (several rejection rounds) are those of one thread.
 TEST(CalibrateTest, CameraFileIsByteIdenticalForOneAndTwoThreads) {

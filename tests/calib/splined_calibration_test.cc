@@ -21,6 +21,7 @@
 #include "sim/synthetic_views.h"
 #include "tests/calib/scenes.h"
 #include "tests/support/draws.h"
+#include "util/angles.h"
 
 namespace puzzlecal {
 namespace {
@@ -69,6 +70,57 @@ TEST(SplinedCalibration, GridCoversTheObservedFieldAndIsNotEstimated) {
   EXPECT_NE(result.initialization_method.find("grid over"), std::string::npos);
 }
 
+// An asked knot spacing sets the grid's reach (3.5 spacings for 10 knots)
+// when the grid then covers every corner, and is refused, with the spacing
+// that would, when it does not.
+TEST(SplinedCalibration, AskedKnotSpacingSetsTheGridOrIsRefusedWithWhy) {
+  const sim::SyntheticData data = BumpyData(12, 12);
+  const Camera truth = sim::TruthBumpyFisheye();
+  CalibrationOptions options;
+  options.spline_knot_spacing_deg = 40;
+  CalibrationResult result;
+  std::string error;
+  ASSERT_TRUE(Calibrate(data.views, CameraModelId::kKannalaBrandtSplined,
+                        truth.width, truth.height, options, &result, &error))
+      << error;
+  const int grid = KannalaBrandtSplinedModel::kGridRadiusIndex;
+  EXPECT_DOUBLE_EQ(result.camera.params[grid], 3.5 * 40 * kDegree);
+  EXPECT_NE(result.initialization_method.find("40.0 deg apart, as asked"),
+            std::string::npos)
+      << result.initialization_method;
+  // The corners reach about 90 degrees (a 180-degree lens): 10-degree knots
+  // reach 35.
+  options.spline_knot_spacing_deg = 10;
+  EXPECT_FALSE(Calibrate(data.views, CameraModelId::kKannalaBrandtSplined,
+                         truth.width, truth.height, options, &result, &error));
+  EXPECT_NE(error.find("knot spacing of 10.0 deg"), std::string::npos) << error;
+  EXPECT_NE(error.find("covers them"), std::string::npos) << error;
+}
+
+// Threads evaluate the splined corners' costs ahead of the solve
+// (calib/parallel_costs.h): every output bit is that of one thread,
+// through the cell re-checks and the covariance.
+TEST(SplinedCalibration, ResultIsBitIdenticalForOneAndTwoThreads) {
+  const sim::SyntheticData data = BumpyData(14, 12);
+  const Camera truth = sim::TruthBumpyFisheye();
+  std::vector<CalibrationResult> results(2);
+  for (int threads : {1, 2}) {
+    CalibrationOptions options;
+    options.num_threads = threads;
+    std::string error;
+    ASSERT_TRUE(Calibrate(
+        data.views, CameraModelId::kKannalaBrandtSplinedNoncentral, truth.width,
+        truth.height, options, &results[threads - 1], &error))
+        << error;
+  }
+  ASSERT_TRUE(results[0].covariance_ok);
+  EXPECT_EQ(results[0].camera.params, results[1].camera.params);
+  EXPECT_EQ(results[0].param_stddev, results[1].param_stddev);
+  EXPECT_EQ(results[0].inlier, results[1].inlier);
+  EXPECT_EQ(results[0].iterations, results[1].iterations);
+  EXPECT_EQ(results[0].residuals, results[1].residuals);
+}
+
 // Where no corner was seen (the grid is square, the observed field round)
 // the prior decides: every control value stays finite and small, and the
 // covariance of all 209 parameters exists.
@@ -104,6 +156,12 @@ TEST(SplinedCalibration, OptionsAreChecked) {
   options = CalibrationOptions();
   options.spline_grid_margin = 0.9;
   EXPECT_FALSE(options.Check(&why));
+  for (double spacing : {-1.0, 0.5, 52.0}) {
+    options = CalibrationOptions();
+    options.spline_knot_spacing_deg = spacing;
+    EXPECT_FALSE(options.Check(&why)) << spacing;
+    EXPECT_NE(why.find("spline_knot_spacing_deg"), std::string::npos) << why;
+  }
   // A given start without a grid radius is refused, by name.
   const sim::SyntheticData data = BumpyData(14, 8);
   const Camera truth = sim::TruthBumpyFisheye();
@@ -226,9 +284,9 @@ TEST(SplinePrior, OnKnotRowsItIsTheWholeBlocksPrior) {
     }
   }
   const Eigen::MatrixXd information = jacobian.transpose() * jacobian;
-  const Eigen::MatrixXd expected = whole_information.block(
-      Model::kSplineBegin, Model::kSplineBegin, 2 * kSplineValues,
-      2 * kSplineValues);
+  const Eigen::MatrixXd expected =
+      whole_information.block(Model::kSplineBegin, Model::kSplineBegin,
+                              2 * kSplineValues, 2 * kSplineValues);
   EXPECT_LT((information - expected).norm(), 1e-9 * expected.norm());
   EXPECT_GT(expected.norm(), 0.0);
 
