@@ -22,16 +22,8 @@ bool ReprojectionCost<Model>::Evaluate(double const* const* parameters,
       (jacobians[0] == nullptr && jacobians[1] == nullptr)) {
     return functor_(intrinsics, pose, residuals);
   }
-  // d p / d w, 3 wide.
-  using RotationJet = ceres::Jet<double, 3>;
-  const RotationJet w[3] = {RotationJet(pose[0], 0), RotationJet(pose[1], 1),
-                            RotationJet(pose[2], 2)};
-  const Eigen::Vector3d& board_point = functor_.board_point();
-  const RotationJet x[3] = {RotationJet(board_point.x()),
-                            RotationJet(board_point.y()),
-                            RotationJet(board_point.z())};
-  RotationJet rotated[3];
-  ceres::AngleAxisRotatePoint(w, x, rotated);
+  // p and d p / d w, 3 wide.
+  const TurnedBoardPoint turned = TurnBoardPoint(pose, functor_.board_point());
   // d pixel / d (intrinsics, p), N + 3 wide.
   using ProjectionJet = ceres::Jet<double, kNumParams + 3>;
   ProjectionJet params[kNumParams];
@@ -40,7 +32,7 @@ bool ReprojectionCost<Model>::Evaluate(double const* const* parameters,
   }
   ProjectionJet point_cam[3];
   for (int j = 0; j < 3; ++j) {
-    point_cam[j] = ProjectionJet(rotated[j].a + pose[3 + j], kNumParams + j);
+    point_cam[j] = ProjectionJet(turned.point(j) + pose[3 + j], kNumParams + j);
   }
   ProjectionJet pixel[2];
   if (!Model::Project(params, point_cam, pixel)) return false;
@@ -54,15 +46,11 @@ bool ReprojectionCost<Model>::Evaluate(double const* const* parameters,
       }
     }
     if (jacobians[1] != nullptr) {
-      double* row = jacobians[1] + r * kPoseBlockSize;
-      for (int c = 0; c < 3; ++c) {
-        double sum = 0;
-        for (int j = 0; j < 3; ++j) {
-          sum += pixel[r].v[kNumParams + j] * rotated[j].v[c];
-        }
-        row[c] = sum;
-        row[3 + c] = pixel[r].v[kNumParams + c];
-      }
+      const double d_pixel_d_point[3] = {pixel[r].v[kNumParams],
+                                         pixel[r].v[kNumParams + 1],
+                                         pixel[r].v[kNumParams + 2]};
+      PoseJacobianRow(d_pixel_d_point, turned,
+                      jacobians[1] + r * kPoseBlockSize);
     }
   }
   return true;

@@ -25,6 +25,37 @@ Eigen::Isometry3d IsometryFromPoseBlock(const double* pose) {
   return result;
 }
 
+TurnedBoardPoint TurnBoardPoint(const double* angle_axis,
+                                const Eigen::Vector3d& board_point) {
+  using RotationJet = ceres::Jet<double, 3>;
+  const RotationJet w[3] = {RotationJet(angle_axis[0], 0),
+                            RotationJet(angle_axis[1], 1),
+                            RotationJet(angle_axis[2], 2)};
+  const RotationJet x[3] = {RotationJet(board_point.x()),
+                            RotationJet(board_point.y()),
+                            RotationJet(board_point.z())};
+  RotationJet turned[3];
+  ceres::AngleAxisRotatePoint(w, x, turned);
+  TurnedBoardPoint result;
+  for (int j = 0; j < 3; ++j) {
+    result.point(j) = turned[j].a;
+    result.d_point_d_w.row(j) = turned[j].v.transpose();
+  }
+  return result;
+}
+
+void PoseJacobianRow(const double* d_residual_d_point,
+                     const TurnedBoardPoint& turned, double* row) {
+  for (int c = 0; c < 3; ++c) {
+    double sum = 0;
+    for (int j = 0; j < 3; ++j) {
+      sum += d_residual_d_point[j] * turned.d_point_d_w(j, c);
+    }
+    row[c] = sum;
+    row[3 + c] = d_residual_d_point[c];
+  }
+}
+
 template class ReprojectionCost<PinholeRadtanModel>;
 template class ReprojectionCost<PinholeRationalModel>;
 template class ReprojectionCost<KannalaBrandtModel>;

@@ -26,6 +26,24 @@ using PoseBlock = std::array<double, kPoseBlockSize>;
 PoseBlock PoseBlockFromIsometry(const Eigen::Isometry3d& transform);
 Eigen::Isometry3d IsometryFromPoseBlock(const double* pose);
 
+// A board point turned by a pose block's rotation (its angle-axis, the
+// first 3 values), with the derivatives of the turned point by the
+// angle-axis: the rotation's share of the chain rule that the costs take
+// through the camera-frame point (they differentiate the projection by the
+// point only, 3-wide instead of 6).
+struct TurnedBoardPoint {
+  Eigen::Vector3d point;        // R(w) X
+  Eigen::Matrix3d d_point_d_w;  // d point / d w
+};
+TurnedBoardPoint TurnBoardPoint(const double* angle_axis,
+                                const Eigen::Vector3d& board_point);
+
+// The 6 values of a pose block's Jacobian row (d/dw, then d/dt) of a
+// residual whose derivative by the camera-frame point is `d_residual_d_point`
+// (3 values), the point being the turned point plus the translation.
+void PoseJacobianRow(const double* d_residual_d_point,
+                     const TurnedBoardPoint& turned, double* row);
+
 template <typename Model>
 class ReprojectionError {
  public:

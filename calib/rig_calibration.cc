@@ -56,18 +56,11 @@ class RigReprojectionCost : public ceres::CostFunction {
     const double* cam_from_rig = parameters[1];
     const double* rig_from_board = parameters[2];
     // p and d p / d w_f, 3 wide.
-    using RotationJet = ceres::Jet<double, 3>;
-    const RotationJet w[3] = {RotationJet(rig_from_board[0], 0),
-                              RotationJet(rig_from_board[1], 1),
-                              RotationJet(rig_from_board[2], 2)};
-    const RotationJet x[3] = {RotationJet(board_point_.x()),
-                              RotationJet(board_point_.y()),
-                              RotationJet(board_point_.z())};
-    RotationJet rotated[3];
-    ceres::AngleAxisRotatePoint(w, x, rotated);
-    const Eigen::Vector3d point_rig(rotated[0].a + rig_from_board[3],
-                                    rotated[1].a + rig_from_board[4],
-                                    rotated[2].a + rig_from_board[5]);
+    const TurnedBoardPoint turned =
+        TurnBoardPoint(rig_from_board, board_point_);
+    const Eigen::Vector3d point_rig =
+        turned.point + Eigen::Vector3d(rig_from_board[3], rig_from_board[4],
+                                       rig_from_board[5]);
     const bool want = jacobians != nullptr &&
                       (jacobians[0] != nullptr || jacobians[1] != nullptr ||
                        jacobians[2] != nullptr);
@@ -101,13 +94,7 @@ class RigReprojectionCost : public ceres::CostFunction {
             d_point[j] += d_cam[r * kPoseBlockSize + 3 + k] * r_c[j * 3 + k];
           }
         }
-        double* row = jacobians[2] + r * kPoseBlockSize;
-        for (int c = 0; c < 3; ++c) {
-          double sum = 0;
-          for (int j = 0; j < 3; ++j) sum += d_point[j] * rotated[j].v[c];
-          row[c] = sum;
-          row[3 + c] = d_point[c];
-        }
+        PoseJacobianRow(d_point, turned, jacobians[2] + r * kPoseBlockSize);
       }
     }
     return true;

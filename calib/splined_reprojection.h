@@ -115,15 +115,8 @@ class SplinedReprojectionCost : public ceres::CostFunction {
       residuals[1] = pixel[1] - observed_.y();
       return true;
     }
-    // d p / d w, 3 wide (as ReprojectionCost).
-    using RotationJet = ceres::Jet<double, 3>;
-    const RotationJet w[3] = {RotationJet(pose[0], 0), RotationJet(pose[1], 1),
-                              RotationJet(pose[2], 2)};
-    const RotationJet x[3] = {RotationJet(board_point_.x()),
-                              RotationJet(board_point_.y()),
-                              RotationJet(board_point_.z())};
-    RotationJet rotated[3];
-    ceres::AngleAxisRotatePoint(w, x, rotated);
+    // p and d p / d w, 3 wide (as ReprojectionCost).
+    const TurnedBoardPoint turned = TurnBoardPoint(pose, board_point_);
     using Jet = ceres::Jet<double, kJetWidth>;
     Jet jet_base[kBase];
     for (int k = 0; k < kBase; ++k) jet_base[k] = Jet(base[k], k);
@@ -134,7 +127,7 @@ class SplinedReprojectionCost : public ceres::CostFunction {
     constexpr int kPointBegin = kBase + kPupilSize;
     Jet point[3];
     for (int j = 0; j < 3; ++j) {
-      point[j] = Jet(rotated[j].a + pose[3 + j], kPointBegin + j);
+      point[j] = Jet(turned.point(j) + pose[3 + j], kPointBegin + j);
     }
     Jet pixel[2];
     if (!ProjectInCell(jet_base, jet_pupil, parameters, point, pixel)) {
@@ -149,15 +142,11 @@ class SplinedReprojectionCost : public ceres::CostFunction {
         }
       }
       if (jacobians[1] != nullptr) {
-        double* row = jacobians[1] + r * kPoseBlockSize;
-        for (int c = 0; c < 3; ++c) {
-          double sum = 0;
-          for (int j = 0; j < 3; ++j) {
-            sum += pixel[r].v[kPointBegin + j] * rotated[j].v[c];
-          }
-          row[c] = sum;
-          row[3 + c] = pixel[r].v[kPointBegin + c];
-        }
+        const double d_pixel_d_point[3] = {pixel[r].v[kPointBegin],
+                                           pixel[r].v[kPointBegin + 1],
+                                           pixel[r].v[kPointBegin + 2]};
+        PoseJacobianRow(d_pixel_d_point, turned,
+                        jacobians[1] + r * kPoseBlockSize);
       }
       if (kPupilSize > 0 && jacobians[kPupilBlock] != nullptr) {
         for (int k = 0; k < kPupilSize; ++k) {
