@@ -46,7 +46,16 @@ Eigen::MatrixXd FreeBlock(const Eigen::MatrixXd& full,
 // The samples of the judged field: each pixel's gauged projection Jacobian
 // over the free parameters (evidence/evidence.h), and its field angle.
 struct FieldSamples {
-  std::vector<Eigen::MatrixXd> jacobian;  // 2 x free
+  // Each sample's d pixel / d (free parameters) is jacobian - rotation *
+  // gauge (evidence's ProjectionJacobian): `jacobian` kept as its non-zero
+  // columns only (2 x columns[s].size()), since a splined model's pixel
+  // depends on the 16 knots around it, a fifth of its parameters, and the
+  // uncertainty at every sample for every candidate is most of the
+  // advice's work; `gauge` (3 x free, or empty) is shared by the samples.
+  std::vector<Eigen::MatrixXd> jacobian;
+  std::vector<std::vector<int>> columns;  // free-parameter indices
+  std::vector<Eigen::Matrix<double, 2, 3>> rotation;
+  Eigen::MatrixXd gauge;
   std::vector<double> angle_deg;
   double field_deg = 0;
 };
@@ -132,17 +141,31 @@ FieldSamples MakeFieldSamples(const Camera& camera,
   }
   const Eigen::MatrixXd gauge = RotationGauge(camera, step, out.field_deg);
   std::vector<double> angles;
+  if (gauge.size() > 0) {
+    out.gauge.resize(3, free.size());
+    for (size_t k = 0; k < free.size(); ++k) {
+      out.gauge.col(k) = gauge.col(free[k]);
+    }
+  }
   for (size_t s = 0; s < pixels.size(); ++s) {
     Eigen::MatrixXd full;
-    if (!ProjectionJacobian(camera, pixels[s], gauge.size() ? &gauge : nullptr,
-                            &full)) {
+    Eigen::Matrix<double, 2, 3> rotation;
+    if (!ProjectionJacobianParts(camera, pixels[s], &full, &rotation)) {
       continue;
     }
-    Eigen::MatrixXd jacobian(2, free.size());
+    std::vector<int> columns;
     for (size_t k = 0; k < free.size(); ++k) {
-      jacobian.col(k) = full.col(free[k]);
+      if (full.col(free[k]).cwiseAbs().maxCoeff() > 0) {
+        columns.push_back(static_cast<int>(k));
+      }
+    }
+    Eigen::MatrixXd jacobian(2, columns.size());
+    for (size_t k = 0; k < columns.size(); ++k) {
+      jacobian.col(k) = full.col(free[columns[k]]);
     }
     out.jacobian.push_back(jacobian);
+    out.columns.push_back(std::move(columns));
+    out.rotation.push_back(rotation);
     angles.push_back(out.angle_deg[s]);
   }
   out.angle_deg = angles;
@@ -155,12 +178,43 @@ FieldUncertainty Evaluate(const FieldSamples& samples,
   const size_t count = samples.jacobian.size();
   if (count == 0) return out;
   std::vector<double> sigma(count);
+  // With the gauge, the sample's covariance J C J' for J = j - r G is
+  // j C j' - j (C G') r' - r (G C) j' + r (G C G') r', j sparse.
+  const Eigen::MatrixXd covariance_gauge =
+      samples.gauge.size() > 0
+          ? Eigen::MatrixXd(covariance.selfadjointView<Eigen::Lower>() *
+                            samples.gauge.transpose())
+          : Eigen::MatrixXd();
+  const Eigen::Matrix3d gauge_covariance_gauge =
+      samples.gauge.size() > 0
+          ? Eigen::Matrix3d(samples.gauge * covariance_gauge)
+          : Eigen::Matrix3d::Zero();
+  Eigen::MatrixXd block, block_gauge;
   for (size_t s = 0; s < count; ++s) {
     const Eigen::MatrixXd& j = samples.jacobian[s];
-    sigma[s] = std::sqrt(std::max(
-        0.0,
-        0.5 * (j * covariance.selfadjointView<Eigen::Lower>() * j.transpose())
-                  .trace()));
+    const std::vector<int>& columns = samples.columns[s];
+    const int m = static_cast<int>(columns.size());
+    // The covariance's block over the sample's columns (from its lower
+    // triangle), and those rows of C G'.
+    block.resize(m, m);
+    for (int a = 0; a < m; ++a) {
+      for (int b = 0; b <= a; ++b) {
+        block(a, b) = block(b, a) = covariance(
+            std::max(columns[a], columns[b]), std::min(columns[a], columns[b]));
+      }
+    }
+    Eigen::Matrix2d pixel_covariance = j * block * j.transpose();
+    if (samples.gauge.size() > 0) {
+      block_gauge.resize(m, 3);
+      for (int a = 0; a < m; ++a) {
+        block_gauge.row(a) = covariance_gauge.row(columns[a]);
+      }
+      const Eigen::Matrix<double, 2, 3>& r = samples.rotation[s];
+      const Eigen::Matrix2d cross = j * block_gauge * r.transpose();
+      pixel_covariance += -cross - cross.transpose() +
+                          r * gauge_covariance_gauge * r.transpose();
+    }
+    sigma[s] = std::sqrt(std::max(0.0, 0.5 * pixel_covariance.trace()));
   }
   out.worst_px = *std::max_element(sigma.begin(), sigma.end());
   out.median_px = Median(sigma);

@@ -222,6 +222,14 @@ bool ProjectionJacobian(const Camera& camera, const Eigen::Vector2d& pixel,
   return true;
 }
 
+bool ProjectionJacobianParts(const Camera& camera, const Eigen::Vector2d& pixel,
+                             Eigen::MatrixXd* jacobian,
+                             Eigen::Matrix<double, 2, 3>* rotation) {
+  const int n = CameraModelNumParams(camera.model);
+  if (static_cast<int>(camera.params.size()) != n) return false;
+  return PixelJacobians(camera, pixel, jacobian, rotation);
+}
+
 bool ProjectionCovariance(const Camera& camera,
                           const Eigen::MatrixXd& covariance,
                           const Eigen::Vector2d& pixel, Eigen::Matrix2d* cov,

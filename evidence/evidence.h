@@ -247,6 +247,15 @@ bool ProjectionJacobian(const Camera& camera, const Eigen::Vector2d& pixel,
                         const Eigen::MatrixXd* gauge,
                         Eigen::MatrixXd* jacobian);
 
+// The two parts of that Jacobian: d pixel / d intrinsics with the ray held
+// fixed (2 x n; a splined model's is zero outside the knots around the
+// pixel), and d pixel / d omega for a small rotation omega of the ray (2 x
+// 3): ProjectionJacobian is jacobian - rotation * gauge. False when the
+// pixel has no ray.
+bool ProjectionJacobianParts(const Camera& camera, const Eigen::Vector2d& pixel,
+                             Eigen::MatrixXd* jacobian,
+                             Eigen::Matrix<double, 2, 3>* rotation);
+
 // M = (sum G^T G)^-1 sum G^T J over the grid pixels of `camera` whose ray is
 // at most max_angle_deg off the axis (see ProjectionUncertainty): the
 // rotation that best undoes a parameter change. Empty when not formed.
