@@ -79,6 +79,11 @@ ceres::CostFunction* ParallelCosts::Add(ceres::CostFunction* cost,
   slot.cost.reset(cost);
   slot.blocks = blocks;
   slot.values.resize(ValuesSize(*cost));
+  double* next = slot.values.data() + cost->num_residuals();
+  for (int block_size : cost->parameter_block_sizes()) {
+    slot.jacobians.push_back(next);
+    next += static_cast<size_t>(cost->num_residuals()) * block_size;
+  }
   slots_.push_back(std::move(slot));
   return new Cached(this, slots_.size() - 1);
 }
@@ -96,17 +101,9 @@ void ParallelCosts::PrepareForEvaluation(bool evaluate_jacobians,
 
 void ParallelCosts::EvaluateSlot(size_t index, bool evaluate_jacobians) {
   Slot& slot = slots_[index];
-  const int num_residuals = slot.cost->num_residuals();
-  const std::vector<int32_t>& sizes = slot.cost->parameter_block_sizes();
-  std::vector<double*> jacobians(sizes.size());
-  double* next = slot.values.data() + num_residuals;
-  for (size_t k = 0; k < sizes.size(); ++k) {
-    jacobians[k] = next;
-    next += static_cast<size_t>(num_residuals) * sizes[k];
-  }
   slot.ok =
       slot.cost->Evaluate(slot.blocks.data(), slot.values.data(),
-                          evaluate_jacobians ? jacobians.data() : nullptr);
+                          evaluate_jacobians ? slot.jacobians.data() : nullptr);
 }
 
 }  // namespace puzzlecal

@@ -44,6 +44,8 @@ class ParallelCosts : public ceres::EvaluationCallback {
     std::vector<double*> blocks;
     // The residuals, then each block's row-major Jacobian.
     std::vector<double> values;
+    // Where each block's Jacobian starts in `values`.
+    std::vector<double*> jacobians;
     bool ok = false;
   };
   class Cached;

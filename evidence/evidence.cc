@@ -209,25 +209,24 @@ int GridStep(const Camera& camera, const EvidenceOptions& options) {
   return std::max(1, step);
 }
 
-bool ProjectionJacobian(const Camera& camera, const Eigen::Vector2d& pixel,
-                        const Eigen::MatrixXd* gauge,
-                        Eigen::MatrixXd* jacobian) {
-  const int n = CameraModelNumParams(camera.model);
-  if (static_cast<int>(camera.params.size()) != n) return false;
-  Eigen::Matrix<double, 2, 3> g;
-  if (!PixelJacobians(camera, pixel, jacobian, &g)) return false;
-  if (gauge != nullptr && gauge->rows() == 3 && gauge->cols() == n) {
-    *jacobian -= g * *gauge;
-  }
-  return true;
-}
-
 bool ProjectionJacobianParts(const Camera& camera, const Eigen::Vector2d& pixel,
                              Eigen::MatrixXd* jacobian,
                              Eigen::Matrix<double, 2, 3>* rotation) {
   const int n = CameraModelNumParams(camera.model);
   if (static_cast<int>(camera.params.size()) != n) return false;
   return PixelJacobians(camera, pixel, jacobian, rotation);
+}
+
+bool ProjectionJacobian(const Camera& camera, const Eigen::Vector2d& pixel,
+                        const Eigen::MatrixXd* gauge,
+                        Eigen::MatrixXd* jacobian) {
+  Eigen::Matrix<double, 2, 3> g;
+  if (!ProjectionJacobianParts(camera, pixel, jacobian, &g)) return false;
+  const int n = CameraModelNumParams(camera.model);
+  if (gauge != nullptr && gauge->rows() == 3 && gauge->cols() == n) {
+    *jacobian -= g * *gauge;
+  }
+  return true;
 }
 
 bool ProjectionCovariance(const Camera& camera,
