@@ -912,6 +912,11 @@ std::string Advice::Text() const {
     out << "the advised kind of photo alone does not reach the target "
            "uncertainty within the estimate's limit\n";
   }
+  out << StringPrintf(
+      "(predicted with the corner noise of the photos taken, %.3f px; a "
+      "steeply tilted or close board usually gives noisier corners, and "
+      "the calibration's figures then grow in proportion)\n",
+      noise_sigma_px);
   return out.str();
 }
 

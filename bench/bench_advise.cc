@@ -81,10 +81,25 @@ FieldUncertainty UncertaintyOf(const CalibrationResult& result,
   return PredictFieldUncertainty(result.camera, free, covariance, options);
 }
 
+// The corner noise the calibration's covariance is scaled by (its inlier
+// RMS with the fitted parameters' share restored), which the advice's
+// prediction takes from the views it starts from.
+double StatedNoise(const CalibrationResult& result) {
+  int free = 0, poses = 0;
+  for (bool fixed : result.param_fixed) free += fixed ? 0 : 1;
+  for (bool used : result.view_used) poses += used ? 6 : 0;
+  const double corners = result.num_corners_used;
+  return result.rms_px * std::sqrt(2 * corners / (2 * corners - free - poses));
+}
+
+// Whether the verdict is good; `reason` gets its reason otherwise (quotes
+// made single for the JSON).
 bool VerdictGood(const std::vector<CalibrationView>& views,
-                 const CalibrationResult& result) {
+                 const CalibrationResult& result, std::string* reason) {
   const Judgement judgement =
       JudgeCalibration(views, result, CalibrationOptions(), JudgementOptions());
+  *reason = judgement.verdict.reason;
+  std::replace(reason->begin(), reason->end(), '"', '\'');
   return judgement.verdict.kind == VerdictKind::kGood;
 }
 
@@ -133,10 +148,11 @@ void RunLens(const Lens& lens, bool last) {
         "%s\n     {\"words\": \"%s\", \"detected\": %s, "
         "\"predicted_worst_px\": %.4f, \"recalibrated_worst_px\": %.4f, "
         "\"predicted_median_px\": %.4f, \"recalibrated_median_px\": %.4f, "
-        "\"recalibrated_rms_px\": %.4f}",
+        "\"recalibrated_rms_px\": %.4f, \"recalibrated_noise_px\": %.4f}",
         k ? "," : "", advice.views[k].words.c_str(),
         added.empty() ? "false" : "true", advice.views[k].after.worst_px,
-        u.worst_px, advice.views[k].after.median_px, u.median_px, again.rms_px);
+        u.worst_px, advice.views[k].after.median_px, u.median_px, again.rms_px,
+        StatedNoise(again));
   }
   std::printf("],\n");
   std::vector<double> random_worst;
@@ -164,7 +180,10 @@ void RunLens(const Lens& lens, bool last) {
   std::vector<CalibrationView> growing = views;
   CalibrationResult current = result;
   int photos = static_cast<int>(growing.size());
-  bool good = VerdictGood(growing, current);
+  // The verdict's reason when the photos the advice estimated are not
+  // enough.
+  std::string reason, reason_at_estimate;
+  bool good = VerdictGood(growing, current, &reason);
   AdviceOptions one = AdviceOptions();
   one.count = 1;
   while (!good && photos < 40) {
@@ -175,10 +194,15 @@ void RunLens(const Lens& lens, bool last) {
     growing.insert(growing.end(), added.begin(), added.end());
     ++photos;
     if (!Recalibrate(lens, growing, &current)) break;
-    good = VerdictGood(growing, current);
+    good = VerdictGood(growing, current, &reason);
+    if (!good && photos == advice.photos_to_target) reason_at_estimate = reason;
   }
-  std::printf("   \"photos_until_good\": %d, \"good\": %s}%s\n", photos,
-              good ? "true" : "false", last ? "" : ",");
+  std::printf(
+      "   \"photos_until_good\": %d, \"good\": %s, "
+      "\"verdict_at_estimate\": \"%s\"}%s\n",
+      photos, good ? "true" : "false",
+      reason_at_estimate.empty() ? "good" : reason_at_estimate.c_str(),
+      last ? "" : ",");
 }
 
 double AdviceSecondsOn30Views() {

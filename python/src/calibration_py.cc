@@ -393,6 +393,8 @@ void BindCalibration(py::module_& m) {
             advice_options.target_uncertainty_px =
                 options.verdict.max_uncertainty_px;
             advice_options.target_min_views = options.verdict.min_views;
+            // The prior the calibration had (as the program's advice).
+            advice_options.spline_prior = options.calibration.spline_prior;
             std::string why;
             if (!advice_options.Check(&why)) Raise("advise: " + why);
             Advice advice;

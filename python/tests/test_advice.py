@@ -82,3 +82,35 @@ def test_bad_count_is_refused(advice):
     calibration, _ = advice
     with pytest.raises(ValueError, match="count must be >= 1"):
         calibration.advise(count=0)
+
+
+def test_advice_on_a_splined_camera_keeps_the_prior_the_options_give(
+        start, board, program, tmp_path):
+    """A splined camera's advice holds the knots no corner saw with the
+    smoothness prior its calibration had: the one the options give (as
+    `puzzlecal advise --options` does), not the default."""
+    stiff = {"spline_prior": {"smoothness_weight": 10.0, "zero_weight": 1.0}}
+    options = puzzlecal.options(calibration=stiff)
+    calibration = puzzlecal.calibrate(str(start), board,
+                                      model="kannala-brandt-splined",
+                                      options=options, threads=2)
+    mine = calibration.advise(count=1, options=options, threads=2)
+    default = calibration.advise(count=1, threads=2)
+    # A stiffer prior holds the unseen knots tighter: less uncertainty now.
+    assert mine["uncertainty_now"]["worst_px"] < \
+        0.9 * default["uncertainty_now"]["worst_px"]
+    options_file = tmp_path / "options.yaml"
+    options_file.write_text(yaml.safe_dump({"calibration": stiff}),
+                            encoding="utf-8")
+    out = tmp_path / "advice"
+    subprocess.run([program, "advise", "--images", str(start), "--board",
+                    str(BOARD_FILE), "--out", str(out), "--model",
+                    "kannala-brandt-splined", "--options", str(options_file),
+                    "--count", "1", "--threads", "2"],
+                   check=True, capture_output=True)
+    with open(out / "advice.yaml", encoding="utf-8") as f:
+        written = yaml.safe_load(f)
+    assert written["views"][0]["words"] == mine["views"][0]["words"]
+    assert written["views"][0]["expected_after"]["worst_px"] == \
+        pytest.approx(mine["views"][0]["expected_after"]["worst_px"],
+                      rel=1e-9)
