@@ -2,11 +2,7 @@
 
 #include <ceres/rotation.h>
 
-#include <algorithm>
-#include <vector>
-
 #include "calib/reprojection_cost_impl.h"
-#include "calib/splined_reprojection.h"
 
 namespace puzzlecal {
 
@@ -65,63 +61,6 @@ template class ReprojectionCost<PinholeRationalModel>;
 template class ReprojectionCost<KannalaBrandtModel>;
 template class ReprojectionCost<KannalaBrandtNoncentralModel>;
 
-namespace {
-
-// A splined model's reprojection through the cost of the point's spline
-// cell (calib/splined_reprojection.h): dual numbers over kannala-brandt's
-// part, the pupil and the point, and the 4 x 4 knots' B-spline weights
-// written directly, instead of dual numbers over all of the model's 200-odd
-// parameters; d_intrinsics is zero outside the cell's knots. The same
-// derivatives (ReprojectionCostTest compares them with automatic
-// differentiation), at a tenth of the cost: the capture advice and the
-// rig's joint solve take every splined corner's Jacobian through here.
-template <typename Model>
-bool EvaluateSplinedReprojection(const double* intrinsics, const double* pose,
-                                 const Eigen::Vector3d& board_point,
-                                 const Eigen::Vector2d& observed,
-                                 double* residual, double* d_intrinsics,
-                                 double* d_pose) {
-  using Cost = SplinedReprojectionCost<Model>;
-  const Eigen::Vector3d point_cam = IsometryFromPoseBlock(pose) * board_point;
-  const Cost cost(board_point, observed,
-                  SplineCellOf<Model>(intrinsics, point_cam));
-  // The cost's blocks point into the caller's vectors; it only reads them.
-  const std::vector<double*> blocks = cost.Blocks(
-      const_cast<double*>(intrinsics), const_cast<double*>(pose));
-  if (d_intrinsics == nullptr && d_pose == nullptr) {
-    return cost.Evaluate(blocks.data(), residual, nullptr);
-  }
-  double d_base[2 * Cost::kBase];
-  double d_knots[Cost::kNumKnotBlocks][2 * Cost::kKnotRowSize];
-  double d_pupil[2 * 2];
-  double d_pose_local[2 * kPoseBlockSize];
-  std::vector<double*> jacobians = {d_base,
-                                    d_pose != nullptr ? d_pose : d_pose_local};
-  for (auto& row : d_knots) jacobians.push_back(row);
-  if (Cost::kPupilSize > 0) jacobians.push_back(d_pupil);
-  if (!cost.Evaluate(blocks.data(), residual, jacobians.data())) return false;
-  if (d_intrinsics == nullptr) return true;
-  constexpr int n = Model::kNumParams;
-  std::fill(d_intrinsics, d_intrinsics + 2 * n, 0.0);
-  const int first_row = cost.cell()[0];
-  for (int r = 0; r < 2; ++r) {
-    double* row = d_intrinsics + r * n;
-    std::copy(d_base + r * Cost::kBase, d_base + (r + 1) * Cost::kBase, row);
-    for (int a = 0; a < Cost::kNumKnotBlocks; ++a) {
-      std::copy(d_knots[a] + r * Cost::kKnotRowSize,
-                d_knots[a] + (r + 1) * Cost::kKnotRowSize,
-                row + Model::kSplineBegin +
-                    Cost::kKnotRowSize * (first_row + a));
-    }
-    for (int k = 0; k < Cost::kPupilSize; ++k) {
-      row[Model::kPupilIndex + k] = d_pupil[r * Cost::kPupilSize + k];
-    }
-  }
-  return true;
-}
-
-}  // namespace
-
 bool EvaluateReprojection(CameraModelId model, const double* intrinsics,
                           const double* pose,
                           const Eigen::Vector3d& board_point,
@@ -129,17 +68,11 @@ bool EvaluateReprojection(CameraModelId model, const double* intrinsics,
                           double* d_intrinsics, double* d_pose) {
   return DispatchCameraModel(model, [&](auto m) {
     using Model = decltype(m);
-    if constexpr (CameraModelIsSplinedModel<Model>()) {
-      return EvaluateSplinedReprojection<Model>(intrinsics, pose, board_point,
-                                                observed, residual,
-                                                d_intrinsics, d_pose);
-    } else {
-      const ReprojectionCost<Model> cost(board_point, observed);
-      const double* parameters[2] = {intrinsics, pose};
-      double* jacobians[2] = {d_intrinsics, d_pose};
-      const bool any = d_intrinsics != nullptr || d_pose != nullptr;
-      return cost.Evaluate(parameters, residual, any ? jacobians : nullptr);
-    }
+    const ReprojectionCost<Model> cost(board_point, observed);
+    const double* parameters[2] = {intrinsics, pose};
+    double* jacobians[2] = {d_intrinsics, d_pose};
+    const bool any = d_intrinsics != nullptr || d_pose != nullptr;
+    return cost.Evaluate(parameters, residual, any ? jacobians : nullptr);
   });
 }
 

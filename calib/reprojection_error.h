@@ -129,6 +129,17 @@ ceres::CostFunction* ReprojectionError<Model>::Create(
   return new ReprojectionCost<Model>(board_point, observed_pixel);
 }
 
+// The splined models' cost goes through the point's spline cell
+// (calib/reprojection_error_splined.cc).
+template <>
+bool ReprojectionCost<KannalaBrandtSplinedModel>::Evaluate(
+    double const* const* parameters, double* residuals,
+    double** jacobians) const;
+template <>
+bool ReprojectionCost<KannalaBrandtSplinedNoncentralModel>::Evaluate(
+    double const* const* parameters, double* residuals,
+    double** jacobians) const;
+
 // Each model's cost is compiled once, in reprojection_error.cc: its
 // Jacobian (Model::Project on dual numbers) is the heaviest code the solvers
 // instantiate, and three solver files create it.

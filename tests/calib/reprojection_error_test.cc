@@ -155,16 +155,17 @@ TEST(ReprojectionCostTest, MatchesAutomaticDifferentiationForEveryModel) {
             return fast->Evaluate(parameters, residual,
                                   any ? jacobians : nullptr);
           };
-      ExpectSameAsAutoDiff<Model>(ParamsOf(id), cost, 0.0);
+      // A splined model's cost goes through its cell's cost, whose residual
+      // rounds differently from the dual numbers' projection by a few ulps.
+      ExpectSameAsAutoDiff<Model>(ParamsOf(id), cost,
+                                  CameraModelIsSplined(id) ? 1e-9 : 0.0);
       return true;
     });
   }
 }
 
 // The runtime-model evaluation the capture advice and the rig's joint solve
-// use: for a splined model through its cell's cost (the knots' weights
-// written directly), whose residual rounds differently from the dual
-// numbers' projection by a few ulps.
+// use.
 TEST(ReprojectionCostTest, RuntimeModelEvaluationMatchesAutomaticDifferentiation) {
   for (CameraModelId id : kAllCameraModels) {
     SCOPED_TRACE(CameraModelName(id));
