@@ -172,6 +172,7 @@ struct Fields<DecodeOptions> {
     v.Group("bits", o.bits);
     v.Field("min_corners", o.min_corners);
     v.Field("max_label_extent", o.max_label_extent);
+    v.Field("max_label_overhang", o.max_label_overhang);
     v.Field("max_lattice_deviation", o.max_lattice_deviation);
     v.Field("min_bits_read", o.min_bits_read);
     v.Field("min_agreement", o.min_agreement);

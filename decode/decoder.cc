@@ -160,12 +160,13 @@ void NameMirroredOrInverted(const std::vector<LabelEdgeVote>& votes,
                             const PositionSearchResult& search,
                             const DecodeOptions& options,
                             ComponentDecoding* decoding, std::string* why) {
-  const PositionSearchResult mirrored =
-      SearchPuzzleBoardPosition(votes, Eigen::Vector2i::Zero(), label_max,
-                                -handedness, parity < 0 ? -1 : parity, board);
+  const PositionSearchResult mirrored = SearchPuzzleBoardPosition(
+      votes, Eigen::Vector2i::Zero(), label_max, -handedness,
+      parity < 0 ? -1 : parity, board, /*inverted=*/false,
+      options.max_label_overhang);
   const PositionSearchResult inverted = SearchPuzzleBoardPosition(
       votes, Eigen::Vector2i::Zero(), label_max, handedness, parity, board,
-      /*inverted=*/true);
+      /*inverted=*/true, options.max_label_overhang);
   const auto agreement = [](const PositionSearchResult& r) {
     return r.found ? static_cast<double>(r.edges_agreeing) /
                          std::max(1, r.num_edges)
@@ -215,6 +216,41 @@ std::vector<char> CornersAgreeingWithCode(const LabelLattice& lattice,
   return keep;
 }
 
+// Labels the accepted position puts beyond the printed board
+// (max_label_overhang) are not board corners. They come from a row joined
+// askew, and at the board's border the grid can also join a false corner
+// beside it (bench_advise's steep fisheye view: one 25 px from the corner
+// whose id it got): the corners on the board's outermost row or column on
+// each side where labels overhang are dropped as well.
+void DropOffBoardLabels(const LabelLattice& lattice, const Board& board,
+                        const LabelToBoard& map, std::vector<char>* keep,
+                        int* dropped) {
+  const Eigen::Vector2i lo = board.origin;
+  const Eigen::Vector2i hi =
+      board.origin + Eigen::Vector2i(board.cols - 1, board.rows - 1);
+  // Per side (x low, x high, y low, y high): labels beyond it.
+  bool beyond[2][2] = {{false, false}, {false, false}};
+  std::vector<Eigen::Vector2i> ids(lattice.xy.size());
+  for (size_t k = 0; k < lattice.xy.size(); ++k) {
+    ids[k] = map.Apply(lattice.label[k]);
+    for (int axis = 0; axis < 2; ++axis) {
+      beyond[axis][0] |= ids[k](axis) < lo(axis);
+      beyond[axis][1] |= ids[k](axis) > hi(axis);
+    }
+  }
+  for (size_t k = 0; k < lattice.xy.size(); ++k) {
+    bool drop = false;
+    for (int axis = 0; axis < 2; ++axis) {
+      drop |= ids[k](axis) < lo(axis) + (beyond[axis][0] ? 1 : 0);
+      drop |= ids[k](axis) > hi(axis) - (beyond[axis][1] ? 1 : 0);
+    }
+    if (drop && (*keep)[k]) {
+      (*keep)[k] = 0;
+      ++*dropped;
+    }
+  }
+}
+
 }  // namespace
 
 bool DecodeComponentBits(const LabelLattice& lattice,
@@ -244,7 +280,8 @@ bool DecodeComponentBits(const LabelLattice& lattice,
   }
   const Eigen::Vector2i label_max(lattice.width - 1, lattice.height - 1);
   const PositionSearchResult search = SearchPuzzleBoardPosition(
-      votes, Eigen::Vector2i::Zero(), label_max, handedness, parity, board);
+      votes, Eigen::Vector2i::Zero(), label_max, handedness, parity, board,
+      /*inverted=*/false, options.max_label_overhang);
   if (!search.found) {
     decoding->reason = StringPrintf(
         "labels spanning %d x %d corners fit on the %d-column board in "
@@ -268,6 +305,7 @@ bool DecodeComponentBits(const LabelLattice& lattice,
   decoding->decoded = true;
   *keep = CornersAgreeingWithCode(lattice, reading, *map, options,
                                   &decoding->corners_dropped);
+  DropOffBoardLabels(lattice, board, *map, keep, &decoding->corners_dropped);
   return true;
 }
 
@@ -275,6 +313,9 @@ bool DecodeOptions::Check(std::string* why) const {
   if (!bits.Check(why)) return false;
   if (min_corners < 1) return Fail("min_corners must be >= 1", why);
   if (max_label_extent < 2) return Fail("max_label_extent must be >= 2", why);
+  if (max_label_overhang < 0 || max_label_overhang > 3) {
+    return Fail("max_label_overhang must lie in [0, 3]", why);
+  }
   if (!(max_lattice_deviation > 0.0))
     return Fail("max_lattice_deviation must be > 0", why);
   if (min_bits_read < 1) return Fail("min_bits_read must be >= 1", why);

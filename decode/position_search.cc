@@ -127,14 +127,17 @@ void ScoreInBoardOffsets(const Table& sv, const Table& sh,
                          const Eigen::Matrix2i& m, int r,
                          const Eigen::Vector2i& label_min,
                          const Eigen::Vector2i& label_max, int dark_tile_parity,
-                         const Board& board, bool inverted, Ranking* ranking,
-                         PositionSearchResult* result) {
-  // Offsets that keep every label of the component on the printed board.
+                         const Board& board, bool inverted, int overhang,
+                         Ranking* ranking, PositionSearchResult* result) {
+  // Offsets that keep every label of the component on the printed board,
+  // give or take `overhang` rows and columns on each side.
   Eigen::Vector2i lo = (m * label_min).cwiseMin(m * label_max);
   Eigen::Vector2i hi = (m * label_min).cwiseMax(m * label_max);
-  const Eigen::Vector2i t_min = board.origin - lo;
+  const Eigen::Vector2i t_min =
+      board.origin - lo - Eigen::Vector2i::Constant(overhang);
   const Eigen::Vector2i t_max =
-      board.origin + Eigen::Vector2i(board.cols - 1, board.rows - 1) - hi;
+      board.origin + Eigen::Vector2i(board.cols - 1, board.rows - 1) - hi +
+      Eigen::Vector2i::Constant(overhang);
   // Colour: label tile (0, 0) maps to the board tile whose min corner is
   // tile_lo + t; it is black when that corner's x + y is even.
   Eigen::Vector2i tile_lo = Eigen::Vector2i::Zero();
@@ -238,7 +241,7 @@ double Log10BinomialTailHalf(int n, int k) {
 PositionSearchResult SearchPuzzleBoardPosition(
     const std::vector<LabelEdgeVote>& votes, const Eigen::Vector2i& label_min,
     const Eigen::Vector2i& label_max, int handedness, int dark_tile_parity,
-    const Board& board, bool inverted) {
+    const Board& board, bool inverted, int overhang) {
   PositionSearchResult result;
   result.num_edges = static_cast<int>(votes.size());
   result.torus_best_score = std::numeric_limits<int>::min();
@@ -256,7 +259,7 @@ PositionSearchResult SearchPuzzleBoardPosition(
     result.torus_best_score =
         std::max(result.torus_best_score, TorusBestScore(sv, sh));
     ScoreInBoardOffsets(sv, sh, m, r, label_min, label_max, dark_tile_parity,
-                        board, inverted, &ranking, &result);
+                        board, inverted, overhang, &ranking, &result);
   }
   if (ranking.best_rotation < 0) return result;
   result.found = true;

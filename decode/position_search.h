@@ -67,11 +67,14 @@ struct PositionSearchResult {
 // in [label_min, label_max]. `dark_tile_parity` (0/1, -1 unknown) is the
 // parity of i + j of the dark label tiles (see EdgeBitReading). With
 // `inverted`, the bits and tile colours are matched as if the print were
-// contrast-inverted (a diagnostic for refusals).
+// contrast-inverted (a diagnostic for refusals). `overhang` > 0 also
+// scores the positions that put up to that many of the labels' outermost
+// rows or columns beyond the printed board on each side (see
+// DecodeOptions::max_label_overhang); they count as in-board hypotheses.
 PositionSearchResult SearchPuzzleBoardPosition(
     const std::vector<LabelEdgeVote>& votes, const Eigen::Vector2i& label_min,
     const Eigen::Vector2i& label_max, int handedness, int dark_tile_parity,
-    const Board& board, bool inverted = false);
+    const Board& board, bool inverted = false, int overhang = 0);
 
 // The code bit of label edge `vote` under `map` (board edge rules of docs/puzzleboard.md).
 int BoardBitOfLabelEdge(const LabelToBoard& map, const Eigen::Vector2i& from,
