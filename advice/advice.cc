@@ -913,9 +913,10 @@ std::string Advice::Text() const {
            "uncertainty within the estimate's limit\n";
   }
   out << StringPrintf(
-      "(predicted with the corner noise of the photos taken, %.3f px; a "
-      "steeply tilted or close board usually gives noisier corners, and "
-      "the calibration's figures then grow in proportion)\n",
+      "(predicted with a corner noise of %.3f px for the new photos, as "
+      "for those taken; a steeply tilted or close board usually gives "
+      "noisier corners, and the calibration's figures then grow in "
+      "proportion)\n",
       noise_sigma_px);
   return out.str();
 }

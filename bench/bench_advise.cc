@@ -89,7 +89,8 @@ double StatedNoise(const CalibrationResult& result) {
   for (bool fixed : result.param_fixed) free += fixed ? 0 : 1;
   for (bool used : result.view_used) poses += used ? 6 : 0;
   const double corners = result.num_corners_used;
-  return result.rms_px * std::sqrt(2 * corners / (2 * corners - free - poses));
+  const double dof = 2 * corners - free - poses;
+  return dof > 0 ? result.rms_px * std::sqrt(2 * corners / dof) : result.rms_px;
 }
 
 // Whether the verdict is good; `reason` gets its reason otherwise (quotes
@@ -180,10 +181,15 @@ void RunLens(const Lens& lens, bool last) {
   std::vector<CalibrationView> growing = views;
   CalibrationResult current = result;
   int photos = static_cast<int>(growing.size());
-  // The verdict's reason when the photos the advice estimated are not
-  // enough.
-  std::string reason, reason_at_estimate;
+  // The verdict at the photo count the advice estimated: "good", its
+  // reason, or why that count was not reached.
+  std::string reason;
   bool good = VerdictGood(growing, current, &reason);
+  std::string at_estimate =
+      advice.photos_to_target < 0 ? "no estimate" : "not reached";
+  if (photos >= advice.photos_to_target && advice.photos_to_target >= 0) {
+    at_estimate = good ? "good" : reason;
+  }
   AdviceOptions one = AdviceOptions();
   one.count = 1;
   while (!good && photos < 40) {
@@ -195,13 +201,15 @@ void RunLens(const Lens& lens, bool last) {
     ++photos;
     if (!Recalibrate(lens, growing, &current)) break;
     good = VerdictGood(growing, current, &reason);
-    if (!good && photos == advice.photos_to_target) reason_at_estimate = reason;
+    if (photos == advice.photos_to_target) at_estimate = good ? "good" : reason;
   }
+  // Good before the estimate: good at it too.
+  if (good && photos < advice.photos_to_target) at_estimate = "good";
   std::printf(
       "   \"photos_until_good\": %d, \"good\": %s, "
       "\"verdict_at_estimate\": \"%s\"}%s\n",
       photos, good ? "true" : "false",
-      reason_at_estimate.empty() ? "good" : reason_at_estimate.c_str(),
+      at_estimate.c_str(),
       last ? "" : ",");
 }
 

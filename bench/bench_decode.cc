@@ -101,7 +101,8 @@ void DecodeAndCount(const Board& board, const cv::Mat& image,
     const PositionSearchResult search = SearchPuzzleBoardPosition(
         votes, Eigen::Vector2i::Zero(),
         Eigen::Vector2i(lattice.width - 1, lattice.height - 1),
-        decoding.handedness, parity, board);
+        decoding.handedness, parity, board, /*inverted=*/false,
+        options.max_label_overhang);
     ++tally->ml_trials;
     bool correct = search.found && search.best_score > search.second_score;
     for (size_t k = 0; correct && k < lattice.xy.size(); ++k) {
@@ -385,7 +386,8 @@ int main() {
           }
           const PositionSearchResult search = SearchPuzzleBoardPosition(
               votes, Eigen::Vector2i::Zero(), Eigen::Vector2i(k, k), +1,
-              (x0 + y0) & 1, board);
+              (x0 + y0) & 1, board, /*inverted=*/false,
+              DecodeOptions().max_label_overhang);
           ++windows;
           const int margin = (search.best_score - search.second_score) / 2;
           if (margin <= 0) {

@@ -1,9 +1,10 @@
 #ifndef PUZZLECAL_CALIB_REPROJECTION_COST_IMPL_H_
 #define PUZZLECAL_CALIB_REPROJECTION_COST_IMPL_H_
 
-// ReprojectionCost<Model>::Evaluate, for the files that instantiate each
-// model's cost (calib/reprojection_error.cc, reprojection_error_splined.cc)
-// and nothing else: every other file links those instances.
+// ReprojectionCost<Model>::Evaluate, for the file that instantiates the
+// models' costs (calib/reprojection_error.cc; the splined models' Evaluate
+// is specialized in reprojection_error_splined.cc) and nothing else: every
+// other file links those instances.
 
 #include <ceres/jet.h>
 #include <ceres/rotation.h>

@@ -101,6 +101,10 @@ class ReprojectionError {
 // numbers through both. The rotation is then differentiated 3 wide instead
 // of N + 6 wide, and the projection N + 3 wide: the Jacobian costs about
 // half. The residual is computed exactly as ReprojectionError computes it.
+// The splined models' cost instead goes through the corner's spline cell
+// (specialized below; calib/reprojection_error_splined.cc): the same
+// derivatives, the knots outside the cell exactly 0, the residual to a few
+// ulps.
 template <typename Model>
 class ReprojectionCost
     : public ceres::SizedCostFunction<2, Model::kNumParams, kPoseBlockSize> {
@@ -111,8 +115,9 @@ class ReprojectionCost
                    const Eigen::Vector2d& observed_pixel)
       : functor_(board_point, observed_pixel) {}
 
-  // Defined in calib/reprojection_cost_impl.h, which only the two files
-  // that compile each model's cost include: an inline definition here would
+  // Defined in calib/reprojection_cost_impl.h (the splined models': in
+  // calib/reprojection_error_splined.cc), which only the file that compiles
+  // the models' costs includes: an inline definition here would
   // be compiled again (Model::Project on N + 3-wide dual numbers, the
   // heaviest code the solvers have) in every file that creates a cost, the
   // extern template declarations below notwithstanding.

@@ -220,29 +220,37 @@ std::vector<char> CornersAgreeingWithCode(const LabelLattice& lattice,
 // (max_label_overhang) are not board corners. They come from a row joined
 // askew, and at the board's border the grid can also join a false corner
 // beside it (bench_advise's steep fisheye view: one 25 px from the corner
-// whose id it got): the corners on the board's outermost row or column on
-// each side where labels overhang are dropped as well.
+// whose id it got): the corners on the board's outermost row or column
+// next to an off-board label (one label step away, diagonals included) are
+// dropped as well.
 void DropOffBoardLabels(const LabelLattice& lattice, const Board& board,
                         const LabelToBoard& map, std::vector<char>* keep,
                         int* dropped) {
   const Eigen::Vector2i lo = board.origin;
   const Eigen::Vector2i hi =
       board.origin + Eigen::Vector2i(board.cols - 1, board.rows - 1);
-  // Per side (x low, x high, y low, y high): labels beyond it.
-  bool beyond[2][2] = {{false, false}, {false, false}};
-  std::vector<Eigen::Vector2i> ids(lattice.xy.size());
+  const auto off_board = [&](const Eigen::Vector2i& id) {
+    return (id.array() < lo.array()).any() || (id.array() > hi.array()).any();
+  };
+  const auto on_edge = [&](const Eigen::Vector2i& id) {
+    return (id.array() == lo.array()).any() || (id.array() == hi.array()).any();
+  };
+  std::vector<char> off(lattice.xy.size(), 0);
+  bool any_off = false;
   for (size_t k = 0; k < lattice.xy.size(); ++k) {
-    ids[k] = map.Apply(lattice.label[k]);
-    for (int axis = 0; axis < 2; ++axis) {
-      beyond[axis][0] |= ids[k](axis) < lo(axis);
-      beyond[axis][1] |= ids[k](axis) > hi(axis);
-    }
+    off[k] = off_board(map.Apply(lattice.label[k])) ? 1 : 0;
+    any_off |= off[k] != 0;
   }
+  if (!any_off) return;
   for (size_t k = 0; k < lattice.xy.size(); ++k) {
-    bool drop = false;
-    for (int axis = 0; axis < 2; ++axis) {
-      drop |= ids[k](axis) < lo(axis) + (beyond[axis][0] ? 1 : 0);
-      drop |= ids[k](axis) > hi(axis) - (beyond[axis][1] ? 1 : 0);
+    bool drop = off[k] != 0;
+    if (!drop && on_edge(map.Apply(lattice.label[k]))) {
+      for (int dj = -1; dj <= 1 && !drop; ++dj) {
+        for (int di = -1; di <= 1 && !drop; ++di) {
+          const int n = lattice.At(lattice.label[k] + Eigen::Vector2i(di, dj));
+          drop = n >= 0 && off[n] != 0;
+        }
+      }
     }
     if (drop && (*keep)[k]) {
       (*keep)[k] = 0;
@@ -284,9 +292,10 @@ bool DecodeComponentBits(const LabelLattice& lattice,
       /*inverted=*/false, options.max_label_overhang);
   if (!search.found) {
     decoding->reason = StringPrintf(
-        "labels spanning %d x %d corners fit on the %d-column board in "
-        "no rotation",
-        lattice.width, lattice.height, board.cols);
+        "labels spanning %d x %d corners fit on the %d x %d-corner board "
+        "in no rotation (%d row(s) beyond it allowed)",
+        lattice.width, lattice.height, board.cols, board.rows,
+        options.max_label_overhang);
     return false;
   }
   RecordSearchFigures(search, decoding);

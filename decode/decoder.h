@@ -19,7 +19,9 @@
 //  1. bits_read >= min_bits_read (a 3 x 3-tile window has 24 edges);
 //  2. agreement = bits_agreeing / bits_read >= min_agreement;
 //  3. margin = agreeing edges at the best position minus at the second-best
-//     position inside the printed board (any rotation) >= the larger of
+//     position inside the printed board (any rotation; "inside" allows
+//     max_label_overhang outermost label rows or columns beyond it, here
+//     and in rules 4 and 5) >= the larger of
 //     min_margin and the margin at which, with the bit error rate
 //     q = max(1 - agreement, 0.02) the view shows, the best position is
 //     10^min_log10_odds times likelier than the second: each edge of margin
@@ -171,7 +173,8 @@ DecodeResult DecodeBoard(const Board& board, const std::vector<Corner>& corners,
 // The PuzzleBoard decision for one component from its edge readings (the
 // part of DecodeBoard after ReadEdgeBits; exposed so tests can corrupt bits).
 // `decoding->handedness` must be set (LabelHandedness). On acceptance fills
-// `map` and `keep` (per lattice point: 0 = dropped for disagreeing edges).
+// `map` and `keep` (per lattice point: 0 = dropped for disagreeing edges, or
+// as beyond the board or on its outermost row where labels overhang it).
 bool DecodeComponentBits(const LabelLattice& lattice,
                          const EdgeBitReading& reading, const Board& board,
                          const DecodeOptions& options,

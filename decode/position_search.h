@@ -44,10 +44,12 @@ struct LabelToBoard {
 std::vector<Eigen::Matrix2i> LabelRotations(int handedness);
 
 struct PositionSearchResult {
+  // "In-board" below: every id inside the printed board (offset unwrapped
+  // so ids are in [origin, origin + size)), give or take `overhang` rows
+  // and columns on each side.
   bool found = false;  // at least one in-board hypothesis was scored
-  // Best hypothesis whose ids all fall inside the printed board (offset
-  // unwrapped so ids are in [origin, origin + size)) and which agrees with
-  // the observed tile colour (when known).
+  // Best in-board hypothesis that agrees with the observed tile colour (when
+  // known).
   LabelToBoard best;
   int best_score = 0;    // agreeing - disagreeing edges at `best`
   // Best score of any other in-board hypothesis; best_score - 2 * num_edges
