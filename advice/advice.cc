@@ -469,19 +469,6 @@ Eigen::MatrixXd PriorInformation(const Camera& camera,
   return prior;
 }
 
-// The noise of the corners: the option, or the calibration's inlier RMS
-// with the fitted parameters' share restored (as its covariance is
-// scaled).
-double NoiseSigma(const CalibrationResult& result, int free_count,
-                  const AdviceOptions& options) {
-  if (options.noise_sigma_px > 0) return options.noise_sigma_px;
-  const int corners = result.num_corners_used;
-  int poses = 0;
-  for (bool used : result.view_used) poses += used ? 6 : 0;
-  const double dof = 2.0 * corners - free_count - poses;
-  if (!(dof > 0)) return result.rms_px;
-  return result.rms_px * std::sqrt(2.0 * corners / dof);
-}
 
 double MedianDistance(const std::vector<CalibrationView>& views,
                       const CalibrationResult& result) {
@@ -680,6 +667,16 @@ bool AdviceOptions::Check(std::string* why) const {
   return true;
 }
 
+double StatedNoiseSigma(const CalibrationResult& result) {
+  const int corners = result.num_corners_used;
+  int fitted = 0;
+  for (bool fixed : result.param_fixed) fitted += fixed ? 0 : 1;
+  for (bool used : result.view_used) fitted += used ? 6 : 0;
+  const double dof = 2.0 * corners - fitted;
+  if (!(dof > 0)) return result.rms_px;
+  return result.rms_px * std::sqrt(2.0 * corners / dof);
+}
+
 Eigen::MatrixXd TakenInformation(const std::vector<CalibrationView>& views,
                                  const CalibrationResult& result) {
   std::vector<bool> free(result.param_fixed.size());
@@ -787,7 +784,8 @@ Advice AdviseViews(const std::vector<CalibrationView>& views,
     return advice;
   }
   for (bool used : result.view_used) advice.views_taken += used ? 1 : 0;
-  const double noise = NoiseSigma(result, free_index.size(), options);
+  const double noise = options.noise_sigma_px > 0 ? options.noise_sigma_px
+                                                  : StatedNoiseSigma(result);
   advice.noise_sigma_px = noise;
   advice.target_uncertainty_px = options.target_uncertainty_px;
   double observed_deg = 0, observed_px = 0;

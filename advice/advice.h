@@ -204,6 +204,11 @@ struct Advice {
   std::string Text() const;
 };
 
+// The corner noise (pixels per coordinate) a calibration's covariance is
+// scaled by: its inlier RMS with the fitted parameters' share restored
+// (the RMS when no degrees of freedom are left).
+double StatedNoiseSigma(const CalibrationResult& result);
+
 // The information matrix of the intrinsics (free ones only, in the order
 // of the free parameters of `result`) of the used views' inlier corners at
 // the solution, for unit noise: sigma^2 times its inverse is the

@@ -20,12 +20,10 @@ bool ViewInformation(const Camera& camera,
   Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> j_intrinsics(2, n);
   Eigen::Matrix<double, 2, kPoseBlockSize, Eigen::RowMajor> j_pose;
   // A splined model's corner moves only the knots around it: the products
-  // are formed over the Jacobian's non-zero columns (about 40 of 211) and
-  // added into their rows and columns, the other entries' products being
-  // exactly 0.
+  // are added over the Jacobian's non-zero columns only (about 40 of 211),
+  // the other entries' products being exactly 0.
   std::vector<int> columns;
   columns.reserve(n);
-  Eigen::Matrix<double, 2, Eigen::Dynamic> j_columns(2, n);
   int used = 0;
   for (const Eigen::Vector3d& point : board_points) {
     if (!ReprojectionJacobians(camera.model, camera.params.data(), pose.data(),
@@ -39,15 +37,13 @@ bool ViewInformation(const Camera& camera,
         columns.push_back(k);
       }
     }
-    const int m = static_cast<int>(columns.size());
-    j_columns.resize(2, m);
-    for (int k = 0; k < m; ++k) j_columns.col(k) = j_intrinsics.col(columns[k]);
-    const Eigen::MatrixXd a_part = j_columns.transpose() * j_columns;
-    const Eigen::Matrix<double, Eigen::Dynamic, kPoseBlockSize> b_part =
-        j_columns.transpose() * j_pose;
-    for (int r = 0; r < m; ++r) {
-      for (int k = 0; k < m; ++k) a(columns[r], columns[k]) += a_part(r, k);
-      b.row(columns[r]) += b_part.row(r);
+    for (int p : columns) {
+      for (int q : columns) {
+        a(p, q) += j_intrinsics(0, p) * j_intrinsics(0, q) +
+                   j_intrinsics(1, p) * j_intrinsics(1, q);
+      }
+      b.row(p) += j_intrinsics(0, p) * j_pose.row(0) +
+                  j_intrinsics(1, p) * j_pose.row(1);
     }
     c.noalias() += j_pose.transpose() * j_pose;
     ++used;

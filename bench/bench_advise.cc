@@ -81,18 +81,6 @@ FieldUncertainty UncertaintyOf(const CalibrationResult& result,
   return PredictFieldUncertainty(result.camera, free, covariance, options);
 }
 
-// The corner noise the calibration's covariance is scaled by (its inlier
-// RMS with the fitted parameters' share restored), which the advice's
-// prediction takes from the views it starts from.
-double StatedNoise(const CalibrationResult& result) {
-  int free = 0, poses = 0;
-  for (bool fixed : result.param_fixed) free += fixed ? 0 : 1;
-  for (bool used : result.view_used) poses += used ? 6 : 0;
-  const double corners = result.num_corners_used;
-  const double dof = 2 * corners - free - poses;
-  return dof > 0 ? result.rms_px * std::sqrt(2 * corners / dof) : result.rms_px;
-}
-
 // Whether the verdict is good; `reason` gets its reason otherwise (quotes
 // made single for the JSON).
 bool VerdictGood(const std::vector<CalibrationView>& views,
@@ -153,7 +141,7 @@ void RunLens(const Lens& lens, bool last) {
         k ? "," : "", advice.views[k].words.c_str(),
         added.empty() ? "false" : "true", advice.views[k].after.worst_px,
         u.worst_px, advice.views[k].after.median_px, u.median_px, again.rms_px,
-        StatedNoise(again));
+        StatedNoiseSigma(again));
   }
   std::printf("],\n");
   std::vector<double> random_worst;

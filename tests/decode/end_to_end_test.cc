@@ -9,6 +9,7 @@
 #include "decode/decoder.h"
 #include "detection/detector.h"
 #include "grid/grid.h"
+#include "sim/scenes.h"
 #include "sim/synthetic_views.h"
 #include "tests/decode/truth_components.h"
 
@@ -119,12 +120,10 @@ TEST(EndToEnd, SmallTilesDecodeCorrectly) {
 // corners. Now the overhanging labels and the board's outermost row on
 // that side are dropped and the rest decodes.
 TEST(EndToEnd, AskewRowOfLabelsDoesNotHideTheTruePosition) {
-  const Board board = MakePuzzleBoard(23, 16, 50, 100, 0.03);
-  RenderOptions options;
-  options.blur_sigma_px = 0.8;
-  options.noise_sigma = 0.02;
-  options.lighting_gradient = 0.2;
-  options.vignetting = 0.2;
+  // The sample scene's board and rendering, as bench_advise renders it.
+  const SceneSpec scene = SampleScene();
+  const Board& board = scene.board;
+  RenderOptions options = scene.render;
   options.seed = 203;
   Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
   const Eigen::Vector3d angle_axis(-0.41862897639958113, 0.11402208123296614,
