@@ -346,6 +346,39 @@ double SmallestTilePx(const Camera& camera, const Board& board,
   return smallest;
 }
 
+// The corners of `corners` that the board at `pose` puts inside the image
+// (image_margin_px from the border) and the lens's field.
+std::vector<Eigen::Vector3d> VisibleCorners(
+    const Camera& camera, const std::vector<Eigen::Vector3d>& corners,
+    const LensLimits& lens, const Eigen::Isometry3d& pose,
+    const AdviceOptions& options) {
+  std::vector<Eigen::Vector3d> visible;
+  for (const Eigen::Vector3d& point : corners) {
+    Eigen::Vector2d pixel;
+    if (Visible(camera, pose * point, lens, options.image_margin_px, &pixel)) {
+      visible.push_back(point);
+    }
+  }
+  return visible;
+}
+
+// The information (free parameters, unit noise) of the board seen from
+// `pose` through `visible`, the visible ones of a subsample of
+// `num_subsampled` corners standing for all of the board's. False when the
+// view tells nothing (fewer than 3 of them project).
+bool SubsampleInformation(const Camera& camera, const Board& board,
+                          const std::vector<Eigen::Vector3d>& visible,
+                          size_t num_subsampled, const std::vector<int>& free,
+                          const Eigen::Isometry3d& pose,
+                          Eigen::MatrixXd* information) {
+  Eigen::MatrixXd full;
+  const double weight = static_cast<double>(board.NumCorners()) /
+                        std::max<size_t>(1, num_subsampled);
+  if (!ViewInformation(camera, visible, pose, weight, &full)) return false;
+  *information = FreeBlock(full, free);
+  return true;
+}
+
 // The candidate for a board centre at `centre_px`, `distance_m` away, with
 // a tilt; false when a person could not use it (see AdviceOptions).
 bool MakeCandidate(const Camera& camera, const Board& board,
@@ -367,13 +400,8 @@ bool MakeCandidate(const Camera& camera, const Board& board,
   pose.linear() = rotation;
   pose.translation() = distance_m * ray - rotation * BoardCentre(board);
 
-  std::vector<Eigen::Vector3d> visible;
-  for (const Eigen::Vector3d& point : corners) {
-    Eigen::Vector2d pixel;
-    if (Visible(camera, pose * point, lens, options.image_margin_px, &pixel)) {
-      visible.push_back(point);
-    }
-  }
+  const std::vector<Eigen::Vector3d> visible =
+      VisibleCorners(camera, corners, lens, pose, options);
   const double fraction =
       static_cast<double>(visible.size()) / std::max<size_t>(1, corners.size());
   const double needed =
@@ -382,11 +410,10 @@ bool MakeCandidate(const Camera& camera, const Board& board,
   if (SmallestTilePx(camera, board, pose, lens) < options.min_tile_px) {
     return false;
   }
-  Eigen::MatrixXd full;
-  const double weight = static_cast<double>(board.NumCorners()) /
-                        std::max<size_t>(1, corners.size());
-  if (!ViewInformation(camera, visible, pose, weight, &full)) return false;
-  out->information = FreeBlock(full, free);
+  if (!SubsampleInformation(camera, board, visible, corners.size(), free,
+                            pose, &out->information)) {
+    return false;
+  }
   out->cam_from_board = pose;
   out->centre_px = centre_px;
   out->normal = normal;
@@ -604,6 +631,64 @@ int BestCandidate(const std::vector<Candidate>& candidates,
   return best;
 }
 
+// What the predictions for a calibration start from: its free parameters,
+// the corner noise, the judged field and the information of the views
+// taken (with the priors), in units of that noise.
+struct PredictionStart {
+  std::vector<int> free_index;
+  double noise = 0;
+  double precision = 0;  // 1 / noise^2
+  double observed_deg = 0;
+  double field_radius_px = 0;
+  LensLimits lens;
+  FieldSamples samples;
+  Eigen::MatrixXd information;
+  Eigen::MatrixXd covariance;
+};
+
+// False with `error` when the calibration gives no prediction.
+bool StartPrediction(const std::vector<CalibrationView>& views,
+                     const CalibrationResult& result,
+                     const AdviceOptions& options, PredictionStart* start,
+                     std::string* error) {
+  const Camera& camera = result.camera;
+  std::vector<bool> free(result.param_fixed.size());
+  for (size_t k = 0; k < free.size(); ++k) free[k] = !result.param_fixed[k];
+  start->free_index = FreeIndices(free);
+  if (start->free_index.empty()) {
+    *error = "every intrinsic is held: there is nothing to determine";
+    return false;
+  }
+  start->noise = options.noise_sigma_px > 0 ? options.noise_sigma_px
+                                            : StatedNoiseSigma(result);
+  double observed_px = 0;
+  ObservedField(views, result, &start->observed_deg, &observed_px);
+  start->field_radius_px = JudgedRadiusPx(camera, observed_px, options);
+  start->lens = {LensFieldDeg(camera, start->observed_deg),
+                 MaxMonotonicRadius(camera)};
+  start->samples = MakeFieldSamples(camera, start->free_index,
+                                    start->field_radius_px, options);
+  if (start->samples.jacobian.empty()) {
+    *error = "no pixel of the judged field has a ray";
+    return false;
+  }
+  // Information in units of the corner noise.
+  start->precision = 1.0 / (start->noise * start->noise);
+  start->information =
+      start->precision *
+          (TakenInformation(views, result) +
+           FreeBlock(SplinePriorInformation(camera.model, camera.params[0],
+                                            camera.params[1],
+                                            options.spline_prior),
+                     start->free_index)) +
+      PriorInformation(camera, start->free_index, options);
+  if (!CovarianceOf(start->information, &start->covariance)) {
+    *error = "the information of the views taken is not usable";
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool AdviceOptions::Check(std::string* why) const {
@@ -771,53 +856,29 @@ Advice AdviseViews(const std::vector<CalibrationView>& views,
   if (!options.Check(&advice.error)) return advice;
   advice.camera = result.camera;
   const Camera& camera = result.camera;
-  std::vector<bool> free(result.param_fixed.size());
-  for (size_t k = 0; k < free.size(); ++k) free[k] = !result.param_fixed[k];
-  const std::vector<int> free_index = FreeIndices(free);
-  if (free_index.empty()) {
-    advice.error = "every intrinsic is held: there is nothing to determine";
-    return advice;
-  }
   advice.reference_distance_m = MedianDistance(views, result);
   if (!(advice.reference_distance_m > 0)) {
     advice.error = "no view of the board was posed";
     return advice;
   }
   for (bool used : result.view_used) advice.views_taken += used ? 1 : 0;
-  const double noise = options.noise_sigma_px > 0 ? options.noise_sigma_px
-                                                  : StatedNoiseSigma(result);
-  advice.noise_sigma_px = noise;
+  PredictionStart start;
+  if (!StartPrediction(views, result, options, &start, &advice.error)) {
+    return advice;
+  }
+  advice.noise_sigma_px = start.noise;
   advice.target_uncertainty_px = options.target_uncertainty_px;
-  double observed_deg = 0, observed_px = 0;
-  ObservedField(views, result, &observed_deg, &observed_px);
-  advice.field_radius_px = JudgedRadiusPx(camera, observed_px, options);
-  const FieldSamples samples =
-      MakeFieldSamples(camera, free_index, advice.field_radius_px, options);
-  advice.field_deg = samples.field_deg;
-  if (samples.jacobian.empty()) {
-    advice.error = "no pixel of the judged field has a ray";
-    return advice;
-  }
-  // Information in units of the corner noise.
-  const double precision = 1.0 / (noise * noise);
-  Eigen::MatrixXd information =
-      precision * (TakenInformation(views, result) +
-                   FreeBlock(SplinePriorInformation(
-                                 camera.model, camera.params[0],
-                                 camera.params[1], options.spline_prior),
-                             free_index)) +
-      PriorInformation(camera, free_index, options);
-  Eigen::MatrixXd covariance;
-  if (!CovarianceOf(information, &covariance)) {
-    advice.error = "the information of the views taken is not usable";
-    return advice;
-  }
+  advice.field_radius_px = start.field_radius_px;
+  advice.field_deg = start.samples.field_deg;
+  const FieldSamples& samples = start.samples;
+  const double precision = start.precision;
+  Eigen::MatrixXd information = start.information;
+  Eigen::MatrixXd covariance = start.covariance;
   advice.now = Evaluate(samples, covariance);
 
-  std::vector<Candidate> candidates = MakeCandidates(
-      camera, board, free_index,
-      {LensFieldDeg(camera, observed_deg), MaxMonotonicRadius(camera)},
-      advice.reference_distance_m, options);
+  std::vector<Candidate> candidates =
+      MakeCandidates(camera, board, start.free_index, start.lens,
+                     advice.reference_distance_m, options);
   for (Candidate& c : candidates) c.information *= precision;
   for (const Candidate& c : candidates) {
     advice.candidate_poses.push_back(c.cam_from_board);
@@ -882,6 +943,35 @@ Advice AdviseViews(const std::vector<CalibrationView>& views,
   if (!advice.ok) advice.error = "no candidate pose lowers the uncertainty";
   advice.seconds = timer.Seconds();
   return advice;
+}
+
+bool PredictWithPoses(const std::vector<CalibrationView>& views,
+                      const CalibrationResult& result, const Board& board,
+                      const std::vector<Eigen::Isometry3d>& poses,
+                      const AdviceOptions& options, FieldUncertainty* after,
+                      std::string* error) {
+  if (!options.Check(error)) return false;
+  PredictionStart start;
+  if (!StartPrediction(views, result, options, &start, error)) return false;
+  const std::vector<Eigen::Vector3d> corners =
+      SubsampledCorners(board, options.max_corners_per_view);
+  Eigen::MatrixXd information = start.information;
+  for (const Eigen::Isometry3d& pose : poses) {
+    const std::vector<Eigen::Vector3d> visible =
+        VisibleCorners(result.camera, corners, start.lens, pose, options);
+    Eigen::MatrixXd view;
+    if (SubsampleInformation(result.camera, board, visible, corners.size(),
+                             start.free_index, pose, &view)) {
+      information += start.precision * view;
+    }
+  }
+  Eigen::MatrixXd covariance;
+  if (!CovarianceOf(information, &covariance)) {
+    *error = "the information with the added views is not usable";
+    return false;
+  }
+  *after = Evaluate(start.samples, covariance);
+  return true;
 }
 
 std::string Advice::Text() const {

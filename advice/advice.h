@@ -230,6 +230,18 @@ Advice AdviseViews(const std::vector<CalibrationView>& views,
                    const CalibrationResult& result, const Board& board,
                    const AdviceOptions& options);
 
+// The predicted uncertainty over the judged field after adding views of
+// `board` from `poses` (cam_from_board) to the views taken, as AdviseViews
+// predicts it for its candidates: for poses of the caller's choosing (a
+// comparison of the advised views with others). Poses of which too little
+// is seen add nothing. False with `error` when the views taken give no
+// prediction.
+bool PredictWithPoses(const std::vector<CalibrationView>& views,
+                      const CalibrationResult& result, const Board& board,
+                      const std::vector<Eigen::Isometry3d>& poses,
+                      const AdviceOptions& options, FieldUncertainty* after,
+                      std::string* error);
+
 // Words for a pose: distance, where the centre appears, tilt.
 std::string DescribePose(const Camera& camera, const Eigen::Vector2d& centre_px,
                          double distance_m, double tilt_deg,

@@ -5,6 +5,10 @@
 // candidates (10 draws). Then advised views are added one at a time (the
 // advice recomputed each time) until the verdict is good, against the
 // first advice's estimate. And the time of the advice on 30 views.
+// "predicted": the same comparison as the advice's prediction scores it
+// (PredictWithPoses, no render): the advised four against the 10 random
+// draws, and the best and median of 500 more random draws, which says how
+// much better than random any choice among the candidates could be.
 // Prints JSON. `bench_advise splined` runs the splined lens alone.
 
 #include <algorithm>
@@ -25,6 +29,10 @@
 
 namespace puzzlecal {
 namespace {
+
+// Random draws of 4 candidates whose uncertainty only the prediction
+// scores (no render).
+constexpr int kPredictedDraws = 500;
 
 struct Lens {
   std::string name;
@@ -144,14 +152,37 @@ void RunLens(const Lens& lens, bool last) {
         StatedNoiseSigma(again));
   }
   std::printf("],\n");
-  std::vector<double> random_worst;
+  std::vector<double> random_worst, random_predicted_worst;
   std::mt19937 rng(17);
   std::uniform_int_distribution<size_t> pick(0,
                                              advice.candidate_poses.size() - 1);
-  for (int draw = 0; draw < 10; ++draw) {
+  auto draw_four = [&](std::mt19937* generator) {
     std::vector<Eigen::Isometry3d> random;
     for (int k = 0; k < 4; ++k)
-      random.push_back(advice.candidate_poses[pick(rng)]);
+      random.push_back(advice.candidate_poses[pick(*generator)]);
+    return random;
+  };
+  // The prediction's own view of the choice: how low it puts the worst
+  // uncertainty after 4 random candidates, over many draws.
+  std::vector<double> many_predicted;
+  std::mt19937 many_rng(29);
+  for (int draw = 0; draw < kPredictedDraws; ++draw) {
+    FieldUncertainty u;
+    std::string error;
+    if (PredictWithPoses(views, result, lens.board, draw_four(&many_rng),
+                         options, &u,
+                         &error)) {
+      many_predicted.push_back(u.worst_px);
+    }
+  }
+  for (int draw = 0; draw < 10; ++draw) {
+    const std::vector<Eigen::Isometry3d> random = draw_four(&rng);
+    FieldUncertainty predicted;
+    std::string error;
+    if (PredictWithPoses(views, result, lens.board, random, options,
+                         &predicted, &error)) {
+      random_predicted_worst.push_back(predicted.worst_px);
+    }
     std::vector<CalibrationView> random_views = views;
     const std::vector<CalibrationView> added =
         RenderedViews(lens, random, 300 + 10 * draw);
@@ -165,6 +196,19 @@ void RunLens(const Lens& lens, bool last) {
       "\"random_draws\": %zu, \"random_over_advised\": %.2f,\n",
       advised_worst, Median(random_worst), random_worst.size(),
       Median(random_worst) / advised_worst);
+  const double advised_predicted = advice.views.back().after.worst_px;
+  std::printf(
+      "   \"predicted\": {\"advised_worst_px\": %.4f, "
+      "\"random_median_worst_px\": %.4f, \"random_over_advised\": %.2f, "
+      "\"draws\": %zu, \"best_draw_worst_px\": %.4f, "
+      "\"median_draw_over_advised\": %.2f},\n",
+      advised_predicted, Median(random_predicted_worst),
+      Median(random_predicted_worst) / advised_predicted,
+      many_predicted.size(),
+      many_predicted.empty()
+          ? -1.0
+          : *std::min_element(many_predicted.begin(), many_predicted.end()),
+      Median(many_predicted) / advised_predicted);
   // Advised views one at a time until the verdict is good.
   std::vector<CalibrationView> growing = views;
   CalibrationResult current = result;

@@ -161,6 +161,13 @@ struct Comparison {
   std::vector<double> recalibrated;      // the same, recalibrated
   std::vector<double> predicted_median;  // the medians over the field
   std::vector<double> recalibrated_median;
+  // PredictWithPoses with the advised poses, to compare with the advice's
+  // own prediction after its last view.
+  FieldUncertainty advised_by_poses;
+  FieldUncertainty advised_by_advice;
+  // PredictWithPoses for each random draw, and its recalibration.
+  std::vector<FieldUncertainty> random_predicted;
+  std::vector<FieldUncertainty> random_recalibrated;
 };
 
 Comparison CompareAdvisedWithRandom(const Camera& truth, const Board& board) {
@@ -195,6 +202,15 @@ Comparison CompareAdvisedWithRandom(const Camera& truth, const Board& board) {
             .median_px);
   }
   out.advised_worst = out.recalibrated.back();
+  out.advised_by_advice = advice.views.back().after;
+  std::vector<Eigen::Isometry3d> advised_poses;
+  for (const AdvisedView& view : advice.views) {
+    advised_poses.push_back(view.cam_from_board);
+  }
+  std::string error;
+  EXPECT_TRUE(PredictWithPoses(start, result, board, advised_poses, options,
+                               &out.advised_by_poses, &error))
+      << error;
   std::vector<double> random_worst;
   std::mt19937 rng(17);
   for (int draw = 0; draw < 10; ++draw) {
@@ -208,6 +224,16 @@ Comparison CompareAdvisedWithRandom(const Camera& truth, const Board& board) {
       continue;
     }
     random_worst.push_back(WorstSigma(again, options));
+    FieldUncertainty predicted;
+    EXPECT_TRUE(PredictWithPoses(
+        start, result, board,
+        std::vector<Eigen::Isometry3d>(random.begin() + start_poses.size(),
+                                       random.end()),
+        options, &predicted, &error))
+        << error;
+    out.random_predicted.push_back(predicted);
+    out.random_recalibrated.push_back(PredictFieldUncertainty(
+        again.camera, FreeOf(again), FreeCovariance(again), options));
   }
   out.random_median_worst = Median(random_worst);
   return out;
@@ -231,6 +257,31 @@ void ExpectPredictionsFollow(const Comparison& c) {
   }
 }
 
+// PredictWithPoses gives for the advised poses what the advice predicted
+// after its last one, and for poses of the caller's choosing (the random
+// draws) what their recalibration states: the medians over the field
+// within 20 % (measured: 0.92-0.99 on the sample lens, 0.97-1.09 on the
+// fisheye), the worst within 40 % (measured: 0.72-1.18 and 1.07-1.32: the
+// prediction linearises at the start's intrinsics, whose distortion the
+// six frontal views leave uncertain by a pixel at the field's edge, where
+// the worst pixel lies).
+void ExpectPosePredictionsFollow(const Comparison& c) {
+  EXPECT_NEAR(c.advised_by_poses.worst_px, c.advised_by_advice.worst_px,
+              1e-9 * c.advised_by_advice.worst_px);
+  EXPECT_NEAR(c.advised_by_poses.median_px, c.advised_by_advice.median_px,
+              1e-9 * c.advised_by_advice.median_px);
+  ASSERT_EQ(c.random_predicted.size(), 10u);
+  ASSERT_EQ(c.random_recalibrated.size(), 10u);
+  for (size_t k = 0; k < c.random_predicted.size(); ++k) {
+    const FieldUncertainty& p = c.random_predicted[k];
+    const FieldUncertainty& r = c.random_recalibrated[k];
+    EXPECT_LT(p.median_px, 1.2 * r.median_px) << "draw " << k;
+    EXPECT_GT(p.median_px, r.median_px / 1.2) << "draw " << k;
+    EXPECT_LT(p.worst_px, 1.4 * r.worst_px) << "draw " << k;
+    EXPECT_GT(p.worst_px, r.worst_px / 1.4) << "draw " << k;
+  }
+}
+
 TEST(Advice, AdvisedViewsBeatRandomOnesForTheSampleLens) {
   const SceneSpec scene = SampleScene();
   const Comparison c = CompareAdvisedWithRandom(scene.camera, scene.board);
@@ -238,6 +289,7 @@ TEST(Advice, AdvisedViewsBeatRandomOnesForTheSampleLens) {
   EXPECT_LT(c.advised_worst, c.start_worst / 20);
   EXPECT_LT(2 * c.advised_worst, c.random_median_worst);
   ExpectPredictionsFollow(c);
+  ExpectPosePredictionsFollow(c);
 }
 
 TEST(Advice, AdvisedViewsBeatRandomOnesForAFisheye) {
@@ -248,6 +300,7 @@ TEST(Advice, AdvisedViewsBeatRandomOnesForAFisheye) {
   EXPECT_LT(c.advised_worst, c.start_worst / 20);
   EXPECT_LT(c.advised_worst, c.random_median_worst);
   ExpectPredictionsFollow(c);
+  ExpectPosePredictionsFollow(c);
 }
 
 TEST(Advice, DescribesPosesInWords) {
