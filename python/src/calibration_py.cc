@@ -85,6 +85,27 @@ py::dict AdviceDict(const Advice& advice, const PyCalibration& c) {
   return d;
 }
 
+// A pose (R, t) given from Python: R a rotation (3 x 3), t 3 values.
+Eigen::Isometry3d PoseFrom(const py::handle& pose, const char* what) {
+  const py::tuple pair = py::cast<py::tuple>(pose);
+  if (pair.size() != 2) Raise(std::string(what) + ": expected a pair (R, t)");
+  const std::vector<Eigen::Vector3d> rows = Points3(pair[0], what);
+  const std::vector<Eigen::Vector3d> t = Points3(
+      py::array::ensure(pair[1]).attr("reshape")(-1, 3), what);
+  if (rows.size() != 3 || t.size() != 1) {
+    Raise(std::string(what) + ": R must be 3 x 3 and t 3 values");
+  }
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) out.linear().row(r) = rows[r].transpose();
+  out.translation() = t[0];
+  const Eigen::Matrix3d R = out.linear();
+  if (!((R * R.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
+        std::abs(R.determinant() - 1.0) < 1e-6)) {
+    Raise(std::string(what) + ": R is not a rotation");
+  }
+  return out;
+}
+
 }  // namespace
 
 int Threads(int threads) {
@@ -93,6 +114,25 @@ int Threads(int threads) {
                      : static_cast<int>(
                            std::max(1u, std::thread::hardware_concurrency()));
 }
+
+namespace {
+
+// The advice's options as the program sets them from a run's options: its
+// verdict's target, the spline prior the calibration had.
+AdviceOptions AdviceOptionsFor(const RunOptions& options, double field_deg,
+                               int threads, const std::string& what) {
+  AdviceOptions advice = options.advice;
+  advice.field_deg = field_deg;
+  advice.num_threads = Threads(threads);
+  advice.target_uncertainty_px = options.verdict.max_uncertainty_px;
+  advice.target_min_views = options.verdict.min_views;
+  advice.spline_prior = options.calibration.spline_prior;
+  std::string why;
+  if (!advice.Check(&why)) Raise(what + ": " + why);
+  return advice;
+}
+
+}  // namespace
 
 namespace {
 
@@ -386,15 +426,9 @@ void BindCalibration(py::module_& m) {
           "advise",
           [](const PyCalibration& c, int count, double field_deg,
              const RunOptions& options, int threads) {
-            AdviceOptions advice_options = options.advice;
+            AdviceOptions advice_options =
+                AdviceOptionsFor(options, field_deg, threads, "advise");
             advice_options.count = count;
-            advice_options.field_deg = field_deg;
-            advice_options.num_threads = Threads(threads);
-            advice_options.target_uncertainty_px =
-                options.verdict.max_uncertainty_px;
-            advice_options.target_min_views = options.verdict.min_views;
-            // The prior the calibration had (as the program's advice).
-            advice_options.spline_prior = options.calibration.spline_prior;
             std::string why;
             if (!advice_options.Check(&why)) Raise("advise: " + why);
             Advice advice;
@@ -416,6 +450,36 @@ void BindCalibration(py::module_& m) {
           "tilt_deg, tilt_direction_deg, outline_px (the board's border in "
           "the image), expected_after and picture (an image as next_K.png "
           "shows it). field_deg limits the judged field (0: the default).")
+      .def(
+          "predict",
+          [](const PyCalibration& c, const py::list& poses, double field_deg,
+             const RunOptions& options) {
+            const AdviceOptions advice_options =
+                AdviceOptionsFor(options, field_deg, 1, "predict");
+            std::vector<Eigen::Isometry3d> cam_from_board;
+            for (const py::handle& pose : poses) {
+              cam_from_board.push_back(PoseFrom(pose, "predict: pose"));
+            }
+            FieldUncertainty after;
+            std::string error;
+            bool ok = false;
+            {
+              py::gil_scoped_release release;
+              ok = PredictWithPoses(c.views, c.judged.result, c.board,
+                                    cam_from_board, advice_options, &after,
+                                    &error);
+            }
+            if (!ok) Raise("predict: " + error);
+            return UncertaintyDict(after);
+          },
+          py::arg("poses"), py::arg("field_deg") = 0.0,
+          py::arg("options") = RunOptions(),
+          "The projection uncertainty the advice predicts after adding "
+          "photos of the board from `poses` (a list of (R, t), "
+          "cam_from_board as `poses` and advise() give them) to the views "
+          "used: a dict of worst_px, median_px and worst_band_median_px over "
+          "the judged field, as advise() reports expected_after. For "
+          "comparing the advised views with poses of your own choosing.")
       .def(
           "save",
           [](const PyCalibration& c, const std::string& path,

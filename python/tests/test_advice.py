@@ -114,3 +114,36 @@ def test_advice_on_a_splined_camera_keeps_the_prior_the_options_give(
     assert written["views"][0]["expected_after"]["worst_px"] == \
         pytest.approx(mine["views"][0]["expected_after"]["worst_px"],
                       rel=1e-9)
+
+
+def test_predict_with_the_advised_poses_gives_the_advices_expectation(advice):
+    """Calibration.predict scores poses the way the advice scores its
+    candidates: the advised poses give the advice's expectation after its
+    last view, no pose gives the uncertainty now, and the taken views'
+    own poses taken once more at least double the information (the
+    uncertainty falls by sqrt(2) or more): a predicted view counts every
+    board corner its pose puts in the image, the calibration only those
+    detected and kept; but less than triple it."""
+    calibration, result = advice
+    poses = [(view["R"], view["t"]) for view in result["views"]]
+    expected = result["views"][-1]["expected_after"]
+    predicted = calibration.predict(poses)
+    for key in ("worst_px", "median_px", "worst_band_median_px"):
+        assert predicted[key] == pytest.approx(expected[key], rel=1e-9)
+    now = calibration.predict([])
+    assert now["worst_px"] == pytest.approx(
+        result["uncertainty_now"]["worst_px"], rel=1e-9)
+    used = [pose for pose, kept in zip(calibration.poses,
+                                       calibration.view_used) if kept]
+    again = calibration.predict(used)
+    ratio = now["median_px"] / again["median_px"]
+    assert np.sqrt(2) * 0.98 < ratio < np.sqrt(3)
+
+
+def test_predict_refuses_a_matrix_that_is_no_rotation(advice):
+    calibration, result = advice
+    t = result["views"][0]["t"]
+    with pytest.raises(ValueError, match="R is not a rotation"):
+        calibration.predict([(2 * np.eye(3), t)])
+    with pytest.raises(ValueError, match="R must be 3 x 3"):
+        calibration.predict([(np.eye(3)[:2], t)])
