@@ -47,7 +47,9 @@ void PrintProgramHelp() {
 }
 
 // True when --NAME appears in the synopsis (the usage up to its first blank
-// line) outside square brackets: a flag the subcommand needs.
+// line) outside square brackets and parentheses (a remark such as "(MODEL:
+// see --model below)" names a flag without requiring it): a flag the
+// subcommand needs.
 bool IsRequiredFlag(const Subcommand& s, const std::string& name) {
   const std::string usage = s.usage;
   const std::string synopsis = usage.substr(0, usage.find("\n\n"));
@@ -65,7 +67,8 @@ bool IsRequiredFlag(const Subcommand& s, const std::string& name) {
       }
       int depth = 0;
       for (size_t k = 0; k < at; ++k) {
-        depth += synopsis[k] == '[' ? 1 : synopsis[k] == ']' ? -1 : 0;
+        const char c = synopsis[k];
+        depth += (c == '[' || c == '(') ? 1 : (c == ']' || c == ')') ? -1 : 0;
       }
       if (depth == 0) return true;
     }

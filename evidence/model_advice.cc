@@ -43,6 +43,15 @@ ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
     advice.suggested_rms_px = suggested->holdout_rms_px;
     advice.confirmed =
         BeatsOnHeldOutViews(*suggested, *current, selection_options, &advice.z);
+  } else if (current != nullptr && suggested != nullptr && !current->ok &&
+             suggested->ok) {
+    // The calibrated model cannot even be fitted to the folds (a pinhole
+    // model for corners beyond the field it is meant for) while the
+    // suggested one fits and predicts the held-out views: that is the
+    // comparison's answer, not a failure to compare.
+    advice.suggested_rms_px = suggested->holdout_rms_px;
+    advice.current_error = current->error;
+    advice.confirmed = true;
   } else if (advice.error.empty()) {
     advice.error = suggested != nullptr && !suggested->ok
                        ? advice.suggested + ": " + suggested->error
@@ -50,6 +59,18 @@ ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
   }
   const std::string current_name = CameraModelName(current_id);
   if (advice.confirmed) {
+    if (!advice.current_error.empty()) {
+      // The reason the calibrated model cannot be fitted replaces the
+      // verdict's own (a pinhole fit places wide corners at smaller
+      // angles than they are).
+      verdict->next_step = StringPrintf(
+          "calibrate with --model %s; on held-out views it fits %.4f px, "
+          "where %s cannot be fitted (%s)",
+          advice.suggested.c_str(),
+          advice.suggested_rms_px, current_name.c_str(),
+          advice.current_error.c_str());
+      return advice;
+    }
     verdict->next_step += StringPrintf(
         "; on held-out views it fits %.4f px against %.4f px for %s",
         advice.suggested_rms_px, advice.current_rms_px, current_name.c_str());

@@ -842,7 +842,7 @@ TEST_F(BadInputTest, ConsoleVersionHelpAndQuiet) {
   EXPECT_EQ(run.exit_code, kExitOk) << run.all();
   for (const char* line :
        {"--images (required)", "--board (required)", "--out (required)",
-        "--format (default: puzzlecal)",
+        "--model (default: pinhole-radtan)", "--format (default: puzzlecal)",
         "--rostopic (default: /cam0/image_raw)",
         "--camera-name (default: camera)", "--quiet", "--verbose"}) {
     EXPECT_NE(run.out.find(line), std::string::npos) << line << "\n" << run.out;

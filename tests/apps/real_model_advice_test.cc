@@ -126,6 +126,34 @@ TEST(RealSets, AutoPicksPinholeForPinholeCamerasAndAdviceFollowsHeldOut) {
         EXPECT_TRUE(CameraModelIsPinhole(suggested)) << verdict.Line();
       }
     }
+    // A pinhole model the comparison could not even fit (corners beyond
+    // its field): when a calibration with it is written at all, its
+    // verdict names the fisheye model that fits the held-out views, and
+    // does not blame the photos (bfish with pinhole-radtan said
+    // inconsistent-views: "retake").
+    for (const ModelCandidate& current : selection.candidates) {
+      if (current.ok || !CameraModelIsPinhole(current.model)) continue;
+      SCOPED_TRACE(CameraModelName(current.model));
+      CalibrationResult result;
+      if (!Calibrate(views, current.model, width, height, calibration, &result,
+                     &error)) {
+        continue;
+      }
+      const EvidenceOptions evidence_options;
+      Verdict verdict = MakeVerdict(
+          result, ComputeEvidence(views, result, calibration, evidence_options),
+          evidence_options, VerdictOptions());
+      CheckModelAdvice(views, result, calibration, selection_options, nullptr,
+                       &verdict);
+      EXPECT_EQ(verdict.kind, VerdictKind::kModelError) << verdict.Line();
+      CameraModelId suggested;
+      ASSERT_TRUE(CameraModelIdFromName(verdict.suggested_model, &suggested))
+          << verdict.Line();
+      EXPECT_FALSE(CameraModelIsPinhole(suggested)) << verdict.Line();
+      const ModelCandidate* fitted = selection.Find(suggested);
+      ASSERT_NE(fitted, nullptr);
+      EXPECT_TRUE(fitted->ok) << selection.Table();
+    }
   }
 }
 
