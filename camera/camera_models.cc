@@ -1,5 +1,7 @@
 #include "camera/camera_models.h"
 
+#include <algorithm>
+
 namespace puzzlecal {
 
 const char* CameraModelName(CameraModelId id) {
@@ -66,6 +68,29 @@ double MaxMonotonicRadius(const Camera& camera) {
   return DispatchCameraModel(camera.model, [&](auto model) {
     return decltype(model)::MaxMonotonicRadius(camera.params.data());
   });
+}
+
+double BorderFractionWithoutRay(const Camera& camera, int samples_per_side) {
+  const double max_radius = MaxMonotonicRadius(camera);
+  const int n = std::max(1, samples_per_side);
+  const double w = camera.width, h = camera.height;
+  int without = 0, samples = 0;
+  auto sample = [&](double x, double y) {
+    ++samples;
+    Eigen::Vector3d ray;
+    if (!camera.Unproject(Eigen::Vector2d(x, y), &ray).converged ||
+        !(FieldRadius(camera, ray) < max_radius)) {
+      ++without;
+    }
+  };
+  for (int k = 0; k < n; ++k) {
+    const double s = (k + 0.5) / n;
+    sample(-0.5, -0.5 + s * h);
+    sample(w - 0.5, -0.5 + s * h);
+    sample(-0.5 + s * w, -0.5);
+    sample(-0.5 + s * w, h - 0.5);
+  }
+  return static_cast<double>(without) / samples;
 }
 
 bool CameraModelIsSplined(CameraModelId id) {

@@ -620,6 +620,15 @@ double FieldRadius(const Camera& camera, const Eigen::Vector3d& ray);
 // for pinhole models.
 double MaxMonotonicRadius(const Camera& camera);
 
+// The share of the image border (samples_per_side points along each of its
+// four sides) whose pixels have no ray: the model's inverse does not
+// converge there, or only to a ray beyond the distortion's fold
+// (MaxMonotonicRadius). A polynomial distortion fitted to corners near the
+// image's centre can fold over before the image's corners; undistorted and
+// rectified images are wrong there. 0 when every sample has a ray.
+double BorderFractionWithoutRay(const Camera& camera,
+                                int samples_per_side = 64);
+
 // The central model whose projection a non-central one approaches for far
 // points, and its parameters (the model itself for central ones):
 // kannala-brandt-noncentral -> kannala-brandt without e1 e2.

@@ -781,6 +781,23 @@ std::string NextModel(CameraModelId model, bool grows_with_closeness,
   }
 }
 
+// A pinhole calibration whose fitted distortion folds over inside the
+// image: a note (the verdict judges the field the corners covered, where
+// the model may be right), because undistorted and rectified images are
+// wrong beyond the fold and a user cannot see it from the figures.
+void AddFoldNote(const Camera& camera, std::vector<std::string>* notes) {
+  if (!CameraModelIsPinhole(camera.model)) return;  // fisheye: image circle
+  const double without = BorderFractionWithoutRay(camera);
+  if (!(without > 0)) return;
+  notes->push_back(StringPrintf(
+      "the fitted distortion folds over inside the image: %.1f %% of the "
+      "image border has no ray (the model has no inverse there): "
+      "undistorted and rectified images are wrong towards the image's "
+      "corners. Unless the lens itself shows nothing there, views with the "
+      "board in the image's corners pin the distortion down",
+      100 * without));
+}
+
 Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
                     const EvidenceOptions& evidence_options,
                     const VerdictOptions& options) {
@@ -812,6 +829,7 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   AddInsufficientDataFindings(result, evidence, evidence_options, options,
                               &findings, &notes);
 
+  AddFoldNote(result.camera, &notes);
   RankFindings(findings, &verdict);
   verdict.notes = notes;
   for (const Finding& f : findings) {

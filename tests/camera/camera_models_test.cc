@@ -403,6 +403,45 @@ TEST(CameraModelFacts, MaxMonotonicRadiusIsWhereTheImageFoldsOver) {
   EXPECT_NEAR(MaxMonotonicRadius(plain), 572.0, 1e-9);
 }
 
+// BorderFractionWithoutRay against the closed form of a pure k1 lens: r (1 +
+// k1 r^2) peaks at r = 1 / sqrt(-3 k1) with the distorted radius 2/3 of it,
+// so the border pixels farther than f times that from the principal point
+// have no ray. A mild lens keeps every border pixel.
+TEST(CameraModelFacts, BorderPixelsBeyondTheFoldHaveNoRay) {
+  Camera camera;
+  camera.model = CameraModelId::kPinholeRadtan;
+  camera.width = 640;
+  camera.height = 480;
+  const double f = 400;
+  for (double k1 : {-0.05, -0.3, -0.6}) {
+    camera.params = {f, f, 320, 240, k1, 0, 0, 0, 0};
+    const double fold_px = f * (2.0 / 3.0) / std::sqrt(-3 * k1);
+    const int n = 64;
+    int beyond = 0, samples = 0;
+    for (int k = 0; k < n; ++k) {
+      const double s = (k + 0.5) / n;
+      for (const Eigen::Vector2d& p :
+           {Eigen::Vector2d(-0.5, -0.5 + s * 480),
+            Eigen::Vector2d(639.5, -0.5 + s * 480),
+            Eigen::Vector2d(-0.5 + s * 640, -0.5),
+            Eigen::Vector2d(-0.5 + s * 640, 479.5)}) {
+        ++samples;
+        beyond += (p - Eigen::Vector2d(320, 240)).norm() > fold_px ? 1 : 0;
+      }
+    }
+    const double expected = static_cast<double>(beyond) / samples;
+    EXPECT_NEAR(BorderFractionWithoutRay(camera, n), expected,
+                1.0 / samples)
+        << "k1 " << k1 << ", fold at " << fold_px << " px";
+    if (k1 == -0.05) {
+      EXPECT_EQ(expected, 0.0);
+    }
+    if (k1 == -0.6) {
+      EXPECT_GT(expected, 0.3);
+    }
+  }
+}
+
 // The far-field camera of the non-central model is kannala-brandt with its
 // first eight parameters; central models are their own far field.
 TEST(CameraModelFacts, FarFieldCamera) {
