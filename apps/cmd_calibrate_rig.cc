@@ -588,6 +588,9 @@ void PrintRigOutcome(const RigCalibrationResult& result,
   for (size_t c = 0; c < result.cameras.size(); ++c) {
     std::cout << RigVerdictLine(result.cameras[c].name, judged.verdicts[c])
               << "\n";
+    for (const std::string& note : judged.verdicts[c].notes) {
+      std::cout << result.cameras[c].name << ": note: " << note << "\n";
+    }
   }
   std::cout << judged.rig_verdict.Line() << "\n";
   const bool rectified =
