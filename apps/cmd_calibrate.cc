@@ -657,21 +657,19 @@ int CalibrateAndJudge(CalibrateRequest* request_in, CalibrationRun* run) {
 
 // The camera file, written first so that a failing report or Ctrl-C does
 // not lose it. Returns kExitOk or kExitOutputError.
-int WriteCameraOf(const CalibrateRequest& request, const CalibrationRun& run) {
+int WriteCameraOf(const CalibrateRequest& request, const CalibrationRun& run,
+                  std::string* format_note) {
   CameraFileNames names;
   names.camera_name = FLAGS_camera_name;
   names.rostopic = FLAGS_rostopic;
   const CameraFileStats stats = CalibrationFileStats(
       run.result, run.views, ViewFiles(run.images, run.views.size()),
       request.board.Point(request.board.origin), run.verdict.Line());
-  std::string error, format_note;
+  std::string error;
   if (!WriteCameraFile(FLAGS_out, request.format, run.result.camera, stats,
-                       &error, &format_note, names)) {
+                       &error, format_note, names)) {
     std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitOutputError;
-  }
-  if (!format_note.empty() && request.verbosity != Verbosity::kQuiet) {
-    std::cout << "note: " << FLAGS_out << ": " << format_note << "\n";
   }
   g_camera_written = 1;
   return kExitOk;
@@ -755,8 +753,10 @@ int FinishRun(const CalibrateRequest& request, const CalibrationRun& run,
   const std::vector<ReportImage> report_images =
       MakeReportImages(run.images, run.calibrated ? &run.result : nullptr);
   PrintImageProblems(report_images);
+  std::string format_note;
   if (run.calibrated) {
-    if (const int code = WriteCameraOf(request, run); code != kExitOk) {
+    if (const int code = WriteCameraOf(request, run, &format_note);
+        code != kExitOk) {
       return code;
     }
   }
@@ -771,6 +771,12 @@ int FinishRun(const CalibrateRequest& request, const CalibrationRun& run,
     return kExitNoResult;
   }
   PrintOutcome(request, run, run_timer.Seconds());
+  // What the file's format could not hold, after the verdict that judged
+  // the calibration (its "ready to use" is about the calibration; this is
+  // about the file), also with --quiet.
+  if (!format_note.empty()) {
+    std::cout << "note: " << FLAGS_out << ": " << format_note << "\n";
+  }
   return kExitOk;
 }
 

@@ -685,6 +685,29 @@ TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
   EXPECT_FALSE(fs::exists(rational));
 }
 
+// A camera file whose format cannot hold the model (a splined camera in
+// OpenCV's YAML) says so on the terminal after the verdict: the verdict's
+// "ready to use" is about the calibration, the note about the file, and a
+// note printed before the summary scrolled out of sight.
+TEST_F(BadInputTest, LossyFormatNoteComesAfterTheVerdict) {
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const ProgramRun run =
+      Calibrate(folder, camera, "--model kannala-brandt-splined --format opencv");
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  const std::string note = "note: " + camera.string() +
+                           ": the opencv format has no kannala-brandt-splined "
+                           "model";
+  const size_t at_note = run.out.find(note);
+  const size_t at_verdict = run.out.find("verdict: ");
+  ASSERT_NE(at_note, std::string::npos) << run.out;
+  ASSERT_NE(at_verdict, std::string::npos) << run.out;
+  EXPECT_GT(at_note, at_verdict) << run.out;
+  EXPECT_EQ(run.out.find(note, at_note + 1), std::string::npos)
+      << "said twice:\n"
+      << run.out;
+}
+
 // A board file that does not fit the photos (another board, another origin,
 // cols and rows swapped) ends with a message about the board file, not with
 // one about image sizes or the number of views.
