@@ -5,6 +5,7 @@
 #include "target/puzzleboard_codes.h"
 #include "util/enum_names.h"
 #include "util/failure.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 
@@ -44,6 +45,12 @@ bool Board::Check(std::string* why) const {
   }
   if (!(std::isfinite(tile_size_m) && tile_size_m > 0.0)) {
     return Fail("tile_size_m must be a positive number of metres", why);
+  }
+  if (tile_size_m > kMaxTileSizeM) {
+    return Fail(StringPrintf("tile_size_m is %g m, more than %g m: it is in "
+                             "metres (30 mm tiles are 0.030)",
+                             tile_size_m, kMaxTileSizeM),
+                why);
   }
   if (Traits().has_origin) {
     if (cols > kPuzzleBoardPeriod || rows > kPuzzleBoardPeriod) {

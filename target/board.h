@@ -45,6 +45,10 @@ bool BoardTypeFromName(const std::string& name, BoardType* type);
 // (a checkerboard; a PuzzleBoard is limited to 501 by its code). Bounds
 // memory and work for a mistyped size.
 inline constexpr int kMaxBoardSide = 2000;
+// Largest tile side a board file may give, in metres: a larger one is a
+// length in millimetres or centimetres written as metres (30 for 30 mm
+// tiles made a rig's baseline 120 km and advised the board 190 m away).
+inline constexpr double kMaxTileSizeM = 1.0;
 
 struct Board {
   // Which pattern is printed.

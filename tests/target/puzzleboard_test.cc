@@ -255,6 +255,12 @@ TEST(BoardGeometry, CheckRejectsBadFields) {
   board.tile_size_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(board.Check(&why));
   EXPECT_NE(why.find("tile_size_m"), std::string::npos);
+  // Millimetres written as metres: 30 mm tiles given as 30.
+  board.tile_size_m = 30;
+  EXPECT_FALSE(board.Check(&why));
+  EXPECT_NE(why.find("30 mm tiles are 0.030"), std::string::npos) << why;
+  board.tile_size_m = 1.0;  // the largest accepted
+  EXPECT_TRUE(board.Check(&why)) << why;
   board = Board();
   board.origin = Eigen::Vector2i(501, 0);
   EXPECT_FALSE(board.Check(&why));
