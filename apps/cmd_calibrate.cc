@@ -583,8 +583,9 @@ int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
       run->calibration_error = error;
       return kExitNoResult;
     }
-    std::cerr << run->selection.Table() << "puzzlecal calibrate: " << error
-              << "\n";
+    // The table, when any candidate was tried (it shows why each failed).
+    if (!run->selection.candidates.empty()) std::cerr << run->selection.Table();
+    std::cerr << "puzzlecal calibrate: " << error << "\n";
     return kExitNoResult;
   }
   if (!request->watching && request->verbosity != Verbosity::kQuiet) {

@@ -552,6 +552,19 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
   std::string why;
   if (!options.Check(&why))
     return Fail("model selection options: " + why, error);
+  // Too few views fail every candidate's folds alike: said once, in the
+  // calibration's words.
+  const size_t needed = static_cast<size_t>(calibration.min_views) + 1;
+  if (views.size() < needed) {
+    return Fail(StringPrintf("only %zu usable view%s (need at least %zu to "
+                             "compare models, which fits on some views and "
+                             "holds others out; %d for one named model): add "
+                             "views of the board at different positions and "
+                             "tilted by 30 degrees or more",
+                             views.size(), views.size() == 1 ? "" : "s",
+                             needed, calibration.min_views),
+                error);
+  }
   SelectionRun run;
   run.views = &views;
   run.width = width;

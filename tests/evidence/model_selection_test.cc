@@ -88,6 +88,37 @@ TEST(SelectModel, SplitsViewsAndListsCandidates) {
   }
 }
 
+// Fewer views than a comparison can fit on and hold out: one message in
+// the calibration's words, not a failure per candidate and fold.
+TEST(SelectModel, TooFewViewsAreSaidOnce) {
+  const Camera truth = sim::TruthRadtan();
+  SyntheticData data = Data(truth, 2);
+  for (size_t count : {1u, 3u}) {
+    std::vector<CalibrationView> views(data.views.begin(),
+                                       data.views.begin() + count);
+    ModelSelection selection;
+    std::string error;
+    EXPECT_FALSE(SelectModel(views, truth.width, truth.height,
+                             CalibrationOptions(), ModelSelectionOptions(),
+                             &selection, &error));
+    EXPECT_EQ(error.rfind("only " + std::to_string(count) + " usable view", 0),
+              0u)
+        << error;
+    EXPECT_NE(error.find("need at least 4 to compare models"),
+              std::string::npos)
+        << error;
+    EXPECT_TRUE(selection.candidates.empty());
+  }
+  // Four: a comparison runs.
+  std::vector<CalibrationView> four(data.views.begin(),
+                                    data.views.begin() + 4);
+  ModelSelection selection;
+  std::string error;
+  SelectModel(four, truth.width, truth.height, CalibrationOptions(),
+              ModelSelectionOptions(), &selection, &error);
+  EXPECT_FALSE(selection.candidates.empty()) << error;
+}
+
 // Radtan lens: radtan (the rational model fits as well, with more
 // parameters, and does not win).
 TEST(SelectModel, ChoosesRadtanForARadtanLens) {
