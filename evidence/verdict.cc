@@ -645,19 +645,21 @@ std::string GoodReason(const CalibrationResult& result,
     }
   }
   std::string reason = StringPrintf("RMS %.3f px", result.rms_px);
-  if (cv.ok) {
+  if (cv.ok && halves_scale > 1) {
+    // Not "the halves agree" alone: they do only once their uncertainty
+    // is scaled, and the stated one is what the camera file carries.
+    reason += StringPrintf(
+        "; the halves agree only with their stated uncertainty scaled by "
+        "%.2f, the factor by which they differ more than it in every band "
+        "(largest band median %.3f px, the stated uncertainty predicts "
+        "%.3f px): corner errors shared within views, so the stated "
+        "uncertainty is optimistic by about that factor",
+        halves_scale, worst_diff, worst_expected);
+  } else if (cv.ok) {
     reason += StringPrintf(
         "; the halves agree (largest band median %.3f px, noise predicts "
-        "%.3f px",
+        "%.3f px)",
         worst_diff, worst_expected);
-    if (halves_scale > 1) {
-      reason += StringPrintf(
-          "; they differ %.2f times more than it in every band: corner "
-          "errors shared within views, the stated uncertainty is "
-          "optimistic by about that factor",
-          halves_scale);
-    }
-    reason += ")";
   }
   return reason + "; no systematic residuals";
 }
