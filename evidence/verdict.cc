@@ -295,9 +295,17 @@ int AddBadDetectionFindings(const CalibrationResult& result,
     findings->push_back(
         {VerdictKind::kBadDetections,
          StringPrintf("%.1f %% of the corners were rejected as outliers (limit "
-                      "%.1f %%)",
+                      "%.1f %%",
                       100 * outlier_fraction,
-                      100 * options.max_outlier_fraction)});
+                      100 * options.max_outlier_fraction) +
+             (view_errors.empty()
+                  ? std::string(")")
+                  : StringPrintf("; %.1f %% with the %zu view(s) of "
+                                 "view-level errors, counted apart)",
+                                 100.0 * result.num_outliers /
+                                     std::max(1, result.num_corners_used +
+                                                     result.num_outliers),
+                                 view_errors.size()))});
   }
   std::vector<ViewJudgement>& judged = verdict->views;
   judged.assign(result.view_used.size(), ViewJudgement());
@@ -363,7 +371,7 @@ int AddBadDetectionFindings(const CalibrationResult& result,
     findings->push_back(
         {VerdictKind::kBadDetections,
          StringPrintf(
-             "%d view(s) dropped, with more than %.0f %% of their "
+             "%d view(s) stand out, with more than %.0f %% of their "
              "corners rejected, or with inliers above %.2f px (%.0f x the "
              "median view's %.3f px): ",
              num_bad_views, 100 * options.max_view_outlier_fraction, limit,
