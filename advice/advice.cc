@@ -816,17 +816,27 @@ std::string DescribePose(const Camera& camera, const Eigen::Vector2d& centre_px,
     shift += std::string(shift.empty() ? "" : " and ") +
              (right < 0 ? "left of" : "right of");
   }
+  // "At the edge" and "in the corner" only within the outer sixth of the
+  // image (a centre a third of the way in was "at the left edge"); the
+  // rest of an outer third is said as such.
+  const bool near_side = std::abs(right) > 1.0 / 3;
+  const bool near_top_bottom = std::abs(down) > 1.0 / 3;
   std::string place;
   if (row == 1 && col == 1) {
     place = shift.empty() ? "in the centre of the image"
                           : "a little " + shift + " the centre of the image";
   } else if (row == 1) {
-    place = std::string("at the ") + kCols[col] + " edge of the image";
+    place = near_side
+                ? std::string("at the ") + kCols[col] + " edge of the image"
+                : std::string("in the ") + kCols[col] + " third of the image";
   } else if (col == 1) {
-    place = std::string("at the ") + kRows[row] + " edge of the image";
+    place = near_top_bottom
+                ? std::string("at the ") + kRows[row] + " edge of the image"
+                : std::string("in the ") + kRows[row] + " third of the image";
   } else {
     place = std::string("in the ") + kRows[row] + "-" + kCols[col] +
-            " corner of the image";
+            (near_side && near_top_bottom ? " corner of the image"
+                                          : " part of the image");
   }
   // Centimetres for a board held close, where "0.073 m" reads badly.
   const std::string distance = distance_m < 0.3

@@ -320,6 +320,14 @@ TEST(Advice, DescribesPosesInWords) {
   EXPECT_EQ(DescribePose(camera, {400, 300}, 1.0, 0, 0),
             "board about 1 m away, its centre in the centre of the image, "
             "facing the camera squarely");
+  // A third of the way in (the advice's second column of places) is not
+  // "at the edge": 240 of 800 px.
+  EXPECT_EQ(DescribePose(camera, {239.5, 299.5}, 1.0, 0, 0),
+            "board about 1 m away, its centre in the left third of the "
+            "image, facing the camera squarely");
+  EXPECT_EQ(DescribePose(camera, {239.5, 74.5}, 1.0, 0, 0),
+            "board about 1 m away, its centre in the top-left part of the "
+            "image, facing the camera squarely");
 }
 
 }  // namespace
