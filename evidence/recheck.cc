@@ -143,6 +143,24 @@ void JudgeBands(const RecheckOptions& options, Recheck* out) {
         options.drift_sigmas,
         options.drift_sigmas * diff.expected_bands[largest].median,
         options.min_drift_px);
+    // Bands too uncertain to tell a drift are named: their medians (in
+    // the table above the verdict) may be larger than the one quoted.
+    std::string unresolved;
+    for (size_t b = 0; b < count; ++b) {
+      const AngleBand& band = diff.difference_bands[b];
+      if (out->band_resolved[b] || band.count < options.evidence.min_bin_count ||
+          !std::isfinite(band.median)) {
+        continue;
+      }
+      unresolved += StringPrintf("%s%s %.3f px", unresolved.empty() ? "" : ", ",
+                                 BandName(band).c_str(), band.median);
+    }
+    if (!unresolved.empty()) {
+      out->reason += StringPrintf(
+          "; the bands whose %.0f sigma exceeds %.2f px cannot tell a drift "
+          "and are not judged: %s",
+          options.drift_sigmas, options.max_detectable_px, unresolved.c_str());
+    }
     return;
   }
   out->verdict = RecheckVerdict::kNotEnoughData;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "calib/calibrate.h"
 #include "evidence/evidence.h"
 #include "sim/synthetic_views.h"
+#include "util/string_format.h"
 
 namespace puzzlecal {
 namespace {
@@ -237,6 +239,54 @@ TEST(Recheck, TheSameCameraIsStillValidAndAChangedFocalLengthHasDrifted) {
   EXPECT_NEAR(worst.median, truth_worst.median, 0.15 * truth_worst.median)
       << drifted.reason;
   EXPECT_NE(drifted.reason.find("bands drifted"), std::string::npos);
+}
+
+// A still-valid verdict quotes the largest median of the bands that can
+// tell a drift; the bands too uncertain to (3 sigma above
+// max_detectable_px) are named with their medians, which may be larger.
+TEST(Recheck, StillValidNamesTheBandsItCannotJudge) {
+  const Camera truth = sim::TruthRadtan();
+  const SyntheticData original = MakeSyntheticData(Scene(truth, 25, 7));
+  const StoredCalibration stored =
+      StoredOf(CalibrateOrFail(original.views, truth.model, truth));
+  const SyntheticData same = MakeSyntheticData(Scene(truth, 15, 8));
+  const Recheck all = RecheckCalibration(same.views, stored,
+                                         CalibrationOptions(), RecheckOptions());
+  ASSERT_EQ(all.verdict, RecheckVerdict::kStillValid) << all.reason;
+  EXPECT_EQ(all.reason.find("not judged"), std::string::npos) << all.reason;
+  // The bound between the two most certain judged bands: only the most
+  // certain stays judged.
+  RecheckOptions options;
+  std::vector<double> bounds;
+  for (size_t b = 0; b < all.difference.expected_bands.size(); ++b) {
+    if (all.difference.difference_bands[b].count <
+        options.evidence.min_bin_count) {
+      continue;
+    }
+    bounds.push_back(options.drift_sigmas *
+                     all.difference.expected_bands[b].median);
+  }
+  ASSERT_GE(bounds.size(), 2u);
+  std::sort(bounds.begin(), bounds.end());
+  options.max_detectable_px = 0.5 * (bounds[0] + bounds[1]);
+  const Recheck few =
+      RecheckCalibration(same.views, stored, CalibrationOptions(), options);
+  ASSERT_EQ(few.verdict, RecheckVerdict::kStillValid) << few.reason;
+  EXPECT_NE(few.reason.find("cannot tell a drift and are not judged"),
+            std::string::npos)
+      << few.reason;
+  for (size_t b = 0; b < few.band_resolved.size(); ++b) {
+    const AngleBand& band = few.difference.difference_bands[b];
+    if (few.band_resolved[b] || band.count < options.evidence.min_bin_count) {
+      continue;
+    }
+    const std::string named =
+        StringPrintf("%.0f-%.0f deg %.3f px", band.lo_deg, band.hi_deg,
+                     band.median);
+    EXPECT_NE(few.reason.find(named), std::string::npos)
+        << named << "\n"
+        << few.reason;
+  }
 }
 
 TEST(Recheck, TooFewViewsIsNotEnoughData) {
