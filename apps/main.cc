@@ -79,8 +79,11 @@ bool IsRequiredFlag(const Subcommand& s, const std::string& name) {
 void PrintSubcommandHelp(const Subcommand& s) {
   std::cout << s.usage << "\n\nFlags:\n";
   std::vector<std::string> names = s.flags;
-  names.push_back("quiet");
-  names.push_back("verbose");
+  for (const char* common : {"quiet", "verbose"}) {
+    if (std::find(names.begin(), names.end(), common) == names.end()) {
+      names.push_back(common);
+    }
+  }
   for (const std::string& name : names) {
     gflags::CommandLineFlagInfo info;
     if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info)) continue;

@@ -871,8 +871,8 @@ std::string ProjectionDifferenceText(const ProjectionDiff& diff,
     const AngleBand& d = diff.difference_bands[b];
     if (d.count == 0) continue;
     text << indent
-         << StringPrintf("%3.0f-%3.0f deg %9.3f %8.3f %8.3f", d.lo_deg,
-                         d.hi_deg, d.median, d.p95, d.max);
+         << StringPrintf("%11s %9.3f %8.3f %8.3f", BandLabel(d).c_str(),
+                         d.median, d.p95, d.max);
     if (diff.expected_ok && b < diff.expected_bands.size()) {
       const AngleBand& e = diff.expected_bands[b];
       text << StringPrintf(" %17.3f %8.3f", e.median, e.p95);
@@ -880,6 +880,17 @@ std::string ProjectionDifferenceText(const ProjectionDiff& diff,
     text << "  n=" << d.count << "\n";
   }
   return text.str();
+}
+
+std::string AngleRangeLabel(double lo_deg, double hi_deg) {
+  if (std::lround(lo_deg) == std::lround(hi_deg)) {
+    return StringPrintf("%.0f-%.1f deg", lo_deg, hi_deg);
+  }
+  return StringPrintf("%.0f-%.0f deg", lo_deg, hi_deg);
+}
+
+std::string BandLabel(const AngleBand& band) {
+  return AngleRangeLabel(band.lo_deg, band.hi_deg);
 }
 
 std::string EvidenceText(const Evidence& evidence) {
@@ -896,8 +907,8 @@ std::string EvidenceText(const Evidence& evidence) {
       const AngleBand& d = cv.difference_bands[b];
       const AngleBand& e = cv.expected_bands[b];
       if (d.count == 0) continue;
-      text << StringPrintf("  %3.0f-%3.0f deg   %8.3f   %8.3f", d.lo_deg,
-                           d.hi_deg, d.median, d.p95)
+      text << StringPrintf("  %11s   %8.3f   %8.3f", BandLabel(d).c_str(),
+                           d.median, d.p95)
            << StringPrintf("   %8.3f   %8.3f px", e.median, e.p95)
            << "  n=" << d.count << "\n";
     }

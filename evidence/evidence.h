@@ -87,6 +87,11 @@ struct AngleBand {
   double max = 0;
 };
 
+// "10-20 deg"; a last band cut short by the widest angle seen gets its end
+// to a tenth of a degree ("20-20.4 deg", not "20-20 deg").
+std::string AngleRangeLabel(double lo_deg, double hi_deg);
+std::string BandLabel(const AngleBand& band);
+
 // The far-field projection difference between two cameras of one image
 // size (ProjectionDifference): each grid pixel's ray under camera A, turned
 // by the rotation b_from_a that best aligns the two cameras' rays, projected

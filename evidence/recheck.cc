@@ -82,9 +82,6 @@ void FitFresh(const std::vector<CalibrationView>& views,
                             fresh, &out->fresh, &out->fresh_error);
 }
 
-std::string BandName(const AngleBand& band) {
-  return StringPrintf("%.0f-%.0f deg", band.lo_deg, band.hi_deg);
-}
 
 // The bands judged and the verdict drawn from them.
 void JudgeBands(const RecheckOptions& options, Recheck* out) {
@@ -109,7 +106,7 @@ void JudgeBands(const RecheckOptions& options, Recheck* out) {
     if (out->band_drifted[b]) {
       drifted_list +=
           StringPrintf("%s%s %.2f px", drifted_list.empty() ? "" : ", ",
-                       BandName(d).c_str(), d.median);
+                       BandLabel(d).c_str(), d.median);
       if (out->worst_band < 0 ||
           d.median > diff.difference_bands[out->worst_band].median) {
         out->worst_band = static_cast<int>(b);
@@ -128,7 +125,7 @@ void JudgeBands(const RecheckOptions& options, Recheck* out) {
         "the projection moved by up to %.2f px (median of the %s band; 95th "
         "percentile %.2f px, largest %.2f px), where the uncertainties give "
         "%.3f px; bands drifted: %s",
-        d.median, BandName(d).c_str(), d.p95, d.max, e.median,
+        d.median, BandLabel(d).c_str(), d.p95, d.max, e.median,
         drifted_list.c_str());
     return;
   }
@@ -139,7 +136,7 @@ void JudgeBands(const RecheckOptions& options, Recheck* out) {
         "the projection agrees with the new views' calibration up to %.0f "
         "deg off the axis: the largest band median is %.3f px (%s), where "
         "%.0f sigma is %.3f px (drifts below %.2f px are not counted)",
-        out->observed_angle_deg, d.median, BandName(d).c_str(),
+        out->observed_angle_deg, d.median, BandLabel(d).c_str(),
         options.drift_sigmas,
         options.drift_sigmas * diff.expected_bands[largest].median,
         options.min_drift_px);
@@ -153,7 +150,7 @@ void JudgeBands(const RecheckOptions& options, Recheck* out) {
         continue;
       }
       unresolved += StringPrintf("%s%s %.3f px", unresolved.empty() ? "" : ", ",
-                                 BandName(band).c_str(), band.median);
+                                 BandLabel(band).c_str(), band.median);
     }
     if (!unresolved.empty()) {
       out->reason += StringPrintf(

@@ -1067,9 +1067,9 @@ std::string EvidenceMarkdown(const Evidence& evidence, const Verdict* verdict,
       const AngleBand& d = cv.difference_bands[b];
       const AngleBand& e = cv.expected_bands[b];
       if (d.count == 0) continue;
-      md << StringPrintf("| %.0f-%.0f deg | %d | %.3f | %.3f | %.3f | %.3f |\n",
-                         d.lo_deg, d.hi_deg, d.count, d.median, d.p95, e.median,
-                         e.p95);
+      md << StringPrintf("| %s | %d | %.3f | %.3f | %.3f | %.3f |\n",
+                         BandLabel(d).c_str(), d.count, d.median, d.p95,
+                         e.median, e.p95);
     }
     md << "\n";
   } else {
@@ -1110,7 +1110,7 @@ std::string EvidenceMarkdown(const Evidence& evidence, const Verdict* verdict,
        << "|---|---:|---:|---:|\n";
     for (const ResidualBin& b : bins) {
       md << (metres ? StringPrintf("| %.3f-%.3f m", b.lo, b.hi)
-                    : StringPrintf("| %.0f-%.0f deg", b.lo, b.hi))
+                    : "| " + AngleRangeLabel(b.lo, b.hi))
          << StringPrintf(" | %d | %+.4f ± %.4f | %+.4f ± %.4f |\n", b.count,
                          b.mean_radial_px, b.se_radial_px, b.mean_tangential_px,
                          b.se_tangential_px);

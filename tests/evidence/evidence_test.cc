@@ -379,3 +379,22 @@ TEST(SystematicResiduals, ZeroForTheRightModelNotForAWrongOne) {
 
 }  // namespace
 }  // namespace puzzlecal
+
+namespace puzzlecal {
+namespace {
+
+// A last band cut short by the widest angle seen is labelled to a tenth of
+// a degree ("20-20.4 deg", not "20-20 deg").
+TEST(BandLabel, ShortLastBandKeepsItsEnd) {
+  AngleBand band;
+  band.lo_deg = 10;
+  band.hi_deg = 20;
+  EXPECT_EQ(BandLabel(band), "10-20 deg");
+  band.lo_deg = 20;
+  band.hi_deg = 20.4;
+  EXPECT_EQ(BandLabel(band), "20-20.4 deg");
+  EXPECT_EQ(AngleRangeLabel(80, 92.7), "80-93 deg");
+}
+
+}  // namespace
+}  // namespace puzzlecal
