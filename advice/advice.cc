@@ -410,8 +410,8 @@ bool MakeCandidate(const Camera& camera, const Board& board,
   if (SmallestTilePx(camera, board, pose, lens) < options.min_tile_px) {
     return false;
   }
-  if (!SubsampleInformation(camera, board, visible, corners.size(), free,
-                            pose, &out->information)) {
+  if (!SubsampleInformation(camera, board, visible, corners.size(), free, pose,
+                            &out->information)) {
     return false;
   }
   out->cam_from_board = pose;
@@ -495,7 +495,6 @@ Eigen::MatrixXd PriorInformation(const Camera& camera,
   }
   return prior;
 }
-
 
 double MedianDistance(const std::vector<CalibrationView>& views,
                       const CalibrationResult& result) {
@@ -675,12 +674,11 @@ bool StartPrediction(const std::vector<CalibrationView>& views,
   // Information in units of the corner noise.
   start->precision = 1.0 / (start->noise * start->noise);
   start->information =
-      start->precision *
-          (TakenInformation(views, result) +
-           FreeBlock(SplinePriorInformation(camera.model, camera.params[0],
-                                            camera.params[1],
-                                            options.spline_prior),
-                     start->free_index)) +
+      start->precision * (TakenInformation(views, result) +
+                          FreeBlock(SplinePriorInformation(
+                                        camera.model, camera.params[0],
+                                        camera.params[1], options.spline_prior),
+                                    start->free_index)) +
       PriorInformation(camera, start->free_index, options);
   if (!CovarianceOf(start->information, &start->covariance)) {
     *error = "the information of the views taken is not usable";

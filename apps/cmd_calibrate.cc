@@ -215,7 +215,8 @@ std::string BoardMismatchMessage(const std::vector<ImageResult>& images,
     out << "the code of " << board_file
         << " at any position: check cols, rows and origin (" << board.cols
         << " x " << board.rows << " from [" << board.origin.x() << ", "
-        << board.origin.y() << "]), or whether the board is a plain "
+        << board.origin.y()
+        << "]), or whether the board is a plain "
            "checkerboard (type: checkerboard)";
   } else {
     out << "the " << board.cols << " x " << board.rows << " corners of "

@@ -170,8 +170,7 @@ void RunLens(const Lens& lens, bool last) {
     FieldUncertainty u;
     std::string error;
     if (PredictWithPoses(views, result, lens.board, draw_four(&many_rng),
-                         options, &u,
-                         &error)) {
+                         options, &u, &error)) {
       many_predicted.push_back(u.worst_px);
     }
   }
@@ -179,8 +178,8 @@ void RunLens(const Lens& lens, bool last) {
     const std::vector<Eigen::Isometry3d> random = draw_four(&rng);
     FieldUncertainty predicted;
     std::string error;
-    if (PredictWithPoses(views, result, lens.board, random, options,
-                         &predicted, &error)) {
+    if (PredictWithPoses(views, result, lens.board, random, options, &predicted,
+                         &error)) {
       random_predicted_worst.push_back(predicted.worst_px);
     }
     std::vector<CalibrationView> random_views = views;
@@ -203,8 +202,7 @@ void RunLens(const Lens& lens, bool last) {
       "\"draws\": %zu, \"best_draw_worst_px\": %.4f, "
       "\"median_draw_over_advised\": %.2f},\n",
       advised_predicted, Median(random_predicted_worst),
-      Median(random_predicted_worst) / advised_predicted,
-      many_predicted.size(),
+      Median(random_predicted_worst) / advised_predicted, many_predicted.size(),
       many_predicted.empty()
           ? -1.0
           : *std::min_element(many_predicted.begin(), many_predicted.end()),
@@ -240,9 +238,7 @@ void RunLens(const Lens& lens, bool last) {
   std::printf(
       "   \"photos_until_good\": %d, \"good\": %s, "
       "\"verdict_at_estimate\": \"%s\"}%s\n",
-      photos, good ? "true" : "false",
-      at_estimate.c_str(),
-      last ? "" : ",");
+      photos, good ? "true" : "false", at_estimate.c_str(), last ? "" : ",");
 }
 
 double AdviceSecondsOn30Views() {

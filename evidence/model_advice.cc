@@ -66,9 +66,8 @@ ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
       verdict->next_step = StringPrintf(
           "calibrate with --model %s; on held-out views it fits %.4f px, "
           "where %s cannot be fitted (%s)",
-          advice.suggested.c_str(),
-          advice.suggested_rms_px, current_name.c_str(),
-          advice.current_error.c_str());
+          advice.suggested.c_str(), advice.suggested_rms_px,
+          current_name.c_str(), advice.current_error.c_str());
       return advice;
     }
     verdict->next_step += StringPrintf(

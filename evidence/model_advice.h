@@ -20,16 +20,16 @@
 namespace puzzlecal {
 
 struct ModelAdvice {
-  bool checked = false;    // a suggestion was there and was compared
+  bool checked = false;  // a suggestion was there and was compared
   // It beat the calibrated model on held-out views, or it fits them and the
   // calibrated model cannot be fitted to the folds at all (then
   // current_error says why: a pinhole model for corners beyond its field).
   bool confirmed = false;
-  std::string suggested;   // the model that was suggested
+  std::string suggested;        // the model that was suggested
   double suggested_rms_px = 0;  // held-out RMS of both (when compared)
   double current_rms_px = 0;
-  double z = 0;       // BeatsOnHeldOutViews' standard errors
-  std::string error;  // why the comparison could not be made
+  double z = 0;               // BeatsOnHeldOutViews' standard errors
+  std::string error;          // why the comparison could not be made
   std::string current_error;  // why the calibrated model could not be fitted
 };
 

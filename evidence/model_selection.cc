@@ -561,8 +561,8 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
                              "holds others out; %d for one named model): add "
                              "views of the board at different positions and "
                              "tilted by 30 degrees or more",
-                             views.size(), views.size() == 1 ? "" : "s",
-                             needed, calibration.min_views),
+                             views.size(), views.size() == 1 ? "" : "s", needed,
+                             calibration.min_views),
                 error);
   }
   SelectionRun run;

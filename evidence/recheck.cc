@@ -82,7 +82,6 @@ void FitFresh(const std::vector<CalibrationView>& views,
                             fresh, &out->fresh, &out->fresh_error);
 }
 
-
 // The bands judged and the verdict drawn from them.
 void JudgeBands(const RecheckOptions& options, Recheck* out) {
   const ProjectionDiff& diff = out->difference;
@@ -145,7 +144,8 @@ void JudgeBands(const RecheckOptions& options, Recheck* out) {
     std::string unresolved;
     for (size_t b = 0; b < count; ++b) {
       const AngleBand& band = diff.difference_bands[b];
-      if (out->band_resolved[b] || band.count < options.evidence.min_bin_count ||
+      if (out->band_resolved[b] ||
+          band.count < options.evidence.min_bin_count ||
           !std::isfinite(band.median)) {
         continue;
       }

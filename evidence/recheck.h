@@ -67,6 +67,9 @@ struct StoredCalibration {
   double rms_px = 0;
   std::vector<double> param_stddev;
   Eigen::MatrixXd covariance;
+  // The photos it was calibrated from, as its file lists them (puzzlecal
+  // camera files; empty when the file does not say).
+  std::vector<std::string> view_files;
 };
 
 // One new view with the stored intrinsics held.

@@ -29,6 +29,10 @@ struct RecheckRun {
   std::vector<ImageResult> images;  // one record per photo, in file order
   std::vector<CalibrationView> views;
   Recheck recheck;
+  // Views from photos the stored calibration was made from (the same
+  // files as its file lists): they cannot show a drift. When every view is
+  // one, the verdict is not-enough-data and says so.
+  int own_views = 0;
 };
 
 // The calibration a camera file holds, with its RMS, standard deviations

@@ -76,8 +76,8 @@ py::dict AdviceDict(const Advice& advice, const PyCalibration& c) {
     view["visible_corners"] = v.visible_corners;
     view["outline_px"] = PointsArray(v.outline_px);
     view["expected_after"] = UncertaintyDict(v.after);
-    view["picture"] = BgrArray(
-        DrawAdvicePicture(advice, static_cast<int>(k), seen, 1200));
+    view["picture"] =
+        BgrArray(DrawAdvicePicture(advice, static_cast<int>(k), seen, 1200));
     views.append(view);
   }
   d["views"] = views;
@@ -90,8 +90,8 @@ Eigen::Isometry3d PoseFrom(const py::handle& pose, const char* what) {
   const py::tuple pair = py::cast<py::tuple>(pose);
   if (pair.size() != 2) Raise(std::string(what) + ": expected a pair (R, t)");
   const std::vector<Eigen::Vector3d> rows = Points3(pair[0], what);
-  const std::vector<Eigen::Vector3d> t = Points3(
-      py::array::ensure(pair[1]).attr("reshape")(-1, 3), what);
+  const std::vector<Eigen::Vector3d> t =
+      Points3(py::array::ensure(pair[1]).attr("reshape")(-1, 3), what);
   if (rows.size() != 3 || t.size() != 1) {
     Raise(std::string(what) + ": R must be 3 x 3 and t 3 values");
   }

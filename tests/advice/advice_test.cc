@@ -225,11 +225,11 @@ Comparison CompareAdvisedWithRandom(const Camera& truth, const Board& board) {
     }
     random_worst.push_back(WorstSigma(again, options));
     FieldUncertainty predicted;
-    EXPECT_TRUE(PredictWithPoses(
-        start, result, board,
-        std::vector<Eigen::Isometry3d>(random.begin() + start_poses.size(),
-                                       random.end()),
-        options, &predicted, &error))
+    EXPECT_TRUE(
+        PredictWithPoses(start, result, board,
+                         std::vector<Eigen::Isometry3d>(
+                             random.begin() + start_poses.size(), random.end()),
+                         options, &predicted, &error))
         << error;
     out.random_predicted.push_back(predicted);
     out.random_recalibrated.push_back(PredictFieldUncertainty(

@@ -692,8 +692,8 @@ TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
 TEST_F(BadInputTest, LossyFormatNoteComesAfterTheVerdict) {
   const fs::path folder = ImagesWithGoodViews("views", 5);
   const fs::path camera = case_dir_ / "camera.yaml";
-  const ProgramRun run =
-      Calibrate(folder, camera, "--model kannala-brandt-splined --format opencv");
+  const ProgramRun run = Calibrate(
+      folder, camera, "--model kannala-brandt-splined --format opencv");
   ASSERT_EQ(run.exit_code, kExitOk) << run.all();
   const std::string note = "note: " + camera.string() +
                            ": the opencv format has no kannala-brandt-splined "

@@ -185,6 +185,43 @@ TEST_F(CheckDiffTest, CheckThatCannotSeeADriftSaysNotEnoughData) {
             std::string::npos);
 }
 
+// The calibration's own photos (the camera file lists them) fit it by
+// construction: checked alone they give not-enough-data, saying why; mixed
+// with new ones they are counted in the verdict's reason. A link to an own
+// photo is that photo.
+TEST_F(CheckDiffTest, CheckOnTheCalibrationsOwnPhotosSaysSo) {
+  ProgramRun run = RunPuzzlecal(Check("original.yaml", "original"));
+  EXPECT_EQ(run.exit_code, kExitNoResult) << run.all();
+  EXPECT_NE(run.out.find("verdict: not-enough-data — every photo is one the "
+                         "camera file was calibrated from"),
+            std::string::npos)
+      << run.out;
+  const fs::path mixed = Scratch() / "mixed";
+  fs::create_directories(mixed);
+  const fs::path original = Root() / "original";
+  const fs::path same = Root() / "same";
+  Path("same");
+  int linked = 0;
+  for (const auto& entry : fs::directory_iterator(original)) {
+    if (entry.path().extension() != ".png" || linked == 3) continue;
+    fs::create_symlink(entry.path(),
+                       mixed / ("own_" + entry.path().filename().string()));
+    ++linked;
+  }
+  for (const auto& entry : fs::directory_iterator(same)) {
+    if (entry.path().extension() != ".png") continue;
+    fs::copy_file(entry.path(),
+                  mixed / ("new_" + entry.path().filename().string()));
+  }
+  ASSERT_EQ(linked, 3);
+  run = RunPuzzlecal("check --camera " + Path("original.yaml") + " --images " +
+                     Quote(mixed.string()) + " --board " + Path("board.yaml"));
+  EXPECT_NE(run.out.find("(3 of the 13 views are photos the camera file was "
+                         "calibrated from, which cannot show a drift)"),
+            std::string::npos)
+      << run.out;
+}
+
 TEST_F(CheckDiffTest, CheckWithTheFocalLengthChangedHasDriftedByTheTruth) {
   const fs::path out = Scratch() / "check_out";
   const ProgramRun run = RunPuzzlecal(

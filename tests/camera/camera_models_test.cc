@@ -430,8 +430,7 @@ TEST(CameraModelFacts, BorderPixelsBeyondTheFoldHaveNoRay) {
       }
     }
     const double expected = static_cast<double>(beyond) / samples;
-    EXPECT_NEAR(BorderFractionWithoutRay(camera, n), expected,
-                1.0 / samples)
+    EXPECT_NEAR(BorderFractionWithoutRay(camera, n), expected, 1.0 / samples)
         << "k1 " << k1 << ", fold at " << fold_px << " px";
     if (k1 == -0.05) {
       EXPECT_EQ(expected, 0.0);

@@ -110,8 +110,7 @@ TEST(SelectModel, TooFewViewsAreSaidOnce) {
     EXPECT_TRUE(selection.candidates.empty());
   }
   // Four: a comparison runs.
-  std::vector<CalibrationView> four(data.views.begin(),
-                                    data.views.begin() + 4);
+  std::vector<CalibrationView> four(data.views.begin(), data.views.begin() + 4);
   ModelSelection selection;
   std::string error;
   SelectModel(four, truth.width, truth.height, CalibrationOptions(),

@@ -250,8 +250,8 @@ TEST(Recheck, StillValidNamesTheBandsItCannotJudge) {
   const StoredCalibration stored =
       StoredOf(CalibrateOrFail(original.views, truth.model, truth));
   const SyntheticData same = MakeSyntheticData(Scene(truth, 15, 8));
-  const Recheck all = RecheckCalibration(same.views, stored,
-                                         CalibrationOptions(), RecheckOptions());
+  const Recheck all = RecheckCalibration(
+      same.views, stored, CalibrationOptions(), RecheckOptions());
   ASSERT_EQ(all.verdict, RecheckVerdict::kStillValid) << all.reason;
   EXPECT_EQ(all.reason.find("not judged"), std::string::npos) << all.reason;
   // The bound between the two most certain judged bands: only the most
@@ -280,12 +280,10 @@ TEST(Recheck, StillValidNamesTheBandsItCannotJudge) {
     if (few.band_resolved[b] || band.count < options.evidence.min_bin_count) {
       continue;
     }
-    const std::string named =
-        StringPrintf("%.0f-%.0f deg %.3f px", band.lo_deg, band.hi_deg,
-                     band.median);
-    EXPECT_NE(few.reason.find(named), std::string::npos)
-        << named << "\n"
-        << few.reason;
+    const std::string named = StringPrintf("%.0f-%.0f deg %.3f px", band.lo_deg,
+                                           band.hi_deg, band.median);
+    EXPECT_NE(few.reason.find(named), std::string::npos) << named << "\n"
+                                                         << few.reason;
   }
 }
 
