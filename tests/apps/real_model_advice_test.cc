@@ -71,6 +71,23 @@ bool LoadViews(const RealSet& set, std::vector<CalibrationView>* views,
   return !views->empty();
 }
 
+// The verdict on `result` as `calibrate` gives it: the evidence, the
+// verdict and its model advice checked on held-out views (`selection`:
+// the auto run's comparison, or null to compare the two models afresh).
+Verdict JudgedVerdict(const std::vector<CalibrationView>& views,
+                      const CalibrationResult& result,
+                      const CalibrationOptions& calibration,
+                      const ModelSelectionOptions& selection_options,
+                      const ModelSelection* selection) {
+  const EvidenceOptions evidence_options;
+  Verdict verdict = MakeVerdict(
+      result, ComputeEvidence(views, result, calibration, evidence_options),
+      evidence_options, VerdictOptions());
+  CheckModelAdvice(views, result, calibration, selection_options, selection,
+                   &verdict);
+  return verdict;
+}
+
 TEST(RealSets, AutoPicksPinholeForPinholeCamerasAndAdviceFollowsHeldOut) {
   const std::vector<RealSet> sets = RealSets();
   if (sets.empty()) {
@@ -103,14 +120,10 @@ TEST(RealSets, AutoPicksPinholeForPinholeCamerasAndAdviceFollowsHeldOut) {
                      &error)) {
         continue;
       }
-      const EvidenceOptions evidence_options;
-      const Evidence evidence =
-          ComputeEvidence(views, result, calibration, evidence_options);
-      Verdict verdict =
-          MakeVerdict(result, evidence, evidence_options, VerdictOptions());
       const bool auto_run = current.model == chosen.model;
-      CheckModelAdvice(views, result, calibration, selection_options,
-                       auto_run ? &selection : nullptr, &verdict);
+      const Verdict verdict =
+          JudgedVerdict(views, result, calibration, selection_options,
+                        auto_run ? &selection : nullptr);
       if (verdict.suggested_model.empty()) continue;
       CameraModelId suggested;
       ASSERT_TRUE(CameraModelIdFromName(verdict.suggested_model, &suggested));
@@ -139,12 +152,8 @@ TEST(RealSets, AutoPicksPinholeForPinholeCamerasAndAdviceFollowsHeldOut) {
                      &error)) {
         continue;
       }
-      const EvidenceOptions evidence_options;
-      Verdict verdict = MakeVerdict(
-          result, ComputeEvidence(views, result, calibration, evidence_options),
-          evidence_options, VerdictOptions());
-      CheckModelAdvice(views, result, calibration, selection_options, nullptr,
-                       &verdict);
+      const Verdict verdict =
+          JudgedVerdict(views, result, calibration, selection_options, nullptr);
       EXPECT_EQ(verdict.kind, VerdictKind::kModelError) << verdict.Line();
       CameraModelId suggested;
       ASSERT_TRUE(CameraModelIdFromName(verdict.suggested_model, &suggested))

@@ -207,11 +207,17 @@ StoredCalibration StoredOf(const CalibrationResult& result) {
   return stored;
 }
 
+// The stored calibration of `num_views` synthetic views of `truth`.
+StoredCalibration StoredCalibrationOf(const Camera& truth, int num_views,
+                                      unsigned seed) {
+  const SyntheticData original =
+      MakeSyntheticData(Scene(truth, num_views, seed));
+  return StoredOf(CalibrateOrFail(original.views, truth.model, truth));
+}
+
 TEST(Recheck, TheSameCameraIsStillValidAndAChangedFocalLengthHasDrifted) {
   const Camera truth = sim::TruthRadtan();
-  const SyntheticData original = MakeSyntheticData(Scene(truth, 25, 7));
-  const StoredCalibration stored =
-      StoredOf(CalibrateOrFail(original.views, truth.model, truth));
+  const StoredCalibration stored = StoredCalibrationOf(truth, 25, 7);
 
   const SyntheticData same = MakeSyntheticData(Scene(truth, 15, 8));
   const Recheck valid = RecheckCalibration(
@@ -246,9 +252,7 @@ TEST(Recheck, TheSameCameraIsStillValidAndAChangedFocalLengthHasDrifted) {
 // max_detectable_px) are named with their medians, which may be larger.
 TEST(Recheck, StillValidNamesTheBandsItCannotJudge) {
   const Camera truth = sim::TruthRadtan();
-  const SyntheticData original = MakeSyntheticData(Scene(truth, 25, 7));
-  const StoredCalibration stored =
-      StoredOf(CalibrateOrFail(original.views, truth.model, truth));
+  const StoredCalibration stored = StoredCalibrationOf(truth, 25, 7);
   const SyntheticData same = MakeSyntheticData(Scene(truth, 15, 8));
   const Recheck all = RecheckCalibration(
       same.views, stored, CalibrationOptions(), RecheckOptions());
@@ -289,9 +293,7 @@ TEST(Recheck, StillValidNamesTheBandsItCannotJudge) {
 
 TEST(Recheck, TooFewViewsIsNotEnoughData) {
   const Camera truth = sim::TruthRadtan();
-  const SyntheticData original = MakeSyntheticData(Scene(truth, 20, 9));
-  const StoredCalibration stored =
-      StoredOf(CalibrateOrFail(original.views, truth.model, truth));
+  const StoredCalibration stored = StoredCalibrationOf(truth, 20, 9);
   SyntheticData few = MakeSyntheticData(Scene(truth, 2, 10));
   const Recheck recheck = RecheckCalibration(
       few.views, stored, CalibrationOptions(), RecheckOptions());
