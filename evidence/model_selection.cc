@@ -322,12 +322,13 @@ int ChooseCandidate(const std::vector<ModelCandidate>& candidates,
     BeatsOnHeldOutViews(candidates[lowest], c, options, &z);
     const ModelCandidate& l = candidates[lowest];
     *reason = StringPrintf(
-        "%s has the lowest held-out RMS (%.4f px against %.4f px, %.1f %% "
-        "lower, %.1f standard errors), not by more than both %.0f %% and "
-        "%.1f standard errors: a tie, which goes to %s",
+        "%s has the lowest held-out RMS (%.4f px against %.4f px: %.1f %% "
+        "lower; view by view, %.1f standard errors %s), not lower by both "
+        "%.0f %% and %.1f standard errors: a tie, which goes to %s",
         CameraModelName(l.model), l.holdout_rms_px, c.holdout_rms_px,
-        100 * (1 - l.holdout_rms_px / c.holdout_rms_px), z,
-        100 * options.min_relative_gain, options.min_gain_z,
+        100 * (1 - l.holdout_rms_px / c.holdout_rms_px), std::abs(z),
+        z < 0 ? "higher" : "lower", 100 * options.min_relative_gain,
+        options.min_gain_z,
         CameraModelIsPinhole(c.model) == pinhole_field &&
                 CameraModelIsPinhole(l.model) != pinhole_field
             ? (pinhole_field ? "the pinhole family (every corner within "

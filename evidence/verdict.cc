@@ -432,7 +432,7 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
                         options.max_uncertainty_px)});
     }
   }
-  std::string undetermined_coefficients;
+  std::string undetermined_coefficients, undetermined_names;
   if (result.covariance_ok) {
     const std::vector<std::string> names = CameraModelParamNames(camera.model);
     for (size_t k = 0; k < names.size() && k < result.param_stddev.size() &&
@@ -451,6 +451,8 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
       if (distortion && !options.check_distortion_determined) {
         undetermined_coefficients +=
             (undetermined_coefficients.empty() ? "" : ", ") + text;
+        undetermined_names +=
+            (undetermined_names.empty() ? "" : ",") + names[k];
       } else {
         findings->push_back(
             {VerdictKind::kInsufficientData,
@@ -465,8 +467,9 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
     notes->push_back(
         "coefficients undetermined one by one: " + undetermined_coefficients +
         "; their values mean nothing alone (the projection they make is "
-        "judged by its uncertainty), and a model with fewer coefficients "
-        "may fit as well (--model auto compares models on held-out views)");
+        "judged by its uncertainty); if a model with fewer coefficients is "
+        "wanted, --fix " +
+        undetermined_names + " holds them at their start (zero)");
   }
   const CrossValidation& cv = evidence.cross_validation;
   if (!cv.ok && cv.error != "not run") {
