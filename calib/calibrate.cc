@@ -240,6 +240,26 @@ bool CheckPosedViews(const CalibrationState& s) {
   return true;
 }
 
+// The intrinsics held at their initial values, from the options.
+std::vector<bool> FixedParams(const CalibrationState& s) {
+  const int num_params = static_cast<int>(s.names.size());
+  std::vector<bool> fixed(num_params, false);
+  for (int k = 0; k < num_params; ++k) {
+    if (k < kPrincipalPointBegin)
+      fixed[k] = s.options.fix_focal_length;
+    else if (k < kDistortionBegin)
+      fixed[k] = s.options.fix_principal_point;
+    else
+      fixed[k] = s.options.fix_distortion;
+    const auto& named = s.options.fixed_params;
+    if (std::find(named.begin(), named.end(), s.names[k]) != named.end() ||
+        CameraModelParamIsStructural(s.model, k)) {
+      fixed[k] = true;
+    }
+  }
+  return fixed;
+}
+
 // The caller's intrinsics and poses (options.initial_cam_from_board) as the
 // start.
 bool InitialiseFromGivenPoses(CalibrationState* s) {
@@ -279,6 +299,12 @@ bool Initialise(CalibrationState* s) {
   std::string why;
   InitializationOptions init_options = s->options.initialization;
   init_options.num_threads = s->options.num_threads;
+  const std::vector<bool> fixed = FixedParams(*s);
+  for (size_t k = kDistortionBegin; k < fixed.size(); ++k) {
+    if (fixed[k]) {
+      init_options.held_distortion_params.push_back(static_cast<int>(k));
+    }
+  }
   if (!InitializeCalibration(clean, s->view_used, s->model, s->width, s->height,
                              s->options.initial_params, init_options, &init,
                              &why)) {
@@ -299,26 +325,6 @@ bool Initialise(CalibrationState* s) {
     s->poses[v] = PoseBlockFromIsometry(init.cam_from_board[v]);
   }
   return CheckPosedViews(*s);
-}
-
-// The intrinsics held at their initial values, from the options.
-std::vector<bool> FixedParams(const CalibrationState& s) {
-  const int num_params = static_cast<int>(s.names.size());
-  std::vector<bool> fixed(num_params, false);
-  for (int k = 0; k < num_params; ++k) {
-    if (k < kPrincipalPointBegin)
-      fixed[k] = s.options.fix_focal_length;
-    else if (k < kDistortionBegin)
-      fixed[k] = s.options.fix_principal_point;
-    else
-      fixed[k] = s.options.fix_distortion;
-    const auto& named = s.options.fixed_params;
-    if (std::find(named.begin(), named.end(), s.names[k]) != named.end() ||
-        CameraModelParamIsStructural(s.model, k)) {
-      fixed[k] = true;
-    }
-  }
-  return fixed;
 }
 
 // The parameters without a tangent coordinate of their own: the fixed

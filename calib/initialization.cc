@@ -449,8 +449,11 @@ bool RefineStartOnSubset(const std::vector<const CalibrationView*>& views,
   if (residuals < Model::kNumParams + 6) return false;
   ordering->AddElementToGroup(intrinsics.data(), 1);
   std::vector<int> fixed;
-  for (int k = kDistortionBegin + 2; k < Model::kNumParams; ++k) {
-    fixed.push_back(k);
+  for (int k = kDistortionBegin; k < Model::kNumParams; ++k) {
+    const bool held = std::find(options.held_distortion_params.begin(),
+                                options.held_distortion_params.end(),
+                                k) != options.held_distortion_params.end();
+    if (k >= kDistortionBegin + 2 || held) fixed.push_back(k);
   }
   if (!fixed.empty()) {
     problem.SetManifold(intrinsics.data(),
@@ -766,6 +769,23 @@ size_t BestCandidate(const std::vector<StartCandidate>& candidates) {
   return best;
 }
 
+// "k1, k2 free", or which of the two the start refinement holds at 0.
+std::string StartRefineFreeTerms(CameraModelId model,
+                                 const InitializationOptions& options) {
+  const std::vector<std::string> names = CameraModelParamNames(model);
+  std::string free, held;
+  for (int k = kDistortionBegin;
+       k < kDistortionBegin + 2 && k < static_cast<int>(names.size()); ++k) {
+    const auto& list = options.held_distortion_params;
+    std::string& text =
+        std::find(list.begin(), list.end(), k) != list.end() ? held : free;
+    text += (text.empty() ? "" : ", ") + names[k];
+  }
+  if (held.empty()) return free + " free";
+  if (free.empty()) return "no distortion term free (" + held + " held at 0)";
+  return free + " free (" + held + " held at 0)";
+}
+
 // The distortion-free start refined on a subset of the posed views (k1, k2
 // free); then every view is posed again through the refined camera, which
 // replaces the start when it poses any view.
@@ -811,7 +831,7 @@ void RefineStart(const std::vector<CalibrationView>& views,
   result->view_reason = refined_result.view_reason;
   result->start_refined = true;
   result->method += ", refined on " + std::to_string(subset.size()) +
-                    " views with k1, k2 free";
+                    " views with " + StartRefineFreeTerms(model, options);
 }
 
 // The start: the candidates of StartingCandidates, posed and refined

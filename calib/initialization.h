@@ -102,6 +102,13 @@ struct InitializationOptions {
   // after a successful start refinement. Default 0 (the homography pose through
   // the refined camera is close enough).
   int start_refine_pose_iterations = 0;
+  // Distortion terms the start refinement holds at their start, 0, by
+  // parameter index (CameraModelParamNames order): those the calibration
+  // holds fixed, so that a term held fixed without a given start stays at 0
+  // (as OpenCV's CALIB_FIX_K1..K6) instead of at the start refinement's
+  // value. Calibrate sets it from CalibrationOptions' fixed parameters.
+  // Indices before the distortion terms are ignored. Default: none.
+  std::vector<int> held_distortion_params;
   // Worker threads for the focal-length search and the per-view poses; the
   // result is the same for any count (each view's work has its own slot).
   // Calibrate sets it from CalibrationOptions::num_threads. Default 1.
