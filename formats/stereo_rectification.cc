@@ -102,6 +102,22 @@ double ValidFraction(const Camera& camera,
   return static_cast<double>(seen) / (kCols * kRows);
 }
 
+// Why cv::stereoRectify's crop cannot be used: "" or which camera's
+// distortion folds over inside its image, and over how much of its border.
+std::string FoldedBorder(const Camera& first, const Camera& second) {
+  for (int c = 0; c < 2; ++c) {
+    const double fraction = BorderFractionWithoutRay(c == 0 ? first : second);
+    if (fraction > 0) {
+      return StringPrintf(
+          "camera %d's distortion folds over inside its image (%.1f%% of its "
+          "border has no ray), so the crop to the undistorted border is "
+          "wrong",
+          c + 1, 100 * fraction);
+    }
+  }
+  return "";
+}
+
 // The rotations (and, for pinholes, the projections) of cv::stereoRectify.
 bool OpenCvRectify(const Camera& first, const Camera& second,
                    const Eigen::Isometry3d& second_from_first,
@@ -290,14 +306,17 @@ bool StereoRectificationOptions::Check(std::string* why) const {
 }
 
 std::string StereoRectification::Summary() const {
+  const std::string how =
+      own_target ? "a pinhole target chosen for the pair's common field (" +
+                       own_target_reason + ")"
+                 : std::string("cv::stereoRectify (alpha 0)");
   return StringPrintf(
       "%s, %d x %d, focal length %.2f px, field %.1f x %.1f deg; the cameras "
       "cover %.0f%% and %.0f%% of their rectified images; rows of points "
       "seen by both agree to %.2g px",
-      own_target ? "a pinhole target chosen for the pair's common field"
-                 : "cv::stereoRectify (alpha 0)",
-      width, height, p1(0, 0), field_of_view_deg, vertical_field_of_view_deg,
-      100 * valid_fraction[0], 100 * valid_fraction[1], max_row_difference_px);
+      how.c_str(), width, height, p1(0, 0), field_of_view_deg,
+      vertical_field_of_view_deg, 100 * valid_fraction[0],
+      100 * valid_fraction[1], max_row_difference_px);
 }
 
 bool RectifyPixel(const Camera& camera, const Eigen::Matrix3d& r,
@@ -349,11 +368,22 @@ bool StereoRectify(const Camera& first_lens, const Camera& second_lens,
   if (!OpenCvRectify(first, second, second_from_first, pinholes, rect, error)) {
     return false;
   }
+  // cv::stereoRectify crops (alpha 0) to the undistorted image border; where
+  // a camera's distortion folds over, part of that border has no ray and
+  // the crop follows a border that is not there (bb2: 1.5 times the
+  // focal length, the principal point far off-centre, a view of a corner
+  // of the scene). The target chosen here takes only rays the camera sees.
+  const std::string folded = FoldedBorder(first, second);
   std::string opencv_why;
-  if (pinholes && CheckRectification(first, second, second_from_first, options,
-                                     rect, &opencv_why)) {
+  if (pinholes && folded.empty() &&
+      CheckRectification(first, second, second_from_first, options, rect,
+                         &opencv_why)) {
     return true;
   }
+  rect->own_target_reason =
+      !pinholes ? "a fisheye's coefficients mean nothing to cv::stereoRectify"
+      : !folded.empty() ? "cv::stereoRectify not used: " + folded
+                        : "cv::stereoRectify failed the check: " + opencv_why;
   if (!OwnTarget(first, second, second_from_first, options, rect, &why) ||
       !CheckRectification(first, second, second_from_first, options, rect,
                           &why)) {

@@ -9,7 +9,9 @@
 // - Two pinhole models: cv::stereoRectify (alpha 0), kept when it passes
 //   the check below.
 // - A pair with a fisheye (or pinholes whose cv::stereoRectify fails the
-//   check): the rotations of cv::stereoRectify (they depend only on the
+//   check, or whose distortion folds over inside the image, where
+//   cv::stereoRectify's crop to the undistorted border has no border to
+//   follow): the rotations of cv::stereoRectify (they depend only on the
 //   relative pose) and a pinhole target chosen here: one focal length for
 //   both views, principal point at the image centre, and a horizontal field
 //   of view of the pair's common field (the part of the rectified
@@ -68,6 +70,8 @@ struct StereoRectification {
   // How it was chosen: false = cv::stereoRectify's P1 P2, true = the
   // pinhole target chosen here.
   bool own_target = false;
+  // Why cv::stereoRectify's projections were not taken ("" when they were).
+  std::string own_target_reason;
   // Horizontal and vertical field of view of the rectified views, degrees.
   double field_of_view_deg = 0;
   double vertical_field_of_view_deg = 0;

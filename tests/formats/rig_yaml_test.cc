@@ -216,6 +216,41 @@ TEST(RigYamlTest, OpenCvFormatOfADivergingFisheyePinholePairRectifies) {
   EXPECT_LT(rect.max_row_difference_px, 1e-3);
 }
 
+// A pinhole pair whose fitted distortion folds over inside the image (a
+// strong k1 alone, as a fit to central corners gives): cv::stereoRectify's
+// crop to the undistorted border follows a border that is not there; the
+// target chosen here keeps the whole common view, centred.
+TEST(RigYamlTest, OpenCvFormatOfAFoldingPinholePairRectifiesTheWholeView) {
+  RigSceneSpec scene = StereoPinholeRig();
+  for (RigSceneCamera& cam : scene.cameras) {
+    for (size_t k = kDistortionBegin; k < cam.camera.params.size(); ++k) {
+      cam.camera.params[k] = 0;
+    }
+    cam.camera.params[kDistortionBegin] = -0.6;  // folds at r^2 = 1 / 1.8
+  }
+  ASSERT_GT(BorderFractionWithoutRay(scene.cameras[1].camera), 0.0);
+  const std::string path = TempPath("folding_opencv.yaml");
+  std::string error;
+  ASSERT_TRUE(WriteRigFiles(path, CameraFileFormat::kOpenCv,
+                            ResultFromScene(scene), nullptr, &error))
+      << error;
+  ExpectRectifies(scene, path);
+  StereoRectification rect;
+  ASSERT_TRUE(StereoRectify(scene.cameras[0].camera, scene.cameras[1].camera,
+                            scene.cameras[1].cam_from_rig, &rect, &error))
+      << error;
+  EXPECT_TRUE(rect.own_target);
+  EXPECT_NE(rect.own_target_reason.find("folds over"), std::string::npos)
+      << rect.own_target_reason;
+  const Camera& camera = scene.cameras[0].camera;
+  EXPECT_GT(rect.p1(0, 0), 0.5 * camera.params[0]);
+  EXPECT_LT(rect.p1(0, 0), 1.2 * camera.params[0]);
+  EXPECT_NEAR(rect.p1(0, 2), 0.5 * (camera.width - 1), 0.15 * camera.width);
+  EXPECT_NEAR(rect.p1(1, 2), 0.5 * (camera.height - 1), 1e-9);
+  EXPECT_GT(rect.valid_fraction[0], 0.8);
+  EXPECT_GT(rect.valid_fraction[1], 0.8);
+}
+
 TEST(RigYamlTest, RosFormatWritesOneCameraInfoPerCamera) {
   const RigSceneSpec scene = StereoPinholeRig();
   const RigCalibrationResult result = ResultFromScene(scene);
