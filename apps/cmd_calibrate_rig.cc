@@ -459,14 +459,16 @@ int DetectCamera(const RigRequest& request, size_t c,
   const int usable = MakeRigCameraViews(
       request.board, listing.images, frame_of_file, num_frames,
       request.options.pipeline, request.threads, input, frame_files, &images);
-  for (const ImageResult& image : images) {
-    if (image.view_index >= 0) continue;
-    LOG(WARNING) << image.file << ": " << ImageOutcomeName(image.outcome)
-                 << (image.reason.empty() ? "" : " (" + image.reason + ")");
-  }
   if (!FLAGS_quiet) {
     std::cerr << "camera '" << input->name << "': " << usable << " of "
               << images.size() << " images usable\n";
+    for (const ImageResult& image : images) {
+      if (image.view_index >= 0) continue;
+      std::cerr << "  " << image.file << ": not used \u2014 "
+                << ImageOutcomeName(image.outcome)
+                << (image.reason.empty() ? "" : " (" + image.reason + ")")
+                << "\n";
+    }
   }
   return FinishCamera(request, c, usable, "image", input);
 }

@@ -38,6 +38,10 @@ struct RigCameraInput {
   int width = 0;
   int height = 0;
   std::vector<CalibrationView> frames;
+  // Per frame (or empty): why the camera's image of the frame gave no view
+  // ("" where it gave one or the camera has no image of it), for the
+  // frames' notes; the calibration does not read it.
+  std::vector<std::string> frame_unusable_reason;
   // Parameters held at their initial values for this camera (by name), on
   // top of the options' fixed_params; e.g. {"k3"} for a pinhole-radtan
   // camera written to Kalibr's 4-coefficient radtan. Default empty.

@@ -53,6 +53,7 @@ constexpr EnumName<ImageOutcome> kImageOutcomeNames[] = {
     {ImageOutcome::kNotDecoded, "code not recognised"},
     {ImageOutcome::kTooFewCorners, "too few corners"},
     {ImageOutcome::kSizeMismatch, "image size differs"},
+    {ImageOutcome::kPartialBoard, "part of the board only"},
 };
 
 const char* ImageOutcomeName(ImageOutcome outcome) {

@@ -29,6 +29,7 @@ enum class ImageOutcome {
   kNotDecoded,     // PuzzleBoard: no component decoded
   kTooFewCorners,  // decoded, but fewer corners than a view needs
   kSizeMismatch,   // image size differs from the one most images have
+  kPartialBoard,   // a rig: part of a plain checkerboard (relative labels)
 };
 
 // "usable", "unreadable", "no corners", ...

@@ -52,8 +52,9 @@ void BindDetection(py::module_& m) {
           [](const ImageResult& r) {
             return std::string(ImageOutcomeName(r.outcome));
           },
-          "'usable', 'unreadable', 'no corners', 'no grid', 'not decoded', "
-          "'too few corners' or 'size mismatch'")
+          "'usable', 'unreadable', 'no corners', 'no consistent grid', "
+          "'code not recognised', 'too few corners', 'image size differs' "
+          "or 'part of the board only'")
       .def_property_readonly(
           "usable",
           [](const ImageResult& r) {
