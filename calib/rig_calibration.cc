@@ -578,12 +578,13 @@ bool FailUnplacedCameras(const std::vector<RigCameraInput>& cameras,
 // other, within max_deviation_deg; the labels as found win ties) fixes the
 // convention: a frame that agrees only with its labels turned gets b's
 // labels turned (board points and b's own pose of the frame); a frame that
-// agrees neither way gets a note.
-void ResolveHalfTurns(int a, int b, const RigBoardSymmetry& symmetry,
+// agrees neither way gets a note and is left out. False, with the reason,
+// when no candidate has a majority of the frames.
+bool ResolveHalfTurns(int a, int b, const RigBoardSymmetry& symmetry,
                       double max_deviation_deg,
                       std::vector<RigCameraInput>* inputs,
                       std::vector<CalibrationResult>* singles,
-                      std::vector<RigCameraResult>* out) {
+                      std::vector<RigCameraResult>* out, std::string* error) {
   std::vector<CalibrationResult>& single = *singles;
   const size_t num_frames = (*inputs)[0].frames.size();
   Eigen::Isometry3d half_turn = Eigen::Isometry3d::Identity();
@@ -601,7 +602,7 @@ void ResolveHalfTurns(int a, int b, const RigBoardSymmetry& symmetry,
           (single[b].cam_from_board[f] * half_turn * a_inv).linear());
     }
   }
-  if (frames.size() < 2) return;
+  if (frames.size() < 2) return true;
   std::vector<const Eigen::Matrix3d*> candidates;
   for (const Eigen::Matrix3d& r : as_found) candidates.push_back(&r);
   if (symmetry.half_turn) {
@@ -622,6 +623,29 @@ void ResolveHalfTurns(int a, int b, const RigBoardSymmetry& symmetry,
       best_count = count;
       centre = candidate;
     }
+  }
+  // The rig's relative pose is the one most frames agree on; when no
+  // majority agrees on any, the frames do not show one rig (unsynchronised
+  // or mismatched folders: each pair of photos shows the board at two
+  // moments), and the few that agree by chance would make a rig of noise.
+  if (2 * best_count <= static_cast<int>(frames.size())) {
+    double spread = 0;
+    for (const Eigen::Matrix3d& r : as_found) {
+      spread = std::max(spread, RotationDifferenceDeg(r, *centre));
+    }
+    return Fail(
+        StringPrintf("cameras '%s' and '%s' do not agree on one relative "
+                     "pose: of the %zu frames both posed, at most %d agree "
+                     "within %.1f deg (the board's pose seen by '%s' relative "
+                     "to '%s' varies by up to %.0f deg); the folders' photos "
+                     "do not look like the same instants: check that the same "
+                     "file name (with --match_by_order, the same position) in "
+                     "every folder is one instant and that the cameras were "
+                     "triggered together",
+                     (*out)[a].name.c_str(), (*out)[b].name.c_str(),
+                     frames.size(), best_count, max_deviation_deg,
+                     (*out)[b].name.c_str(), (*out)[a].name.c_str(), spread),
+        error);
   }
   RigCameraResult& note_b = (*out)[b];
   for (size_t k = 0; k < frames.size(); ++k) {
@@ -644,6 +668,8 @@ void ResolveHalfTurns(int a, int b, const RigBoardSymmetry& symmetry,
     // Neither way: b's view of the frame is left out of the rig.
     single[b].view_used[f] = false;
     (*inputs)[b].frames[f] = CalibrationView();
+    note_b.start_disagreement_deg[f] =
+        symmetry.half_turn ? std::min(before, after) : before;
     if (symmetry.half_turn) {
       note_b.frame_note[f] = StringPrintf(
           "its board pose relative to '%s' is %.1f deg from the rig's, %.1f "
@@ -656,6 +682,7 @@ void ResolveHalfTurns(int a, int b, const RigBoardSymmetry& symmetry,
           (*out)[a].name.c_str(), before);
     }
   }
+  return true;
 }
 
 // Stage 2: the starting cam_from_rig of every camera, from the frames two
@@ -701,9 +728,11 @@ bool StartCamFromRig(std::vector<RigCameraInput>* inputs,
       }
     }
     if (best_b < 0) break;
-    ResolveHalfTurns(best_a, best_b, symmetry,
-                     options.max_start_rotation_deviation_deg, inputs, singles,
-                     out);
+    if (!ResolveHalfTurns(best_a, best_b, symmetry,
+                          options.max_start_rotation_deviation_deg, inputs,
+                          singles, out, error)) {
+      return false;
+    }
     std::vector<Eigen::Isometry3d> samples;  // cam_b_from_cam_a per frame
     for (size_t f = 0; f < num_frames; ++f) {
       if (single[best_a].view_used[f] && single[best_b].view_used[f]) {
@@ -1167,6 +1196,7 @@ bool CalibrateRig(const std::vector<RigCameraInput>& input_cameras,
     result->cameras[c].camera.height = cameras[c].height;
     result->cameras[c].relabelled.assign(num_frames, false);
     result->cameras[c].frame_note.assign(num_frames, "");
+    result->cameras[c].start_disagreement_deg.assign(num_frames, 0.0);
   }
 
   const Timer single_timer;

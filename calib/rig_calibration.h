@@ -133,6 +133,11 @@ struct RigCameraResult {
   // view was not used.
   std::vector<bool> relabelled;
   std::vector<std::string> frame_note;
+  // Per frame: how far (degrees) the camera's board pose relative to the
+  // camera it was placed from lay from the rig's when that left its view
+  // of the frame out (the frame shows another moment, or the board moved);
+  // 0 where it did not.
+  std::vector<double> start_disagreement_deg;
   // Per frame: the camera's own pose of the board (its own calibration,
   // in the rig's labels: turned where relabelled) and whether it has one.
   std::vector<Eigen::Isometry3d> alone_cam_from_board;

@@ -142,6 +142,10 @@ RigEvidence ComputeRigEvidence(const std::vector<RigCameraInput>& inputs,
       view.rms_px =
           view.corners > 0 ? std::sqrt(sum2 / (2.0 * view.corners)) : 0.0;
       evidence.frames[f].cameras.push_back(view);
+      if (f < cam.start_disagreement_deg.size()) {
+        double& left_out = evidence.frames[f].left_out_deg;
+        left_out = std::max(left_out, cam.start_disagreement_deg[f]);
+      }
     }
   }
   // Each camera against the camera its start was chained from.
@@ -188,6 +192,11 @@ RigEvidence ComputeRigEvidence(const std::vector<RigCameraInput>& inputs,
       frame.epipolar_px = EpipolarError(inputs, result, p, c, f);
     }
   }
+  for (size_t f = 0; f < num_frames; ++f) {
+    if (evidence.frames[f].left_out_deg > 0) {
+      evidence.left_out_frames.push_back(static_cast<int>(f));
+    }
+  }
   std::vector<double> transfers;
   for (const RigFrameEvidence& frame : evidence.frames) {
     if (frame.compared) transfers.push_back(frame.transfer_px);
@@ -223,27 +232,43 @@ RigVerdict MakeRigVerdict(const RigCalibrationResult& result,
     verdict.next_step = "fix the options";
     return verdict;
   }
-  if (!evidence.moved_frames.empty()) {
+  if (!evidence.moved_frames.empty() || !evidence.left_out_frames.empty()) {
     std::ostringstream reason;
-    reason << evidence.moved_frames.size() << " of "
-           << std::count_if(
-                  evidence.frames.begin(), evidence.frames.end(),
-                  [](const RigFrameEvidence& f) { return f.compared; })
-           << " frames look unsynchronised or moved between the cameras "
-              "(their corners move by more than "
-           << StringPrintf("%.2f", evidence.moved_limit_px)
-           << " px from one camera to the other; typical "
-           << StringPrintf("%.2f", evidence.median_transfer_px) << " px): ";
-    for (size_t k = 0; k < evidence.moved_frames.size(); ++k) {
-      const int f = evidence.moved_frames[k];
-      const RigFrameEvidence& frame = evidence.frames[f];
-      reason << (k > 0 ? "; " : "") << frame_name(f) << " "
-             << StringPrintf("%.2f px, %.1f mm, %.2f deg", frame.transfer_px,
-                             frame.pose_difference_mm,
-                             frame.pose_difference_deg);
+    if (!evidence.moved_frames.empty()) {
+      reason << evidence.moved_frames.size() << " of "
+             << std::count_if(
+                    evidence.frames.begin(), evidence.frames.end(),
+                    [](const RigFrameEvidence& f) { return f.compared; })
+             << " frames look unsynchronised or moved between the cameras "
+                "(their corners move by more than "
+             << StringPrintf("%.2f", evidence.moved_limit_px)
+             << " px from one camera to the other; typical "
+             << StringPrintf("%.2f", evidence.median_transfer_px) << " px): ";
+      for (size_t k = 0; k < evidence.moved_frames.size(); ++k) {
+        const int f = evidence.moved_frames[k];
+        const RigFrameEvidence& frame = evidence.frames[f];
+        reason << (k > 0 ? "; " : "") << frame_name(f) << " "
+               << StringPrintf("%.2f px, %.1f mm, %.2f deg", frame.transfer_px,
+                               frame.pose_difference_mm,
+                               frame.pose_difference_deg);
+      }
+      reason << "; they are kept and bend the rig";
+    }
+    if (!evidence.left_out_frames.empty()) {
+      reason << (evidence.moved_frames.empty() ? "" : "; and ")
+             << evidence.left_out_frames.size()
+             << " frame(s) show the board at another moment in one camera "
+                "(its pose relative to the rig is off by degrees, not "
+                "noise): ";
+      for (size_t k = 0; k < evidence.left_out_frames.size(); ++k) {
+        const int f = evidence.left_out_frames[k];
+        reason << (k > 0 ? "; " : "") << frame_name(f) << " "
+               << StringPrintf("%.1f deg", evidence.frames[f].left_out_deg);
+      }
+      reason << "; the rig is made without them";
     }
     verdict.kind = "moved-frames";
-    verdict.reason = reason.str() + "; they are kept and bend the rig";
+    verdict.reason = reason.str();
     verdict.next_step =
         "remove these frames from every camera's folder and run again (or "
         "take the photos with the board held still, or with the cameras "

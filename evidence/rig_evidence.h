@@ -22,8 +22,11 @@
 // in pixels of the second).
 //
 // The rig verdict: `moved-frames` when frames are named (and kept: they
-// bend the rig), `inconsistent` when a camera's joint RMS exceeds
-// max_joint_over_alone times its own calibration's, else the first
+// bend the rig) or a camera's view of a frame was left out before the
+// joint solve because its board pose relative to the rig disagreed (the
+// photos show two moments; the rig is made without them, but the folders
+// hold photos that are not one instant), `inconsistent` when a camera's joint
+// RMS exceeds max_joint_over_alone times its own calibration's, else the first
 // camera verdict that is not good (with the camera's name), else `good`.
 
 #include <string>
@@ -66,6 +69,10 @@ struct RigFrameEvidence {
   double pose_difference_deg = 0;
   double epipolar_px = 0;  // median, 0 without shared corners
   bool moved = false;      // named as unsynchronised or moved
+  // A camera's view of the frame was left out before the joint solve: its
+  // board pose relative to the rig disagreed by this many degrees (the
+  // largest over cameras); 0 when none was.
+  double left_out_deg = 0;
 };
 
 struct RigEvidence {
@@ -73,6 +80,8 @@ struct RigEvidence {
   double median_transfer_px = 0;
   double moved_limit_px = 0;
   std::vector<int> moved_frames;
+  // Frames with a view left out for its disagreeing pose (left_out_deg).
+  std::vector<int> left_out_frames;
   // Per camera: joint RMS / own calibration's RMS.
   std::vector<double> joint_over_alone;
 };

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -90,9 +91,9 @@ TEST(RigRunTest, ListingsThatCannotBePairedAreRefusedNamingTheCamera) {
       << error;
 }
 
-TEST(RigRunTest, JudgedStereoRigMeetsTheTruth) {
-  const RigSceneSpec scene = StereoPinholeRig();
-  const std::vector<RigCameraInput> inputs = RigCorrespondences(scene, 0.05);
+// Per camera, the file name of each frame it saw ("" where none).
+std::vector<std::vector<std::string>> FrameFiles(
+    const std::vector<RigCameraInput>& inputs) {
   std::vector<std::vector<std::string>> frame_files(inputs.size());
   for (size_t c = 0; c < inputs.size(); ++c) {
     for (size_t f = 0; f < inputs[c].frames.size(); ++f) {
@@ -102,6 +103,13 @@ TEST(RigRunTest, JudgedStereoRigMeetsTheTruth) {
                                          RigFrameFileName(static_cast<int>(f)));
     }
   }
+  return frame_files;
+}
+
+TEST(RigRunTest, JudgedStereoRigMeetsTheTruth) {
+  const RigSceneSpec scene = StereoPinholeRig();
+  const std::vector<RigCameraInput> inputs = RigCorrespondences(scene, 0.05);
+  const std::vector<std::vector<std::string>> frame_files = FrameFiles(inputs);
   JudgedRig judged;
   std::string error;
   ASSERT_TRUE(CalibrateAndJudgeRig(scene.board, inputs, frame_files,
@@ -122,6 +130,62 @@ TEST(RigRunTest, JudgedStereoRigMeetsTheTruth) {
   EXPECT_EQ(judged.file.frames[0].files[1], "cam1/frame_000.png");
   EXPECT_EQ(judged.file.frames[0].use[0], "used");
   EXPECT_EQ(RigFrameNames(frame_files)[0], "frame_000.png");
+}
+
+// The second camera's photos paired with the wrong frames: each pair shows
+// the board at two moments, and no relative pose is shared by most frames.
+// Refused with that reason, not solved into a rig of noise (a real pair
+// shifted by one frame: "did not converge", then with more iterations a
+// file with fx = 9.8 px and a 180-degree rotation).
+TEST(RigRunTest, FoldersShiftedByOneFrameAreRefusedAsNotOneInstant) {
+  const RigSceneSpec scene = StereoPinholeRig();
+  std::vector<RigCameraInput> inputs = RigCorrespondences(scene, 0.05);
+  std::vector<CalibrationView>& second = inputs[1].frames;
+  std::rotate(second.begin(), second.begin() + 1, second.end());
+  JudgedRig judged;
+  std::string error;
+  EXPECT_FALSE(CalibrateAndJudgeRig(scene.board, inputs, FrameFiles(inputs),
+                                    RigRunOptions(), &judged, &error));
+  EXPECT_NE(error.find("do not agree on one relative pose"), std::string::npos)
+      << error;
+  EXPECT_NE(error.find("same instants"), std::string::npos) << error;
+}
+
+// Two of the second camera's photos swapped: the rig is made from the
+// frames that agree, and the verdict names the two that show another
+// moment (they were left out before the joint solve, so no transfer error
+// names them).
+TEST(RigRunTest, TwoSwappedFramesAreLeftOutAndNamedByTheVerdict) {
+  const RigSceneSpec scene = StereoPinholeRig();
+  std::vector<RigCameraInput> inputs = RigCorrespondences(scene, 0.05);
+  std::vector<int> both;
+  for (size_t f = 0; f < inputs[0].frames.size(); ++f) {
+    if (!inputs[0].frames[f].board_points.empty() &&
+        !inputs[1].frames[f].board_points.empty()) {
+      both.push_back(static_cast<int>(f));
+    }
+  }
+  ASSERT_GE(both.size(), 6u);
+  const int a = both[2], b = both[3];
+  std::swap(inputs[1].frames[a], inputs[1].frames[b]);
+  JudgedRig judged;
+  std::string error;
+  ASSERT_TRUE(CalibrateAndJudgeRig(scene.board, inputs, FrameFiles(inputs),
+                                   RigRunOptions(), &judged, &error))
+      << error;
+  const CamFromRigError cam1 = CompareCamFromRig(judged.result.cameras[1],
+                                                 scene.cameras[1].cam_from_rig);
+  EXPECT_LT(cam1.rotation_deg, 0.01);
+  EXPECT_EQ(judged.rig.left_out_frames, (std::vector<int>{a, b}));
+  EXPECT_EQ(judged.rig_verdict.kind, "moved-frames")
+      << judged.rig_verdict.Line();
+  for (int f : {a, b}) {
+    EXPECT_NE(judged.rig_verdict.reason.find(RigFrameFileName(f)),
+              std::string::npos)
+        << judged.rig_verdict.Line();
+  }
+  EXPECT_NE(judged.rig_verdict.reason.find("another moment"), std::string::npos)
+      << judged.rig_verdict.Line();
 }
 
 TEST(RigRunTest, OnlyAPlainCheckerboardHasTheHalfTurn) {
