@@ -685,6 +685,41 @@ TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
   EXPECT_FALSE(fs::exists(rational));
 }
 
+// `calibrate --format opencv|ros|kalibr` writes the verdict line it prints
+// as the file's first comment (after OpenCV's "%YAML:1.0"), and the file
+// still loads: cv::FileStorage for opencv, a YAML reader for ros and kalibr.
+TEST_F(BadInputTest, OtherFormatsCarryThePrintedVerdict) {
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  for (const std::string format : {"opencv", "ros", "kalibr"}) {
+    SCOPED_TRACE(format);
+    const fs::path camera = case_dir_ / (format + ".yaml");
+    const ProgramRun run =
+        Calibrate(folder, camera, "--format " + format + " --quiet");
+    ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+    const size_t at = run.out.find("verdict: ");
+    ASSERT_NE(at, std::string::npos) << run.out;
+    const std::string verdict = run.out.substr(at, run.out.find('\n', at) - at);
+    const std::string text = ReadFile(camera);
+    const std::string top =
+        (format == "opencv" ? "%YAML:1.0\n# " : "# ") + verdict + "\n";
+    EXPECT_EQ(text.substr(0, top.size()), top) << text;
+    if (format == "opencv") {
+      cv::FileStorage storage(camera.string(), cv::FileStorage::READ);
+      ASSERT_TRUE(storage.isOpened());
+      cv::Mat k;
+      storage["camera_matrix"] >> k;
+      ASSERT_EQ(k.rows, 3);
+      EXPECT_NEAR(k.at<double>(0, 0), 560.0, 5.0);
+    } else {
+      const YAML::Node root = YAML::LoadFile(camera.string());
+      EXPECT_NEAR(format == "ros"
+                      ? root["camera_matrix"]["data"][0].as<double>()
+                      : root["cam0"]["intrinsics"][0].as<double>(),
+                  560.0, 5.0);
+    }
+  }
+}
+
 // A camera file whose format cannot hold the model (a splined camera in
 // OpenCV's YAML) says so on the terminal after the verdict: the verdict's
 // "ready to use" is about the calibration, the note about the file, and a
