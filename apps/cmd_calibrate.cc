@@ -727,9 +727,17 @@ void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
   const CalibrationResult& result = run.result;
   if (request.verbosity != Verbosity::kQuiet) {
     std::cout << CalibrationReport(result) << "\n";
+    const auto repeated = std::count_if(
+        run.images.begin(), run.images.end(), [](const ImageResult& image) {
+          return image.outcome == ImageOutcome::kRepeatedPhoto;
+        });
     std::cout << "views used: " << result.num_views_used << " of "
-              << run.images.size()
-              << " images; corners: " << result.num_corners_used << "; RMS "
+              << run.images.size() << " images"
+              << (repeated == 0 ? ""
+                                : StringPrintf(" (%d the same photo as an "
+                                               "earlier one, not used)",
+                                               static_cast<int>(repeated)))
+              << "; corners: " << result.num_corners_used << "; RMS "
               << std::setprecision(4) << result.rms_px << " px\n";
   }
   if (request.verbosity == Verbosity::kVerbose) {

@@ -480,6 +480,31 @@ TEST_F(BadInputTest, BrokenFilesAmongGoodViews) {
   EXPECT_TRUE(fs::exists(camera)) << all;
 }
 
+// A photo copied under another name is one view, not two: the copy (the
+// later name) is named with the photo it repeats, and the summary line
+// counts it.
+TEST_F(BadInputTest, CopyOfAPhotoIsUsedOnce) {
+  const fs::path folder = ImagesWithGoodViews("copies", 5);
+  fs::copy_file(folder / "view1.png", folder / "view1_copy.png");
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const ProgramRun run = Calibrate(folder, camera);
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_NE(run.err.find("view1_copy.png: repeated photo (not used: the same "
+                         "photo as view1.png)"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.out.find("views used: 5 of 6 images (1 the same photo as an "
+                         "earlier one, not used)"),
+            std::string::npos)
+      << run.out;
+  const YAML::Node root = YAML::LoadFile(camera.string());
+  EXPECT_EQ(root["views_used"].as<int>(), 5);
+  for (const YAML::Node& view : root["views"]) {
+    EXPECT_NE(fs::path(view["file"].as<std::string>()).filename(),
+              "view1_copy.png");
+  }
+}
+
 // The program starts without OpenCV's image codecs (Debian's bring about
 // 140 libraries, 90 ms of every start); they are loaded when an image needs
 // them (see the next test). The dynamic loader lists what it would load.
