@@ -492,6 +492,11 @@ int ParseRequest(CalibrateRequest* request) {
     return kExitBadInput;
   }
   request->verbosity = ConsoleVerbosity();
+  // Photos in formats that are not read, said even without --verbose.
+  if (!request->listing.note.empty() &&
+      request->verbosity != Verbosity::kQuiet) {
+    std::cerr << "note: " << request->listing.note << "\n";
+  }
   if (request->verbosity == Verbosity::kVerbose) {
     for (const std::string& skipped : request->listing.skipped) {
       std::cerr << "skipped " << skipped << "\n";

@@ -321,6 +321,53 @@ TEST_F(BadInputTest, FolderOfNonImages) {
   EXPECT_NE(one.err.find("could not be read"), std::string::npos) << one.err;
 }
 
+// A folder of camera folders given to calibrate (calibrate-rig's input)
+// and a folder of HEIC photos: the message says where the images are and
+// what to do; HEIC photos beside PNGs are counted in one line, not skipped
+// silently.
+TEST_F(BadInputTest, FolderOfFoldersAndPhotosInFormatsNotRead) {
+  const fs::path rig = case_dir_ / "rig";
+  for (const char* camera : {"cam0", "cam1"}) {
+    fs::create_directories(rig / camera);
+    fs::copy_file(*root_ / "good" / "view0.png", rig / camera / "01.png");
+  }
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const ProgramRun folders = Calibrate(rig, camera);
+  EXPECT_EQ(folders.exit_code, kExitBadInput) << folders.all();
+  EXPECT_NE(folders.err.find(rig.string() + ": the folder holds no image"),
+            std::string::npos)
+      << folders.err;
+  EXPECT_NE(folders.err.find("its sub-folders cam0 and cam1 hold 2 image "
+                             "files"),
+            std::string::npos)
+      << folders.err;
+  EXPECT_NE(folders.err.find("calibrate-rig"), std::string::npos)
+      << folders.err;
+
+  const fs::path heic = case_dir_ / "heic";
+  fs::create_directories(heic);
+  WriteFile(heic / "IMG_0001.HEIC", "not decoded");
+  WriteFile(heic / "IMG_0002.HEIC", "not decoded");
+  const ProgramRun only_heic = Calibrate(heic, camera);
+  EXPECT_EQ(only_heic.exit_code, kExitBadInput) << only_heic.all();
+  EXPECT_NE(only_heic.err.find("it holds 2 HEIC files"), std::string::npos)
+      << only_heic.err;
+  EXPECT_NE(only_heic.err.find("convert them to JPEG or PNG"),
+            std::string::npos)
+      << only_heic.err;
+  EXPECT_FALSE(fs::exists(camera));
+
+  const fs::path mixed = ImagesWithGoodViews("mixed", 5);
+  WriteFile(mixed / "IMG_0001.HEIC", "not decoded");
+  WriteFile(mixed / "IMG_0002.HEIC", "not decoded");
+  const ProgramRun run = Calibrate(mixed, camera);
+  EXPECT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_EQ(
+      CountOf(run.err, "note: " + mixed.string() + ": skipped 2 HEIC files"), 1)
+      << run.err;
+  EXPECT_TRUE(fs::exists(camera));
+}
+
 // `detect --board` on a good view beside a broken file: the broken file is
 // named with its reason, and every labelled corner of the good view carries
 // the truth id of the printed corner under it (absolute ids, decoded).
