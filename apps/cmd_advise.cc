@@ -90,6 +90,9 @@ int ParseAdviseRequest(AdviseRequest* request) {
     std::cerr << "puzzlecal advise: " << error << "\n";
     return kExitBadInput;
   }
+  if (!listing.note.empty() && ConsoleVerbosity() != Verbosity::kQuiet) {
+    std::cerr << "note: " << listing.note << "\n";
+  }
   request->files = listing.images;
   return kExitOk;
 }

@@ -492,6 +492,11 @@ int ParseRequest(CalibrateRequest* request) {
     return kExitBadInput;
   }
   request->verbosity = ConsoleVerbosity();
+  // Photos in formats that are not read, said even without --verbose.
+  if (!request->listing.note.empty() &&
+      request->verbosity != Verbosity::kQuiet) {
+    std::cerr << "note: " << request->listing.note << "\n";
+  }
   if (request->verbosity == Verbosity::kVerbose) {
     for (const std::string& skipped : request->listing.skipped) {
       std::cerr << "skipped " << skipped << "\n";
@@ -711,6 +716,15 @@ bool WriteReportOf(const CalibrateRequest& request, const CalibrationRun& run,
   return false;
 }
 
+// The first advised photo's picture as the run writes it: in the report
+// folder, or beside --out while watching without one (next_1.png in the
+// working folder when --out names no folder).
+fs::path NextPicturePath() {
+  const std::string name = AdvicePictureName(0);
+  return FLAGS_report.empty() ? fs::path(FLAGS_out).parent_path() / name
+                              : fs::path(FLAGS_report) / name;
+}
+
 // The closing lines on stdout: the calibration, counts, timings (verbose),
 // the verdict and what was written.
 void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
@@ -718,9 +732,17 @@ void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
   const CalibrationResult& result = run.result;
   if (request.verbosity != Verbosity::kQuiet) {
     std::cout << CalibrationReport(result) << "\n";
+    const auto repeated = std::count_if(
+        run.images.begin(), run.images.end(), [](const ImageResult& image) {
+          return image.outcome == ImageOutcome::kRepeatedPhoto;
+        });
     std::cout << "views used: " << result.num_views_used << " of "
-              << run.images.size()
-              << " images; corners: " << result.num_corners_used << "; RMS "
+              << run.images.size() << " images"
+              << (repeated == 0 ? ""
+                                : StringPrintf(" (%d the same photo as an "
+                                               "earlier one, not used)",
+                                               static_cast<int>(repeated)))
+              << "; corners: " << result.num_corners_used << "; RMS "
               << std::setprecision(4) << result.rms_px << " px\n";
   }
   if (request.verbosity == Verbosity::kVerbose) {
@@ -740,8 +762,8 @@ void PrintOutcome(const CalibrateRequest& request, const CalibrationRun& run,
     std::cout << "note: " << note << "\n";
   }
   if (run.advice.ok && request.verbosity != Verbosity::kQuiet) {
-    std::cout << "next photo (" << FLAGS_report
-              << "/next_1.png): " << run.advice.views[0].words << "\n";
+    std::cout << "next photo (" << NextPicturePath().string()
+              << "): " << run.advice.views[0].words << "\n";
   }
   std::cout << "wrote " << FLAGS_out
             << (FLAGS_report.empty() ? "" : " and the report " + FLAGS_report)
@@ -895,7 +917,8 @@ std::string WatchStep(const std::string& file, CalibrateRequest* request,
 // The advised photo's picture beside --out (next_1.png), refreshed.
 void RefreshNextPicture(const CalibrationRun& run) {
   if (!run.advice.ok) return;
-  const fs::path path = fs::path(FLAGS_out).parent_path() / "next_1.png";
+  const fs::path path =
+      fs::path(FLAGS_out).parent_path() / AdvicePictureName(0);
   std::string error;
   if (!WritePngFile(path.string(),
                     DrawAdvicePicture(run.advice, 0,

@@ -118,6 +118,9 @@ int RunCheck() {
     std::cerr << "puzzlecal check: " << error << "\n";
     return kExitBadInput;
   }
+  if (!listing.note.empty() && ConsoleVerbosity() != Verbosity::kQuiet) {
+    std::cerr << "note: " << listing.note << "\n";
+  }
   RecheckRunOptions run_options;
   run_options.pipeline = options.pipeline;
   run_options.calibration = options.calibration;

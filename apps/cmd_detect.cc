@@ -229,6 +229,9 @@ int RunDetect() {
     std::cerr << "puzzlecal detect: " << error << "\n";
     return kExitBadInput;
   }
+  if (!listing.note.empty() && ConsoleVerbosity() != Verbosity::kQuiet) {
+    std::cerr << "note: " << listing.note << "\n";
+  }
   for (const std::string& skipped : listing.skipped) {
     if (ConsoleVerbosity() == Verbosity::kVerbose) {
       std::cerr << "skipped " << skipped << "\n";

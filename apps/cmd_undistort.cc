@@ -63,6 +63,9 @@ int RunUndistort() {
     std::cerr << "puzzlecal undistort: " << error << "\n";
     return kExitBadInput;
   }
+  if (!listing.note.empty() && ConsoleVerbosity() != Verbosity::kQuiet) {
+    std::cerr << "note: " << listing.note << "\n";
+  }
   std::error_code ec;
   fs::create_directories(FLAGS_out, ec);
   const std::string target_path = (fs::path(FLAGS_out) / kTargetFile).string();

@@ -276,31 +276,23 @@ CameraFileOmission DescribeCameraFileOmission(const Camera& camera,
 
 namespace {
 
-// The file's text for `camera` whose omission in `format` is `omission`
-// (DescribeCameraFileOmission, computed once: a splined camera's costs a
-// fit), a camera CheckCamera accepts: when lossy, the camera the format holds
-// (omission.held) and a comment that says what is missing (after OpenCV's
-// "%YAML:1.0" line, which must come first).
-bool FormatWithOmission(const Camera& camera, const CameraFileStats& stats,
-                        CameraFileFormat format,
-                        const CameraFileOmission& omission, std::string* text,
-                        std::string* error, const CameraFileNames& names) {
-  if (omission.lossy) {
-    std::string body;
-    if (!FormatCameraFile(omission.held, stats, format, &body, error, names)) {
-      return false;
-    }
-    const std::string comment = "# " + omission.note + "\n";
-    const size_t line_end = body.find('\n');
-    if (format == CameraFileFormat::kOpenCv && body.rfind("%YAML", 0) == 0 &&
-        line_end != std::string::npos) {
-      *text =
-          body.substr(0, line_end + 1) + comment + body.substr(line_end + 1);
-    } else {
-      *text = comment + body;
-    }
-    return true;
+// `text` as comment lines ("# " before each of its lines).
+std::string CommentLines(const std::string& text) {
+  std::string comment;
+  size_t begin = 0;
+  while (begin <= text.size()) {
+    size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    comment += "# " + text.substr(begin, end - begin) + "\n";
+    begin = end + 1;
   }
+  return comment;
+}
+
+// The text of `camera` in `format`, nothing added.
+bool FormatBody(const Camera& camera, const CameraFileStats& stats,
+                CameraFileFormat format, std::string* text, std::string* error,
+                const CameraFileNames& names) {
   switch (format) {
     case CameraFileFormat::kPuzzlecal:
       *text = camera_file::FormatPuzzlecal(camera, stats);
@@ -315,6 +307,41 @@ bool FormatWithOmission(const Camera& camera, const CameraFileStats& stats,
       return camera_file::FormatKalibr(camera, names.rostopic, text, error);
   }
   return Fail("unknown camera file format", error);
+}
+
+// The file's text for `camera` whose omission in `format` is `omission`
+// (DescribeCameraFileOmission, computed once: a splined camera's costs a
+// fit), a camera CheckCamera accepts: when lossy, the camera the format holds
+// (omission.held). The opencv, ros and kalibr formats have no field for the
+// verdict or for what is missing: comment lines at the top carry them (the
+// readers of these formats skip comments), after OpenCV's "%YAML:1.0" line,
+// which must come first. The puzzlecal format has a `verdict` field.
+bool FormatWithOmission(const Camera& camera, const CameraFileStats& stats,
+                        CameraFileFormat format,
+                        const CameraFileOmission& omission, std::string* text,
+                        std::string* error, const CameraFileNames& names) {
+  std::string body;
+  if (omission.lossy) {
+    if (!CheckCamera(omission.held, error) ||
+        !FormatBody(omission.held, stats, format, &body, error, names)) {
+      return false;
+    }
+  } else if (!FormatBody(camera, stats, format, &body, error, names)) {
+    return false;
+  }
+  std::string comment;
+  if (format != CameraFileFormat::kPuzzlecal && !stats.verdict.empty()) {
+    comment += CommentLines(stats.verdict);
+  }
+  if (omission.lossy) comment += CommentLines(omission.note);
+  const size_t line_end = body.find('\n');
+  if (format == CameraFileFormat::kOpenCv && body.rfind("%YAML", 0) == 0 &&
+      line_end != std::string::npos) {
+    *text = body.substr(0, line_end + 1) + comment + body.substr(line_end + 1);
+  } else {
+    *text = comment + body;
+  }
+  return true;
 }
 
 }  // namespace

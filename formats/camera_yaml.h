@@ -12,8 +12,10 @@
 // (for example k3 != 0 into Kalibr's radtan), except for a non-central
 // camera: opencv, ros and kalibr get its far-field part, with a comment in
 // the file and a note for the user on what was left out and what it costs
-// (DescribeCameraFileOmission). Reading recognises all four
-// formats; messages name the file and the field.
+// (DescribeCameraFileOmission). A calibration's verdict is the puzzlecal
+// format's `verdict` field and a comment line at the top of the others
+// ("# verdict: ..."; their readers skip comments). Reading recognises all
+// four formats; messages name the file and the field.
 
 #include <Eigen/Geometry>
 #include <string>
@@ -45,7 +47,8 @@ struct CameraFileView {
 };
 
 // What a calibration adds to the camera itself (written by the puzzlecal
-// format; the others have no place for it).
+// format; the others have no place for it but the verdict, which they
+// carry as a comment line).
 struct CameraFileStats {
   bool has_stats = false;            // false: the fields below are not set
   std::vector<double> param_stddev;  // one per parameter, 0 for fixed ones
@@ -59,6 +62,8 @@ struct CameraFileStats {
   int num_outliers = 0;
   std::vector<CameraFileView> views;  // the views used, in input order
   // The calibration's verdict line (evidence/verdict.h); "" writes none.
+  // The puzzlecal format's `verdict` field; the first comment line of the
+  // opencv, ros and kalibr formats.
   std::string verdict;
   // Where the calibration's board corners were (see MeasureCalibrationRange):
   // the error figure of a format that leaves part of the camera out is

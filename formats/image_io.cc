@@ -10,10 +10,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>  // the IMREAD_ flags
 #include <opencv2/imgproc.hpp>
+#include <string>
 #include <system_error>
+#include <vector>
 
 #include "formats/opencv_decoder.h"
 #include "formats/png_filters.h"
@@ -218,6 +222,19 @@ bool HasImageExtension(const std::filesystem::path& path) {
          ext == ".tiff" || ext == ".bmp";
 }
 
+bool HasUnreadPhotoExtension(const std::filesystem::path& path) {
+  static const char* const kExtensions[] = {
+      // HEIC / HEIF (phones), and the newer compressed formats.
+      ".heic", ".heif", ".hif", ".avif", ".webp", ".jxl",
+      // Camera RAW.
+      ".cr2", ".cr3", ".crw", ".nef", ".nrw", ".arw", ".srf", ".sr2", ".dng",
+      ".raf", ".orf", ".rw2", ".rwl", ".pef", ".srw", ".x3f", ".3fr", ".iiq",
+      ".erf", ".kdc", ".mrw", ".raw"};
+  const std::string ext = Lower(path.extension().string());
+  return std::any_of(std::begin(kExtensions), std::end(kExtensions),
+                     [&](const char* known) { return ext == known; });
+}
+
 // What an ImageLoader keeps between files.
 struct ImageLoader::Buffers {
   std::vector<unsigned char> bytes;  // the file
@@ -292,6 +309,107 @@ bool ReadFile(const std::string& path, std::vector<unsigned char>* bytes) {
 
 namespace {
 
+// "12 HEIC files and 1 CR2 file": `files` counted by extension (as
+// spelled, in capitals), the extensions in alphabetical order.
+std::string CountByExtension(const std::vector<std::string>& files) {
+  std::map<std::string, int> count;
+  for (const std::string& file : files) {
+    std::string ext = fs::path(file).extension().string();
+    if (!ext.empty()) ext.erase(0, 1);
+    for (char& c : ext) c = static_cast<char>(std::toupper(c));
+    ++count[ext];
+  }
+  std::string text;
+  size_t k = 0;
+  for (const auto& [ext, n] : count) {
+    if (k > 0) text += k + 1 == count.size() ? " and " : ", ";
+    text += std::to_string(n) + " " + ext + (n == 1 ? " file" : " files");
+    ++k;
+  }
+  return text;
+}
+
+// What `files` (photos in formats not read) are and what to do with them.
+std::string UnreadPhotosAdvice(const std::vector<std::string>& files) {
+  return CountByExtension(files) +
+         " (HEIC/HEIF, RAW and the like are not read): convert them to JPEG "
+         "or PNG";
+}
+
+// The sub-folders of `root` that hold image files (or videos when
+// `with_videos`) themselves, by name, and how many of each they hold.
+void SubfoldersWithImages(const fs::path& root, bool with_videos,
+                          std::vector<std::string>* names, int* images,
+                          int* videos) {
+  names->clear();
+  *images = 0;
+  *videos = 0;
+  std::error_code ec;
+  for (fs::directory_iterator it(root, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    std::error_code entry_ec;
+    if (!it->is_directory(entry_ec)) continue;
+    int found = 0;
+    std::error_code sub_ec;
+    for (fs::directory_iterator sub(it->path(), sub_ec); !sub_ec && sub != end;
+         sub.increment(sub_ec)) {
+      std::error_code file_ec;
+      if (!sub->is_regular_file(file_ec)) continue;
+      if (HasImageExtension(sub->path())) {
+        ++*images;
+        ++found;
+      } else if (with_videos && HasVideoExtension(sub->path().string())) {
+        ++*videos;
+        ++found;
+      }
+    }
+    if (found > 0) names->push_back(it->path().filename().string());
+  }
+  std::sort(names->begin(), names->end());
+}
+
+// "1 image file", "3 videos".
+std::string CountOf(int n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+// Why the folder `path` gave nothing to read, beyond "no image files": its
+// sub-folders that hold images, the photos in formats it does not read.
+std::string NothingToReadDetails(const std::string& path, bool with_videos,
+                                 const std::vector<std::string>& unread) {
+  std::string details;
+  std::vector<std::string> folders;
+  int images = 0, videos = 0;
+  SubfoldersWithImages(fs::path(path), with_videos, &folders, &images, &videos);
+  if (!folders.empty()) {
+    std::string list;
+    const size_t shown = folders.size() > 4 ? 3 : folders.size();
+    for (size_t k = 0; k < shown; ++k) {
+      if (k > 0) list += k + 1 == folders.size() ? " and " : ", ";
+      list += folders[k];
+    }
+    if (shown < folders.size()) {
+      list += " and " + std::to_string(folders.size() - shown) + " more";
+    }
+    std::string held;
+    if (images > 0) held = CountOf(images, "image file", "image files");
+    if (videos > 0) {
+      held +=
+          (held.empty() ? "" : " and ") + CountOf(videos, "video", "videos");
+    }
+    details += std::string("; its sub-folder") +
+               (folders.size() == 1 ? " " : "s ") + list +
+               (folders.size() == 1 ? " holds " : " hold ") + held +
+               " (sub-folders are not searched): for a folder with one "
+               "sub-folder per camera use calibrate-rig, otherwise point "
+               "--images at one of them";
+  }
+  if (!unread.empty()) {
+    details += "; it holds " + UnreadPhotosAdvice(unread);
+  }
+  return details;
+}
+
 // ListImages, with videos listed apart when `with_videos`.
 bool ListMedia(const std::string& path, bool with_videos, ImageListing* listing,
                std::string* error) {
@@ -337,6 +455,11 @@ bool ListMedia(const std::string& path, bool with_videos, ImageListing* listing,
       listing->skipped.push_back(entry.string() +
                                  ": a video (calibrate and calibrate-rig read "
                                  "videos)");
+    } else if (HasUnreadPhotoExtension(entry)) {
+      listing->unread_photos.push_back(entry.string());
+      listing->skipped.push_back(entry.string() +
+                                 ": a photo format not read (png, jpg, jpeg, "
+                                 "tif, tiff, bmp are)");
     } else {
       listing->skipped.push_back(entry.string() +
                                  ": not an image file name (png, jpg, jpeg, "
@@ -346,14 +469,20 @@ bool ListMedia(const std::string& path, bool with_videos, ImageListing* listing,
   std::sort(listing->images.begin(), listing->images.end());
   std::sort(listing->videos.begin(), listing->videos.end());
   std::sort(listing->skipped.begin(), listing->skipped.end());
+  std::sort(listing->unread_photos.begin(), listing->unread_photos.end());
   if (listing->images.empty() && listing->videos.empty()) {
-    *error =
-        path + (with_videos ? ": the folder holds no image files (png, jpg, "
-                              "jpeg, tif, tiff, bmp) and no videos (mp4, avi, "
-                              "mkv, mov, ...)"
-                            : ": the folder holds no image files (png, jpg, "
-                              "jpeg, tif, tiff, bmp)");
+    *error = path +
+             (with_videos ? ": the folder holds no image files (png, jpg, "
+                            "jpeg, tif, tiff, bmp) and no videos (mp4, avi, "
+                            "mkv, mov, ...)"
+                          : ": the folder holds no image files (png, jpg, "
+                            "jpeg, tif, tiff, bmp)") +
+             NothingToReadDetails(path, with_videos, listing->unread_photos);
     return false;
+  }
+  if (!listing->unread_photos.empty()) {
+    listing->note = path + ": skipped " +
+                    UnreadPhotosAdvice(listing->unread_photos) + " to use them";
   }
   return true;
 }

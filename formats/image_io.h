@@ -15,16 +15,33 @@ namespace puzzlecal {
 // tif/tiff, bmp; any case).
 bool HasImageExtension(const std::filesystem::path& path);
 
+// True for the file names of photo formats ListImages does not read:
+// HEIC/HEIF (and AVIF, WebP, JPEG XL) and camera RAW (cr2, cr3, nef, arw,
+// dng, raf, orf, rw2, ...; any case).
+bool HasUnreadPhotoExtension(const std::filesystem::path& path);
+
 // What ListImages found.
 struct ImageListing {
   std::vector<std::string> images;   // image files, sorted by name
   std::vector<std::string> videos;   // ListImagesAndVideos: video files
   std::vector<std::string> skipped;  // other entries, with the reason
+  // The skipped files in photo formats that are not read
+  // (HasUnreadPhotoExtension), sorted by name.
+  std::vector<std::string> unread_photos;
+  // One line for the user when photos in such formats were skipped beside
+  // images that are read: how many of which format, and to convert them
+  // ("DIR: skipped 3 HEIC files (...): convert them to JPEG or PNG to use
+  // them"); "" when none.
+  std::string note;
 };
 
 // Lists the image files (png, jpg/jpeg, tif/tiff, bmp; any case) of a folder,
-// sorted by file name, or the one file `path` names. False with a message
-// naming `path` when it does not exist, is not readable, or holds no image.
+// sorted by file name, or the one file `path` names; sub-folders are not
+// searched. False with a message naming `path` when it does not exist, is
+// not readable, or holds no image; for a folder without images the message
+// also names its sub-folders that hold images (a folder of camera folders
+// is calibrate-rig's) and counts the photos in formats that are not read,
+// by format, with the advice to convert them.
 bool ListImages(const std::string& path, ImageListing* listing,
                 std::string* error);
 

@@ -4,11 +4,16 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include "util/enum_names.h"
 #include "util/timer.h"
@@ -43,6 +48,15 @@ void KeepLargestComponent(DecodeResult* decode) {
   *decode = std::move(kept);
 }
 
+// The bytes of `file`; false when it cannot be read.
+bool ReadFileBytes(const std::string& file, std::string* bytes) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  bytes->assign(std::istreambuf_iterator<char>(in),
+                std::istreambuf_iterator<char>());
+  return !in.bad();
+}
+
 }  // namespace
 
 constexpr EnumName<ImageOutcome> kImageOutcomeNames[] = {
@@ -54,6 +68,7 @@ constexpr EnumName<ImageOutcome> kImageOutcomeNames[] = {
     {ImageOutcome::kTooFewCorners, "too few corners"},
     {ImageOutcome::kSizeMismatch, "image size differs"},
     {ImageOutcome::kPartialBoard, "part of the board only"},
+    {ImageOutcome::kRepeatedPhoto, "repeated photo"},
 };
 
 const char* ImageOutcomeName(ImageOutcome outcome) {
@@ -206,6 +221,51 @@ std::vector<ImageResult> ProcessImageFiles(
   return results;
 }
 
+int MarkRepeatedPhotos(std::vector<ImageResult>* images) {
+  // The usable images by file size, in input order.
+  std::map<std::uintmax_t, std::vector<size_t>> by_size;
+  for (size_t i = 0; i < images->size(); ++i) {
+    const ImageResult& image = (*images)[i];
+    if (image.outcome != ImageOutcome::kUsable) continue;
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(image.file, ec);
+    if (ec) continue;  // no such file: a video's frame ("clip.mp4#frame12")
+    by_size[size].push_back(i);
+  }
+  int marked = 0;
+  for (const auto& [size, same_size] : by_size) {
+    if (same_size.size() < 2) continue;
+    // The first image of each content so far, with the hash of its bytes; a
+    // hash match is confirmed byte for byte.
+    std::vector<std::pair<size_t, size_t>> originals;  // (hash, image)
+    for (const size_t i : same_size) {
+      ImageResult& image = (*images)[i];
+      std::string bytes;
+      if (!ReadFileBytes(image.file, &bytes)) continue;
+      const size_t hash = std::hash<std::string>()(bytes);
+      const ImageResult* original = nullptr;
+      for (const auto& [original_hash, k] : originals) {
+        std::string original_bytes;
+        if (original_hash == hash &&
+            ReadFileBytes((*images)[k].file, &original_bytes) &&
+            original_bytes == bytes) {
+          original = &(*images)[k];
+          break;
+        }
+      }
+      if (original == nullptr) {
+        originals.emplace_back(hash, i);
+        continue;
+      }
+      image.outcome = ImageOutcome::kRepeatedPhoto;
+      image.reason = "not used: the same photo as " +
+                     std::filesystem::path(original->file).filename().string();
+      ++marked;
+    }
+  }
+  return marked;
+}
+
 std::vector<CalibrationView> MakeCalibrationViews(
     const Board& board, std::vector<ImageResult>* images, int* width,
     int* height) {
@@ -213,6 +273,7 @@ std::vector<CalibrationView> MakeCalibrationViews(
   *height = 0;
   std::vector<CalibrationView> views;
   for (ImageResult& image : *images) image.view_index = -1;
+  MarkRepeatedPhotos(images);
   // The size most usable images have (the first of them on a tie).
   std::map<std::pair<int, int>, int> count;
   int best = 0;

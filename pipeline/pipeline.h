@@ -30,6 +30,7 @@ enum class ImageOutcome {
   kTooFewCorners,  // decoded, but fewer corners than a view needs
   kSizeMismatch,   // image size differs from the one most images have
   kPartialBoard,   // a rig: part of a plain checkerboard (relative labels)
+  kRepeatedPhoto,  // the file's bytes are an earlier image's (a copy)
 };
 
 // "usable", "unreadable", "no corners", ...
@@ -95,10 +96,19 @@ std::vector<ImageResult> ProcessImageFiles(
     const PipelineOptions& options, int num_threads,
     const std::function<void(size_t, const ImageResult&)>& on_done = {});
 
+// Marks each usable image whose file holds the same bytes as an earlier
+// usable image's (a copy under another name: it adds no view, only weight)
+// as kRepeatedPhoto, reason "not used: the same photo as <earlier file
+// name>"; the earlier one in `images` order is kept. Files are compared by
+// size first, so only files of a shared size are read. Records that name
+// no file (a video's frames) are left alone. Returns how many were marked.
+int MarkRepeatedPhotos(std::vector<ImageResult>* images);
+
 // The calibration views of a run: one per usable image of the size most
-// usable images have (images of another size are marked kSizeMismatch).
-// Sets each image's view_index; `width`/`height` return the image size (0
-// when no image is usable).
+// usable images have (images of another size are marked kSizeMismatch),
+// copies of an earlier image left out (MarkRepeatedPhotos). Sets each
+// image's view_index; `width`/`height` return the image size (0 when no
+// image is usable).
 std::vector<CalibrationView> MakeCalibrationViews(
     const Board& board, std::vector<ImageResult>* images, int* width,
     int* height);

@@ -53,8 +53,8 @@ void BindDetection(py::module_& m) {
             return std::string(ImageOutcomeName(r.outcome));
           },
           "'usable', 'unreadable', 'no corners', 'no consistent grid', "
-          "'code not recognised', 'too few corners', 'image size differs' "
-          "or 'part of the board only'")
+          "'code not recognised', 'too few corners', 'image size differs', "
+          "'part of the board only' or 'repeated photo'")
       .def_property_readonly(
           "usable",
           [](const ImageResult& r) {

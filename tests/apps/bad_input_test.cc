@@ -321,6 +321,53 @@ TEST_F(BadInputTest, FolderOfNonImages) {
   EXPECT_NE(one.err.find("could not be read"), std::string::npos) << one.err;
 }
 
+// A folder of camera folders given to calibrate (calibrate-rig's input)
+// and a folder of HEIC photos: the message says where the images are and
+// what to do; HEIC photos beside PNGs are counted in one line, not skipped
+// silently.
+TEST_F(BadInputTest, FolderOfFoldersAndPhotosInFormatsNotRead) {
+  const fs::path rig = case_dir_ / "rig";
+  for (const char* camera : {"cam0", "cam1"}) {
+    fs::create_directories(rig / camera);
+    fs::copy_file(*root_ / "good" / "view0.png", rig / camera / "01.png");
+  }
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const ProgramRun folders = Calibrate(rig, camera);
+  EXPECT_EQ(folders.exit_code, kExitBadInput) << folders.all();
+  EXPECT_NE(folders.err.find(rig.string() + ": the folder holds no image"),
+            std::string::npos)
+      << folders.err;
+  EXPECT_NE(folders.err.find("its sub-folders cam0 and cam1 hold 2 image "
+                             "files"),
+            std::string::npos)
+      << folders.err;
+  EXPECT_NE(folders.err.find("calibrate-rig"), std::string::npos)
+      << folders.err;
+
+  const fs::path heic = case_dir_ / "heic";
+  fs::create_directories(heic);
+  WriteFile(heic / "IMG_0001.HEIC", "not decoded");
+  WriteFile(heic / "IMG_0002.HEIC", "not decoded");
+  const ProgramRun only_heic = Calibrate(heic, camera);
+  EXPECT_EQ(only_heic.exit_code, kExitBadInput) << only_heic.all();
+  EXPECT_NE(only_heic.err.find("it holds 2 HEIC files"), std::string::npos)
+      << only_heic.err;
+  EXPECT_NE(only_heic.err.find("convert them to JPEG or PNG"),
+            std::string::npos)
+      << only_heic.err;
+  EXPECT_FALSE(fs::exists(camera));
+
+  const fs::path mixed = ImagesWithGoodViews("mixed", 5);
+  WriteFile(mixed / "IMG_0001.HEIC", "not decoded");
+  WriteFile(mixed / "IMG_0002.HEIC", "not decoded");
+  const ProgramRun run = Calibrate(mixed, camera);
+  EXPECT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_EQ(
+      CountOf(run.err, "note: " + mixed.string() + ": skipped 2 HEIC files"), 1)
+      << run.err;
+  EXPECT_TRUE(fs::exists(camera));
+}
+
 // `detect --board` on a good view beside a broken file: the broken file is
 // named with its reason, and every labelled corner of the good view carries
 // the truth id of the printed corner under it (absolute ids, decoded).
@@ -478,6 +525,31 @@ TEST_F(BadInputTest, BrokenFilesAmongGoodViews) {
   }
   EXPECT_FALSE(HasLogPrefix(all)) << all;
   EXPECT_TRUE(fs::exists(camera)) << all;
+}
+
+// A photo copied under another name is one view, not two: the copy (the
+// later name) is named with the photo it repeats, and the summary line
+// counts it.
+TEST_F(BadInputTest, CopyOfAPhotoIsUsedOnce) {
+  const fs::path folder = ImagesWithGoodViews("copies", 5);
+  fs::copy_file(folder / "view1.png", folder / "view1_copy.png");
+  const fs::path camera = case_dir_ / "camera.yaml";
+  const ProgramRun run = Calibrate(folder, camera);
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_NE(run.err.find("view1_copy.png: repeated photo (not used: the same "
+                         "photo as view1.png)"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.out.find("views used: 5 of 6 images (1 the same photo as an "
+                         "earlier one, not used)"),
+            std::string::npos)
+      << run.out;
+  const YAML::Node root = YAML::LoadFile(camera.string());
+  EXPECT_EQ(root["views_used"].as<int>(), 5);
+  for (const YAML::Node& view : root["views"]) {
+    EXPECT_NE(fs::path(view["file"].as<std::string>()).filename(),
+              "view1_copy.png");
+  }
 }
 
 // The program starts without OpenCV's image codecs (Debian's bring about
@@ -683,6 +755,41 @@ TEST_F(BadInputTest, KalibrFormatFixesK3OrRefusesAtOnce) {
       << "images were read before the refusal:\n"
       << refused.all();
   EXPECT_FALSE(fs::exists(rational));
+}
+
+// `calibrate --format opencv|ros|kalibr` writes the verdict line it prints
+// as the file's first comment (after OpenCV's "%YAML:1.0"), and the file
+// still loads: cv::FileStorage for opencv, a YAML reader for ros and kalibr.
+TEST_F(BadInputTest, OtherFormatsCarryThePrintedVerdict) {
+  const fs::path folder = ImagesWithGoodViews("views", 5);
+  for (const std::string format : {"opencv", "ros", "kalibr"}) {
+    SCOPED_TRACE(format);
+    const fs::path camera = case_dir_ / (format + ".yaml");
+    const ProgramRun run =
+        Calibrate(folder, camera, "--format " + format + " --quiet");
+    ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+    const size_t at = run.out.find("verdict: ");
+    ASSERT_NE(at, std::string::npos) << run.out;
+    const std::string verdict = run.out.substr(at, run.out.find('\n', at) - at);
+    const std::string text = ReadFile(camera);
+    const std::string top =
+        (format == "opencv" ? "%YAML:1.0\n# " : "# ") + verdict + "\n";
+    EXPECT_EQ(text.substr(0, top.size()), top) << text;
+    if (format == "opencv") {
+      cv::FileStorage storage(camera.string(), cv::FileStorage::READ);
+      ASSERT_TRUE(storage.isOpened());
+      cv::Mat k;
+      storage["camera_matrix"] >> k;
+      ASSERT_EQ(k.rows, 3);
+      EXPECT_NEAR(k.at<double>(0, 0), 560.0, 5.0);
+    } else {
+      const YAML::Node root = YAML::LoadFile(camera.string());
+      EXPECT_NEAR(format == "ros"
+                      ? root["camera_matrix"]["data"][0].as<double>()
+                      : root["cam0"]["intrinsics"][0].as<double>(),
+                  560.0, 5.0);
+    }
+  }
 }
 
 // A camera file whose format cannot hold the model (a splined camera in

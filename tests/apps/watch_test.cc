@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -116,6 +117,45 @@ TEST(CalibrateWatch, SaysWhereItStandsAfterEveryPhotoUntilGood) {
   EXPECT_NE(rest.find("the verdict is good: done"), std::string::npos);
   EXPECT_NE(rest.find("verdict: good"), std::string::npos);
   EXPECT_TRUE(fs::exists(out / "camera.yaml"));
+}
+
+// A watch that ends before the verdict is good (five photos, then
+// --watch-idle) names the next advised photo's picture by the path it was
+// written to: with --out naming no folder, next_1.png in the working folder
+// (it was printed as "/next_1.png").
+TEST(CalibrateWatch, NamesTheNextPictureWhereItIsWritten) {
+  const fs::path source = fs::absolute("testdata/sample");
+  const fs::path work = Scratch() / "work";
+  const fs::path in = work / "in";
+  fs::create_directories(in);
+  for (const char* name :
+       {"sample_view_000.png", "sample_view_001.png", "sample_view_002.png",
+        "sample_view_003.png", "sample_view_005.png"}) {
+    fs::copy_file(source / name, in / name);
+  }
+  const fs::path log = Scratch() / "work.log";
+  const std::string command =
+      "cd " + Quote(work.string()) + " && " +
+      Quote(testing_program::ProgramPath().string()) +
+      " calibrate --watch in --board " +
+      Quote(
+          fs::absolute("configs/boards/puzzleboard_23x16_30mm.yaml").string()) +
+      " --out camera.yaml --watch-idle 1 >" + Quote(log.string()) +
+      " 2>&1 </dev/null";
+  const int status = std::system(command.c_str());
+  const std::string out = testing_files::ReadFile(log);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  EXPECT_NE(out.find("verdict: insufficient-data"), std::string::npos) << out;
+  const std::string prefix = "next photo (";
+  const size_t at = out.find(prefix);
+  ASSERT_NE(at, std::string::npos) << out;
+  const size_t end = out.find("): ", at);
+  ASSERT_NE(end, std::string::npos) << out;
+  const std::string picture =
+      out.substr(at + prefix.size(), end - at - prefix.size());
+  EXPECT_EQ(picture, "next_1.png") << out;
+  EXPECT_TRUE(fs::exists(work / picture)) << out;
+  EXPECT_TRUE(fs::exists(work / "camera.yaml")) << out;
 }
 
 }  // namespace

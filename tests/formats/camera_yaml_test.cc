@@ -263,6 +263,89 @@ TEST_F(CameraYamlTest, NoncentralCameraIntoOtherFormatsSaysWhatIsLeftOut) {
   EXPECT_NE(bare.note.find("far-field"), std::string::npos);
 }
 
+// The verdict in the opencv, ros and kalibr formats, which have no field
+// for it: a comment line at the top ("# verdict: ..."), after OpenCV's
+// "%YAML:1.0" line, before a non-central camera's note; the file still
+// reads as the same camera through the project's reader, a plain YAML
+// reader (ros, kalibr) and cv::FileStorage (opencv). The puzzlecal format
+// keeps its `verdict` field and no comment.
+TEST_F(CameraYamlTest, OtherFormatsCarryTheVerdictAsACommentLine) {
+  CameraFileStats stats;
+  stats.has_stats = true;  // the puzzlecal format writes a verdict with them
+  stats.verdict =
+      "verdict: insufficient-data \u2014 4 views used, at least 8 needed "
+      "\u2014 take more photos";
+  stats.closest_board_distance_m = 0.3;
+  for (CameraModelId id : {CameraModelId::kPinholeRadtan,
+                           CameraModelId::kKannalaBrandtNoncentral}) {
+    Camera camera = MakeCamera(id);
+    if (id == CameraModelId::kPinholeRadtan) {
+      camera.params[8] = 0;  // kalibr's radtan has no k3
+    }
+    for (CameraFileFormat format :
+         {CameraFileFormat::kOpenCv, CameraFileFormat::kRos,
+          CameraFileFormat::kKalibr, CameraFileFormat::kPuzzlecal}) {
+      SCOPED_TRACE(std::string(CameraModelName(id)) + " as " +
+                   CameraFileFormatName(format));
+      const std::string path =
+          Path(std::string("verdict_") + CameraModelName(id) + "." +
+               CameraFileFormatName(format) + ".yaml");
+      std::string error, note;
+      ASSERT_TRUE(WriteCameraFile(path, format, camera, stats, &error, &note))
+          << error;
+      std::ifstream in(path);
+      const std::string text((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+      Camera read;
+      ASSERT_TRUE(ReadCameraFile(path, &read, &error)) << error;
+      const Camera held = CameraForFormat(camera, format, stats);
+      EXPECT_EQ(read.model, held.model);
+      EXPECT_EQ(read.params, held.params);
+      if (format == CameraFileFormat::kPuzzlecal) {
+        EXPECT_EQ(YAML::LoadFile(path)["verdict"].as<std::string>(),
+                  stats.verdict);
+        EXPECT_EQ(text.find("# verdict"), std::string::npos) << text;
+        continue;
+      }
+      const std::string header =
+          format == CameraFileFormat::kOpenCv ? "%YAML:1.0\n" : "";
+      const std::string expected_top =
+          header + "# " + stats.verdict + "\n" +
+          (note.empty() ? std::string() : "# " + note + "\n");
+      EXPECT_EQ(text.substr(0, expected_top.size()), expected_top) << text;
+      EXPECT_EQ(id == CameraModelId::kKannalaBrandtNoncentral, !note.empty());
+      if (format == CameraFileFormat::kOpenCv) {
+        cv::FileStorage fs(path, cv::FileStorage::READ);
+        ASSERT_TRUE(fs.isOpened());
+        cv::Mat k;
+        fs["camera_matrix"] >> k;
+        ASSERT_EQ(k.rows, 3);
+        EXPECT_EQ(k.at<double>(0, 0), held.params[0]);
+        EXPECT_EQ(static_cast<int>(fs["image_width"]), held.width);
+        EXPECT_EQ(static_cast<std::string>(fs["model"]),
+                  CameraModelName(held.model));
+      } else {
+        const YAML::Node root = YAML::LoadFile(path);
+        if (format == CameraFileFormat::kRos) {
+          EXPECT_EQ(root["image_width"].as<int>(), held.width);
+          EXPECT_EQ(root["camera_matrix"]["data"][0].as<double>(),
+                    held.params[0]);
+        } else {
+          EXPECT_EQ(root["cam0"]["intrinsics"][0].as<double>(), held.params[0]);
+        }
+      }
+    }
+  }
+  // A verdict of several lines stays a comment, line by line.
+  stats.verdict = "verdict: good \u2014 fine\nsecond line \u2014 none";
+  std::string text, error;
+  ASSERT_TRUE(FormatCameraFile(MakeCamera(CameraModelId::kKannalaBrandt), stats,
+                               CameraFileFormat::kRos, &text, &error))
+      << error;
+  EXPECT_EQ(text.rfind("# verdict: good \u2014 fine\n# second line", 0), 0u)
+      << text;
+}
+
 // A splined camera in the opencv, ros and kalibr formats: the file holds the
 // kannala-brandt that fits it best over the observed field, its comment and
 // the note say how far that is off, and that figure is what the camera read

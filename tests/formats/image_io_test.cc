@@ -74,6 +74,81 @@ TEST_F(ImageIoTest, MissingAndEmptyFoldersNameThePath) {
   EXPECT_NE(error.find("no image"), std::string::npos);
 }
 
+// A folder whose images are all in sub-folders (a rig's camera folders):
+// the message names the sub-folders, counts their images and points to
+// calibrate-rig or to one of them. It said only "holds no image files".
+TEST_F(ImageIoTest, FolderOfImageFoldersSaysWhereTheImagesAre) {
+  for (const char* camera : {"cam0", "cam1"}) {
+    fs::create_directories(dir_ / camera);
+    for (const char* name : {"01.png", "02.png"}) {
+      cv::imwrite((dir_ / camera / name).string(), ramp_);
+    }
+  }
+  fs::create_directories(dir_ / "notes");  // no images: not named
+  WriteBytes("notes/readme.txt", "hello");
+  ImageListing listing;
+  std::string error;
+  EXPECT_FALSE(ListImages(dir_.string(), &listing, &error));
+  EXPECT_EQ(error.rfind(dir_.string() + ": the folder holds no image files", 0),
+            0u)
+      << error;
+  EXPECT_NE(error.find("its sub-folders cam0 and cam1 hold 4 image files "
+                       "(sub-folders are not searched)"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("use calibrate-rig, otherwise point --images at one "
+                       "of them"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(error.find("notes"), std::string::npos) << error;
+  // One sub-folder, said as one.
+  fs::remove_all(dir_ / "cam1");
+  EXPECT_FALSE(ListImages(dir_.string(), &listing, &error));
+  EXPECT_NE(error.find("its sub-folder cam0 holds 2 image files"),
+            std::string::npos)
+      << error;
+}
+
+// Photos in formats that are not read (HEIC, camera RAW): alone, the
+// message counts them by format and says to convert them; beside images
+// that are read, the listing's note says in one line how many were skipped
+// and why (they were skipped silently).
+TEST_F(ImageIoTest, PhotosInFormatsNotReadAreCountedByFormat) {
+  for (const char* name : {"IMG_0001.HEIC", "IMG_0002.HEIC", "IMG_0003.heic",
+                           "DSC_0004.NEF", "notes.txt"}) {
+    WriteBytes(name, "not decoded");
+  }
+  ImageListing listing;
+  std::string error;
+  EXPECT_FALSE(ListImages(dir_.string(), &listing, &error));
+  EXPECT_NE(error.find("no image files"), std::string::npos) << error;
+  EXPECT_NE(error.find("it holds 3 HEIC files and 1 NEF file (HEIC/HEIF, RAW "
+                       "and the like are not read): convert them to JPEG or "
+                       "PNG"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(error.find("sub-folder"), std::string::npos) << error;
+
+  cv::imwrite(Path("a.png"), ramp_);
+  ASSERT_TRUE(ListImages(dir_.string(), &listing, &error)) << error;
+  ASSERT_EQ(listing.images.size(), 1u);
+  EXPECT_EQ(listing.unread_photos.size(), 4u);
+  EXPECT_EQ(listing.skipped.size(), 5u);  // notes.txt too
+  EXPECT_EQ(listing.note, dir_.string() +
+                              ": skipped 3 HEIC files and 1 NEF file "
+                              "(HEIC/HEIF, RAW and the like are not read): "
+                              "convert them to JPEG or PNG to use them");
+  EXPECT_TRUE(HasUnreadPhotoExtension("x.Cr2"));
+  EXPECT_TRUE(HasUnreadPhotoExtension("x.dng"));
+  EXPECT_FALSE(HasUnreadPhotoExtension("x.jpg"));
+  EXPECT_FALSE(HasUnreadPhotoExtension("x.txt"));
+
+  // Only images that are read: no note.
+  for (const std::string& file : listing.unread_photos) fs::remove(file);
+  ASSERT_TRUE(ListImages(dir_.string(), &listing, &error)) << error;
+  EXPECT_EQ(listing.note, "");
+}
+
 TEST_F(ImageIoTest, LoadsEightBitGreyExactly) {
   cv::imwrite(Path("ramp.png"), ramp_);
   cv::Mat grey;

@@ -217,5 +217,51 @@ TEST(MakeCalibrationViewsTest, UsesTheSizeMostImagesHave) {
   EXPECT_EQ(views[0].board_points[2], board.Point(Eigen::Vector2i(2, 0)));
 }
 
+// A rendered photo and a byte-for-byte copy under another name (sorted
+// after it) in one folder: the copy is no second view. It is marked with
+// the photo it repeats; a file of the same size with other bytes, and the
+// photo itself, stay views.
+TEST_F(PipelineTest, CopyOfAnEarlierPhotoIsNoView) {
+  const Board board = MakePuzzleBoard(11, 8, 0, 0, 0.06);
+  Render("a.png", board, LookAt(board, {5, 3.5}, 1.0, 10.0, 15.0));
+  Render("b.png", board, LookAt(board, {5, 3.5}, 1.1, 20.0, 30.0));
+  fs::copy_file(dir_ / "a.png", dir_ / "c.png");
+  files_.push_back((dir_ / "c.png").string());
+  std::vector<ImageResult> images =
+      ProcessImageFiles(files_, board, PipelineOptions(), 2);
+  ASSERT_EQ(images.size(), 3u);
+  for (const ImageResult& image : images) {
+    ASSERT_EQ(image.outcome, ImageOutcome::kUsable) << image.reason;
+  }
+  int width = 0, height = 0;
+  const std::vector<CalibrationView> views =
+      MakeCalibrationViews(board, &images, &width, &height);
+  ASSERT_EQ(views.size(), 2u);
+  EXPECT_EQ(views[0].name, "a.png");
+  EXPECT_EQ(views[1].name, "b.png");
+  EXPECT_EQ(images[2].outcome, ImageOutcome::kRepeatedPhoto);
+  EXPECT_EQ(images[2].reason, "not used: the same photo as a.png");
+  EXPECT_EQ(images[2].view_index, -1);
+  EXPECT_STREQ(ImageOutcomeName(images[2].outcome), "repeated photo");
+
+  // Files of one size: only equal bytes make a copy, whatever the hash.
+  std::vector<ImageResult> records(4);
+  const std::string contents[4] = {"0123456789", "0123456788", "0123456789",
+                                   "0123456788"};
+  for (int i = 0; i < 4; ++i) {
+    const fs::path file = dir_ / ("same_size_" + std::to_string(i) + ".bin");
+    std::ofstream(file, std::ios::binary) << contents[i];
+    records[i].file = file.string();
+    records[i].outcome = ImageOutcome::kUsable;
+  }
+  records[1].outcome = ImageOutcome::kNoGrid;  // not a view: not compared
+  EXPECT_EQ(MarkRepeatedPhotos(&records), 1);
+  EXPECT_EQ(records[0].outcome, ImageOutcome::kUsable);
+  EXPECT_EQ(records[1].outcome, ImageOutcome::kNoGrid);
+  EXPECT_EQ(records[2].outcome, ImageOutcome::kRepeatedPhoto);
+  EXPECT_EQ(records[2].reason, "not used: the same photo as same_size_0.bin");
+  EXPECT_EQ(records[3].outcome, ImageOutcome::kUsable);
+}
+
 }  // namespace
 }  // namespace puzzlecal
