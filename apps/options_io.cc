@@ -292,6 +292,7 @@ struct Fields<EvidenceOptions> {
     v.Field("distance_bins", o.distance_bins);
     v.Field("min_bin_count", o.min_bin_count);
     v.Field("cross_validation", o.cross_validation);
+    v.Field("cross_validation_splits", o.cross_validation_splits);
     v.Field("report_angles_deg", o.report_angles_deg);
     v.Field("report_azimuths", o.report_azimuths);
     v.Field("view_focal_min_corners", o.view_consistency.min_corners);

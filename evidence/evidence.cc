@@ -6,7 +6,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <sstream>
 #include <vector>
@@ -141,16 +144,66 @@ PixelMap CovarianceTraceMap(const Camera& camera,
   return map;
 }
 
-// The used views of `result` at even (half 0) or odd (half 1) positions.
+// A hash of a view's corners (their image and board coordinates, bit for
+// bit), salted: it orders the views of a split by their contents.
+uint64_t ViewHash(const CalibrationView& view, uint64_t salt) {
+  uint64_t hash = 14695981039346656037ull ^ (salt * 0x9e3779b97f4a7c15ull);
+  auto mix = [&hash](double value) {
+    uint64_t bits;
+    std::memcpy(&bits, &value, sizeof(bits));
+    for (int byte = 0; byte < 8; ++byte) {
+      hash ^= (bits >> (8 * byte)) & 0xffu;
+      hash *= 1099511628211ull;
+    }
+  };
+  for (size_t i = 0; i < view.image_points.size(); ++i) {
+    mix(view.image_points[i].x());
+    mix(view.image_points[i].y());
+    mix(view.board_points[i].x());
+    mix(view.board_points[i].y());
+    mix(view.board_points[i].z());
+  }
+  // A final avalanche, so that nearby salts give unrelated orders.
+  hash ^= hash >> 33;
+  hash *= 0xff51afd7ed558ccdull;
+  hash ^= hash >> 33;
+  return hash;
+}
+
+// The half (0 or 1) of each view in split `split`, -1 for views `result`
+// did not use. One split (cross_validation_splits 1): the used views
+// alternate by position. Several: split k orders the used views by their
+// hash salted with k (ties by position) and alternates, so that no split
+// depends on the order of the views.
+std::vector<int> SplitHalves(const std::vector<CalibrationView>& views,
+                             const CalibrationResult& result, int split,
+                             int num_splits) {
+  std::vector<std::pair<uint64_t, size_t>> order;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (v >= result.view_used.size() || !result.view_used[v]) continue;
+    const uint64_t key =
+        num_splits > 1 ? ViewHash(views[v], static_cast<uint64_t>(split)) : 0;
+    order.push_back({key, v});
+  }
+  std::stable_sort(
+      order.begin(), order.end(),
+      [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<int> half(views.size(), -1);
+  for (size_t k = 0; k < order.size(); ++k) {
+    half[order[k].second] = static_cast<int>(k % 2);
+  }
+  return half;
+}
+
+// The views of one half of a split, with their poses in `result`.
 std::vector<CalibrationView> Half(const std::vector<CalibrationView>& views,
-                                  const CalibrationResult& result, int half,
+                                  const CalibrationResult& result,
+                                  const std::vector<int>& half_of, int half,
                                   std::vector<Eigen::Isometry3d>* poses) {
   std::vector<CalibrationView> out;
   poses->clear();
-  int position = 0;
   for (size_t v = 0; v < views.size(); ++v) {
-    if (v >= result.view_used.size() || !result.view_used[v]) continue;
-    if (position++ % 2 != half) continue;
+    if (half_of[v] != half) continue;
     out.push_back(views[v]);
     poses->push_back(result.cam_from_board[v]);
   }
@@ -190,6 +243,9 @@ bool EvidenceOptions::Check(std::string* why) const {
   if (!(band_width_deg > 0)) return Fail("band_width_deg must be > 0", why);
   if (distance_bins < 1) return Fail("distance_bins must be >= 1", why);
   if (min_bin_count < 1) return Fail("min_bin_count must be >= 1", why);
+  if (cross_validation_splits < 1 || cross_validation_splits > 16) {
+    return Fail("cross_validation_splits must lie in 1-16", why);
+  }
   if (report_azimuths < 1) return Fail("report_azimuths must be >= 1", why);
   for (double angle : report_angles_deg) {
     if (!(angle > 0 && angle < 180)) {
@@ -514,13 +570,15 @@ double ChiSquareZ(double chi2, int dof) {
 
 namespace {
 
-// The halves' two calibrations, started from the full solution, each with
-// its covariance. False (with out->error) when a half cannot be calibrated
-// or does not determine the model.
+// The two calibrations of split `split`'s halves, started from the full
+// solution, each with its covariance, and the halves' view counts. False
+// (with *error) when a half cannot be calibrated or does not determine the
+// model.
 bool CalibrateHalves(const std::vector<CalibrationView>& views,
                      const CalibrationResult& result,
-                     const CalibrationOptions& calibration,
-                     CrossValidation* out, CalibrationResult halves[2]) {
+                     const CalibrationOptions& calibration, int split,
+                     int num_splits, int view_counts[2],
+                     CalibrationResult halves[2], std::string* error_out) {
   const Camera& camera = result.camera;
   CalibrationOptions half_options = calibration;
   half_options.initial_params = camera.params;
@@ -535,11 +593,13 @@ bool CalibrateHalves(const std::vector<CalibrationView>& views,
   // Each half starts from the full solution's intrinsics and its views'
   // poses: a few iterations from its own minimum.
   CalibrationOptions options_of[2] = {half_options, half_options};
+  const std::vector<int> half_of =
+      SplitHalves(views, result, split, num_splits);
   std::vector<CalibrationView> half[2] = {
-      Half(views, result, 0, &options_of[0].initial_cam_from_board),
-      Half(views, result, 1, &options_of[1].initial_cam_from_board)};
-  out->views_a = static_cast<int>(half[0].size());
-  out->views_b = static_cast<int>(half[1].size());
+      Half(views, result, half_of, 0, &options_of[0].initial_cam_from_board),
+      Half(views, result, half_of, 1, &options_of[1].initial_cam_from_board)};
+  view_counts[0] = static_cast<int>(half[0].size());
+  view_counts[1] = static_cast<int>(half[1].size());
   std::string error[2];
   char ok[2] = {0, 0};
   ParallelFor(2, workers, [&](int h) {
@@ -549,12 +609,12 @@ bool CalibrateHalves(const std::vector<CalibrationView>& views,
   for (int h = 0; h < 2; ++h) {
     const std::string name = h == 0 ? "A" : "B";
     if (!ok[h]) {
-      out->error = "half " + name + " (" + std::to_string(half[h].size()) +
+      *error_out = "half " + name + " (" + std::to_string(half[h].size()) +
                    " views): " + error[h];
       return false;
     }
     if (!halves[h].covariance_ok) {
-      out->error = "half " + name +
+      *error_out = "half " + name +
                    ": no covariance (the half does not determine the model)";
       return false;
     }
@@ -790,6 +850,88 @@ ProjectionDiff ProjectionDifference(const Camera& a, const Camera& b,
   return out;
 }
 
+namespace {
+
+// One split's comparison of its halves.
+struct SplitComparison {
+  bool ok = false;
+  std::string error;
+  int view_counts[2] = {0, 0};
+  CalibrationResult halves[2];
+  ProjectionDiff diff;
+  double intrinsics_chi2 = 0;
+  int intrinsics_dof = 0;
+};
+
+SplitComparison CompareSplit(const std::vector<CalibrationView>& views,
+                             const CalibrationResult& result,
+                             const CalibrationOptions& calibration, int split,
+                             double max_angle_deg,
+                             const EvidenceOptions& options) {
+  SplitComparison out;
+  if (!CalibrateHalves(views, result, calibration, split,
+                       std::max(1, options.cross_validation_splits),
+                       out.view_counts, out.halves, &out.error)) {
+    return out;
+  }
+  IntrinsicsChiSquare(out.halves[0], out.halves[1], &out.intrinsics_chi2,
+                      &out.intrinsics_dof);
+  // |project_B(R * unproject_A(pixel)) - pixel| after the rotation between
+  // the halves is taken out, against what their covariances predict.
+  out.diff = ProjectionDifference(
+      out.halves[0].camera, out.halves[1].camera, max_angle_deg, options,
+      &out.halves[0].covariance, &out.halves[1].covariance);
+  if (!out.diff.ok) {
+    out.error = "comparing the halves: " + out.diff.error;
+    return out;
+  }
+  out.ok = true;
+  return out;
+}
+
+double MedianOfSplits(std::vector<double> values) {
+  return values.empty() ? 0.0 : Quantile(std::move(values), 0.5);
+}
+
+// Per band, the difference and expected figures of the split whose ratio
+// of the two medians is the median over the splits (the lower middle one
+// for an even count): a band's figures stay one split's, so its ratio is
+// theirs. The count is the smallest over the splits (the bands share their
+// edges: one field limit, one width).
+void MedianBands(const std::vector<const ProjectionDiff*>& splits,
+                 std::vector<AngleBand>* difference,
+                 std::vector<AngleBand>* expected) {
+  *difference = splits.front()->difference_bands;
+  *expected = splits.front()->expected_bands;
+  for (size_t b = 0; b < difference->size() && b < expected->size(); ++b) {
+    std::vector<std::pair<double, const ProjectionDiff*>> ratios;
+    int count = (*difference)[b].count;
+    for (const ProjectionDiff* split : splits) {
+      if (b >= split->difference_bands.size() ||
+          b >= split->expected_bands.size()) {
+        continue;
+      }
+      const double e = split->expected_bands[b].median;
+      const double d = split->difference_bands[b].median;
+      count = std::min(count, split->difference_bands[b].count);
+      ratios.push_back({e > 0 ? d / e : kNaN, split});
+    }
+    // NaN ratios (no prediction) last.
+    std::sort(ratios.begin(), ratios.end(), [](const auto& x, const auto& y) {
+      if (std::isnan(x.first) != std::isnan(y.first))
+        return !std::isnan(x.first);
+      return x.first < y.first;
+    });
+    const ProjectionDiff* middle = ratios[(ratios.size() - 1) / 2].second;
+    (*difference)[b] = middle->difference_bands[b];
+    (*expected)[b] = middle->expected_bands[b];
+    (*difference)[b].count = count;
+    (*expected)[b].count = std::min(count, (*expected)[b].count);
+  }
+}
+
+}  // namespace
+
 CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
                               const CalibrationResult& result,
                               const CalibrationOptions& calibration,
@@ -797,33 +939,43 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
                               const EvidenceOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   CrossValidation out;
-  CalibrationResult halves[2];
-  if (!CalibrateHalves(views, result, calibration, &out, halves)) {
+  const int num_splits = std::max(1, options.cross_validation_splits);
+  std::vector<SplitComparison> splits;
+  for (int split = 0; split < num_splits; ++split) {
+    splits.push_back(CompareSplit(views, result, calibration, split,
+                                  max_angle_deg, options));
+  }
+  out.splits_tried = num_splits;
+  const SplitComparison* first = nullptr;
+  std::vector<const ProjectionDiff*> compared;
+  std::vector<double> chi2;
+  for (const SplitComparison& split : splits) {
+    if (!split.ok) continue;
+    if (first == nullptr) first = &split;
+    compared.push_back(&split.diff);
+    chi2.push_back(split.intrinsics_chi2);
+  }
+  if (first == nullptr) {
+    out.error = splits.front().error;
+    out.views_a = splits.front().view_counts[0];
+    out.views_b = splits.front().view_counts[1];
     out.seconds = SecondsSince(start);
     return out;
   }
-  out.camera_a = halves[0].camera;
-  out.camera_b = halves[1].camera;
-  out.rms_a_px = halves[0].rms_px;
-  out.rms_b_px = halves[1].rms_px;
-  IntrinsicsChiSquare(halves[0], halves[1], &out.intrinsics_chi2,
-                      &out.intrinsics_dof);
-  // |project_B(R * unproject_A(pixel)) - pixel| after the rotation between
-  // the halves is taken out, against what their covariances predict.
-  const ProjectionDiff diff =
-      ProjectionDifference(out.camera_a, out.camera_b, max_angle_deg, options,
-                           &halves[0].covariance, &halves[1].covariance);
-  if (!diff.ok) {
-    out.error = "comparing the halves: " + diff.error;
-    out.seconds = SecondsSince(start);
-    return out;
-  }
-  out.b_from_a = diff.b_from_a;
-  out.rotation_deg = diff.rotation_deg;
-  out.difference_px = diff.difference_px;
-  out.expected_px = diff.expected_px;
-  out.difference_bands = diff.difference_bands;
-  out.expected_bands = diff.expected_bands;
+  out.splits = static_cast<int>(compared.size());
+  out.views_a = first->view_counts[0];
+  out.views_b = first->view_counts[1];
+  out.camera_a = first->halves[0].camera;
+  out.camera_b = first->halves[1].camera;
+  out.rms_a_px = first->halves[0].rms_px;
+  out.rms_b_px = first->halves[1].rms_px;
+  out.b_from_a = first->diff.b_from_a;
+  out.rotation_deg = first->diff.rotation_deg;
+  out.difference_px = first->diff.difference_px;
+  out.expected_px = first->diff.expected_px;
+  MedianBands(compared, &out.difference_bands, &out.expected_bands);
+  out.intrinsics_chi2 = MedianOfSplits(chi2);
+  out.intrinsics_dof = first->intrinsics_dof;
   out.ok = true;
   out.seconds = SecondsSince(start);
   return out;
@@ -897,8 +1049,11 @@ std::string EvidenceText(const Evidence& evidence) {
   std::ostringstream text;
   const CrossValidation& cv = evidence.cross_validation;
   if (cv.ok) {
-    text << "cross-validation (" << cv.views_a << " + " << cv.views_b
-         << " views, RMS "
+    text << "cross-validation ("
+         << (cv.splits > 1 ? "the median split's bands of " +
+                                 std::to_string(cv.splits) + "; first split "
+                           : std::string())
+         << cv.views_a << " + " << cv.views_b << " views, RMS "
          << StringPrintf("%.3f / %.3f px", cv.rms_a_px, cv.rms_b_px)
          << ", rotation between the halves "
          << StringPrintf("%.3f deg", cv.rotation_deg) << "):\n";

@@ -57,6 +57,14 @@ std::string BinText(const ResidualBin& bin, const char* unit, bool metres) {
          unit + StringPrintf(" (n=%d)", bin.count);
 }
 
+// " (the median of 5 splits of the views)" when the cross-validation's
+// figures are the median split's of several (CrossValidation), else "".
+std::string OverSplits(const CrossValidation& cv) {
+  return cv.splits > 1 ? StringPrintf(" (the median of %d splits of the views)",
+                                      cv.splits)
+                       : std::string();
+}
+
 // The judged band (min_count samples or more, a positive prediction) where
 // the halves agree best: the smallest ratio of difference to prediction.
 // Null when no band is judged; `num_bands` (optional) counts them.
@@ -107,11 +115,11 @@ void AddUniformHalvesFinding(const CrossValidation& cv, double halves_scale,
   }
   findings->push_back(
       {VerdictKind::kInconsistentViews,
-       StringPrintf(
-           "the two halves of the views differ %.1f times more than their "
-           "uncertainty predicts in every field-angle band, by %.2f px or "
-           "more (median, at %.0f",
-           halves_scale, best->median, best->lo_deg) +
+       "the two halves of the views" + OverSplits(cv) +
+           StringPrintf(
+               " differ %.1f times more than their uncertainty predicts in "
+               "every field-angle band, by %.2f px or more (median, at %.0f",
+               halves_scale, best->median, best->lo_deg) +
            StringPrintf(
                "-%.0f deg where they agree best); corner errors shared "
                "within views explain up to about %.0f times, so the "
@@ -135,11 +143,12 @@ void AddHalvesFindings(const CrossValidation& cv, double halves_scale,
     if (ratio > options.halves_factor && d.median > options.halves_floor_px &&
         ratio > worst_ratio) {
       worst_ratio = ratio;
-      halves_text = StringPrintf(
-          "the two halves of the views differ by %.3f px (median) at "
-          "%.0f-%.0f deg, %.1f times what their uncertainty predicts "
-          "(%.3f px)",
-          d.median, d.lo_deg, d.hi_deg, ratio, halves_scale * e.median);
+      halves_text =
+          "the two halves of the views" + OverSplits(cv) +
+          StringPrintf(
+              " differ by %.3f px (median) at %.0f-%.0f deg, %.1f times "
+              "what their uncertainty predicts (%.3f px)",
+              d.median, d.lo_deg, d.hi_deg, ratio, halves_scale * e.median);
       if (halves_scale > 1) {
         halves_text += StringPrintf(
             ", the prediction scaled by %.2f, the best-agreeing band's "
@@ -659,18 +668,21 @@ std::string GoodReason(const CalibrationResult& result,
   if (cv.ok && halves_scale > 1) {
     // Not "the halves agree" alone: they do only once their uncertainty
     // is scaled, and the stated one is what the camera file carries.
-    reason += StringPrintf(
-        "; the halves agree only with their stated uncertainty scaled by "
-        "%.2f, the factor by which they differ more than it in every band "
-        "(largest band median %.3f px, the stated uncertainty predicts "
-        "%.3f px): corner errors shared within views, so the stated "
-        "uncertainty is optimistic by about that factor",
-        halves_scale, worst_diff, worst_expected);
+    reason +=
+        "; the halves" + OverSplits(cv) +
+        StringPrintf(
+            " agree only with their stated uncertainty scaled by "
+            "%.2f, the factor by which they differ more than it in every band "
+            "(largest band median %.3f px, the stated uncertainty predicts "
+            "%.3f px): corner errors shared within views, so the stated "
+            "uncertainty is optimistic by about that factor",
+            halves_scale, worst_diff, worst_expected);
   } else if (cv.ok) {
-    reason += StringPrintf(
-        "; the halves agree (largest band median %.3f px, noise predicts "
-        "%.3f px)",
-        worst_diff, worst_expected);
+    reason += "; the halves" + OverSplits(cv) +
+              StringPrintf(
+                  " agree (largest band median %.3f px, noise predicts "
+                  "%.3f px)",
+                  worst_diff, worst_expected);
   }
   return reason + "; no systematic residuals";
 }

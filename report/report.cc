@@ -736,9 +736,15 @@ cv::Mat PlotCrossValidation(const ReportData& data,
   return PlotPixelMap(
       data, options, cv.difference_px, largest_band,
       "Cross-validation: projection difference between two halves of the views",
-      StringPrintf("%d + %d views calibrated apart (alternating); far-field "
-                   "difference after the best-fit rotation (%.3f deg)",
-                   cv.views_a, cv.views_b, cv.rotation_deg),
+      (cv.splits > 1
+           ? StringPrintf("%d + %d views calibrated apart (the first of %d "
+                          "splits); ",
+                          cv.views_a, cv.views_b, cv.splits)
+           : StringPrintf("%d + %d views calibrated apart (alternating); ",
+                          cv.views_a, cv.views_b)) +
+          StringPrintf("far-field difference after the best-fit rotation "
+                       "(%.3f deg)",
+                       cv.rotation_deg),
       "|A - B| (px)",
       {"Each pixel's ray under half A, rotated into half B's frame and "
        "projected by B, against the pixel. Colours up to the largest "
@@ -1054,13 +1060,28 @@ std::string EvidenceMarkdown(const Evidence& evidence, const Verdict* verdict,
   const CrossValidation& cv = evidence.cross_validation;
   md << sub << " Cross-validation (two halves of the views)\n\n";
   if (cv.ok) {
-    md << StringPrintf(
-        "Views alternately into halves of %d and %d, each calibrated alone "
-        "(RMS %.3f and %.3f px). Far-field projection difference after the "
-        "best-fit rotation between the halves' camera frames (%.3f deg), "
-        "against the difference the halves' own covariances predict (RMS "
-        "length):\n\n",
-        cv.views_a, cv.views_b, cv.rms_a_px, cv.rms_b_px, cv.rotation_deg);
+    if (cv.splits > 1) {
+      md << StringPrintf(
+          "The views split into two halves in %d ways (each split orders "
+          "the views by a hash of their corners and alternates, so the "
+          "order of the files does not matter); each half calibrated alone "
+          "(first split: %d and %d views, RMS %.3f and %.3f px). Far-field "
+          "projection difference after the best-fit rotation between the "
+          "halves' camera frames (first split: %.3f deg), against the "
+          "difference the halves' own covariances predict (RMS length); "
+          "each band's figures are those of the split with the median "
+          "ratio:\n\n",
+          cv.splits, cv.views_a, cv.views_b, cv.rms_a_px, cv.rms_b_px,
+          cv.rotation_deg);
+    } else {
+      md << StringPrintf(
+          "Views alternately into halves of %d and %d, each calibrated "
+          "alone (RMS %.3f and %.3f px). Far-field projection difference "
+          "after the best-fit rotation between the halves' camera frames "
+          "(%.3f deg), against the difference the halves' own covariances "
+          "predict (RMS length):\n\n",
+          cv.views_a, cv.views_b, cv.rms_a_px, cv.rms_b_px, cv.rotation_deg);
+    }
     md << "| field angle | samples | difference median (px) | p95 (px) | "
           "expected median (px) | p95 (px) |\n|---|---:|---:|---:|---:|---:|\n";
     for (size_t b = 0; b < cv.difference_bands.size(); ++b) {

@@ -261,6 +261,7 @@ py::list Bins(const std::vector<ResidualBin>& bins) {
 py::dict EvidenceDict(const Evidence& e) {
   const CrossValidation& cv = e.cross_validation;
   py::dict halves(py::arg("ok") = cv.ok, py::arg("error") = cv.error,
+                  py::arg("splits") = cv.splits,
                   py::arg("views") = py::make_tuple(cv.views_a, cv.views_b),
                   py::arg("rms_px") = py::make_tuple(cv.rms_a_px, cv.rms_b_px),
                   py::arg("rotation_deg") = cv.rotation_deg,

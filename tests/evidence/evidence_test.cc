@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "calib/calibrate.h"
@@ -65,6 +67,13 @@ TEST(EvidenceOptions, CheckRejectsBadValues) {
   options = EvidenceOptions();
   options.report_angles_deg = {200};
   EXPECT_FALSE(options.Check());
+  for (int splits : {0, 17}) {
+    options = EvidenceOptions();
+    options.cross_validation_splits = splits;
+    std::string why;
+    EXPECT_FALSE(options.Check(&why)) << splits;
+    EXPECT_NE(why.find("cross_validation_splits"), std::string::npos) << why;
+  }
 }
 
 // The map's samples and their field angles follow the camera.
@@ -287,6 +296,52 @@ TEST(CrossValidation, HalvesAgreeOnCleanData) {
     }
     EXPECT_GE(judged, 2);
   }
+}
+
+// Several splits (EvidenceOptions::cross_validation_splits) order the views
+// by their contents: the same views in another order give the same halves
+// and figures, and on clean data the halves still agree within their
+// predicted difference.
+TEST(CrossValidation, SeveralSplitsDoNotDependOnTheViewOrder) {
+  const Camera truth = sim::TruthRadtan();
+  const SyntheticData data = MakeSyntheticData(Scene(truth, 24, 0.2, 33));
+  std::vector<CalibrationView> shuffled = data.views;
+  std::mt19937 rng(5);
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  ASSERT_NE(shuffled.front().name, data.views.front().name);
+  EvidenceOptions options;
+  options.cross_validation_splits = 5;
+  CrossValidation cv[2];
+  const std::vector<CalibrationView>* orders[2] = {&data.views, &shuffled};
+  for (int k = 0; k < 2; ++k) {
+    const CalibrationResult result = CalibrateOrDie(*orders[k], truth);
+    const SystematicResiduals residuals =
+        ComputeSystematicResiduals(*orders[k], result, options);
+    cv[k] = CrossValidate(*orders[k], result, CalibrationOptions(),
+                          residuals.max_angle_deg, options);
+    ASSERT_TRUE(cv[k].ok) << cv[k].error;
+    EXPECT_EQ(cv[k].splits, 5);
+    EXPECT_EQ(cv[k].splits_tried, 5);
+  }
+  EXPECT_EQ(cv[0].views_a, cv[1].views_a);
+  EXPECT_NEAR(cv[0].intrinsics_chi2, cv[1].intrinsics_chi2,
+              1e-3 * (1 + cv[0].intrinsics_chi2));
+  ASSERT_EQ(cv[0].difference_bands.size(), cv[1].difference_bands.size());
+  int judged = 0;
+  for (size_t b = 0; b < cv[0].difference_bands.size(); ++b) {
+    const AngleBand& d = cv[0].difference_bands[b];
+    const AngleBand& e = cv[0].expected_bands[b];
+    // Another split would differ by about the figure itself.
+    EXPECT_NEAR(d.median, cv[1].difference_bands[b].median, 0.01 * e.median)
+        << d.lo_deg;
+    EXPECT_NEAR(e.median, cv[1].expected_bands[b].median, 0.01 * e.median)
+        << d.lo_deg;
+    if (d.count < options.min_bin_count) continue;
+    ++judged;
+    EXPECT_GT(d.median, 0.3 * e.median) << d.lo_deg;
+    EXPECT_LT(d.median, 2.0 * e.median) << d.lo_deg;
+  }
+  EXPECT_GE(judged, 2);
 }
 
 // Field-angle bins cover 0 to the widest corner; a last sliver narrower than
