@@ -116,15 +116,16 @@ void AddUniformHalvesFinding(const CrossValidation& cv, double halves_scale,
   findings->push_back(
       {VerdictKind::kInconsistentViews,
        "the two halves of the views" + OverSplits(cv) +
-           StringPrintf(
-               " differ %.1f times more than their uncertainty predicts in "
-               "every field-angle band, by %.2f px or more (median, at %.0f",
-               halves_scale, best->median, best->lo_deg) +
-           StringPrintf(
-               "-%.0f deg where they agree best); corner errors shared "
-               "within views explain up to about %.0f times, so the "
-               "halves do not see one camera",
-               best->hi_deg, options.halves_max_scale)});
+           StringPrintf(" differ %.1f times more than their uncertainty "
+                        "predicts in every field-angle band (where they "
+                        "agree best, at ",
+                        halves_scale) +
+           BandLabel(*best) +
+           StringPrintf(": %.2f px against %.2f px predicted); corner "
+                        "errors shared within views explain up to about "
+                        "%.0f times, so the halves do not see one camera",
+                        best->median, best->median / halves_scale,
+                        options.halves_max_scale)});
 }
 
 // Model error: a field-angle band where the halves differ far beyond their
@@ -143,12 +144,13 @@ void AddHalvesFindings(const CrossValidation& cv, double halves_scale,
     if (ratio > options.halves_factor && d.median > options.halves_floor_px &&
         ratio > worst_ratio) {
       worst_ratio = ratio;
-      halves_text =
-          "the two halves of the views" + OverSplits(cv) +
-          StringPrintf(
-              " differ by %.3f px (median) at %.0f-%.0f deg, %.1f times "
-              "what their uncertainty predicts (%.3f px)",
-              d.median, d.lo_deg, d.hi_deg, ratio, halves_scale * e.median);
+      halves_text = "the two halves of the views" + OverSplits(cv) +
+                    StringPrintf(" differ by %.3f px (median) at ", d.median) +
+                    BandLabel(d) +
+                    StringPrintf(
+                        ", %.1f times what their uncertainty predicts "
+                        "(%.3f px)",
+                        ratio, halves_scale * e.median);
       if (halves_scale > 1) {
         halves_text += StringPrintf(
             ", the prediction scaled by %.2f, the best-agreeing band's "
@@ -402,7 +404,6 @@ int AddBadDetectionFindings(const CalibrationResult& result,
 // calibrated.
 void AddInsufficientDataFindings(const CalibrationResult& result,
                                  const Evidence& evidence,
-                                 const EvidenceOptions& evidence_options,
                                  const VerdictOptions& options,
                                  std::vector<Finding>* findings,
                                  std::vector<std::string>* notes) {
@@ -425,20 +426,22 @@ void AddInsufficientDataFindings(const CalibrationResult& result,
                          "every parameter"});
   }
   if (evidence.uncertainty.ok) {
-    double worst = 0, at = 0;
+    double worst = 0;
+    const AngleBand* at = nullptr;
     for (const AngleBand& band : evidence.uncertainty.bands) {
       if (band.count > 0 && band.median > worst) {
         worst = band.median;
-        at = band.lo_deg;
+        at = &band;
       }
     }
-    if (worst > options.max_uncertainty_px) {
+    if (at != nullptr && worst > options.max_uncertainty_px) {
       findings->push_back(
           {VerdictKind::kInsufficientData,
-           StringPrintf("the projection uncertainty reaches %.3f px (median at "
-                        "%.0f-%.0f deg; limit %.2f px)",
-                        worst, at, at + evidence_options.band_width_deg,
-                        options.max_uncertainty_px)});
+           StringPrintf("the projection uncertainty reaches %.3f px (median "
+                        "at ",
+                        worst) +
+               BandLabel(*at) +
+               StringPrintf("; limit %.2f px)", options.max_uncertainty_px)});
     }
   }
   std::string undetermined_coefficients, undetermined_names;
@@ -851,8 +854,7 @@ Verdict MakeVerdict(const CalibrationResult& result, const Evidence& evidence,
   const int num_bad_views = AddBadDetectionFindings(
       result, view_errors, options, &findings, &notes, &verdict);
   MarkViewErrors(evidence.view_consistency, view_errors, &verdict.views);
-  AddInsufficientDataFindings(result, evidence, evidence_options, options,
-                              &findings, &notes);
+  AddInsufficientDataFindings(result, evidence, options, &findings, &notes);
 
   AddFoldNote(result.camera, &notes);
   RankFindings(findings, &verdict);
