@@ -596,6 +596,12 @@ int SelectModelOf(CalibrateRequest* request, CalibrationRun* run) {
   }
   if (!request->watching && request->verbosity != Verbosity::kQuiet) {
     std::cout << run->selection.Table();
+  } else if (!request->watching && !run->selection.compared) {
+    // The table's "chosen:" line says it otherwise.
+    std::cerr << "note: --model auto: "
+              << CameraModelName(
+                     run->selection.candidates[run->selection.chosen].model)
+              << ": " << run->selection.reason << "\n";
   }
   request->model = run->selection.candidates[run->selection.chosen].model;
   if (!CameraFormatFixedParams(request->format, request->model,

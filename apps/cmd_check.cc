@@ -121,6 +121,19 @@ int RunCheck() {
   if (!listing.note.empty() && ConsoleVerbosity() != Verbosity::kQuiet) {
     std::cerr << "note: " << listing.note << "\n";
   }
+  if (stored.covariance.size() == 0 &&
+      ConsoleVerbosity() != Verbosity::kQuiet) {
+    // A hand-written or trimmed file, or a format without the field: the
+    // check runs, but the stored camera's own uncertainty cannot widen
+    // what counts as a drift.
+    std::cerr
+        << "note: " << FLAGS_camera
+        << " has no parameter_covariance: the check cannot judge drift "
+           "against its uncertainty, only against the new photos' "
+           "(a difference within the stored calibration's own "
+           "uncertainty can count as drift); `puzzlecal calibrate` writes "
+           "it in its own format (--format puzzlecal)\n";
+  }
   RecheckRunOptions run_options;
   run_options.pipeline = options.pipeline;
   run_options.calibration = options.calibration;

@@ -20,7 +20,10 @@ ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
   const CameraModelId current_id = result.camera.model;
   const ModelCandidate* current = nullptr;
   const ModelCandidate* suggested = nullptr;
-  if (selection != nullptr) {
+  // A selection that could not compare (ModelSelection::compared) says
+  // nothing of either model; neither does its failure of the calibrated
+  // model on a fold.
+  if (selection != nullptr && selection->compared) {
     current = selection->Find(current_id);
     suggested = selection->Find(suggested_id);
   }
@@ -35,6 +38,10 @@ ModelAdvice CheckModelAdvice(const std::vector<CalibrationView>& views,
     }
     current = own.Find(current_id);
     suggested = own.Find(suggested_id);
+    if (!own.compared) {
+      advice.error = own.reason;
+      current = suggested = nullptr;
+    }
   }
   advice.checked = true;
   if (current != nullptr && suggested != nullptr && current->ok &&

@@ -442,9 +442,12 @@ void FitOverFolds(const std::vector<size_t>& which, bool count,
       total.holdout_views += c.holdout_views;
       if (!c.ok) {
         total.ok = false;
-        total.error = folds > 1 || options.all_folds
-                          ? StringPrintf("fold %d: ", fold + 1) + c.error
-                          : c.error;
+        total.error =
+            folds > 1 || options.all_folds
+                ? StringPrintf("fold %d (%zu views fitted): ", fold + 1,
+                               fit.size()) +
+                      c.error
+                : c.error;
         if (c.error.rfind("skipped", 0) == 0) total.error = c.error;
         continue;
       }
@@ -544,6 +547,49 @@ void CheckSplinedChoiceOnHalves(const std::vector<CalibrationView>& views,
   selection->chosen = leader;
 }
 
+// When the candidate preferred for the field failed on a fold (not
+// skipped), the others were compared without it: a fold of few views can
+// be too few or too alike for a model that calibrates on all of them (five
+// renders of a pinhole lens: pinhole-radtan failed on the 4 views of one
+// fold, "all views show the board at nearly the same orientation", and
+// kannala-brandt was chosen by default). Then that candidate is chosen
+// without a comparison, when it calibrates on all the views.
+void FallBackToThePreferredModel(const std::vector<CalibrationView>& views,
+                                 int width, int height,
+                                 const CalibrationOptions& calibration,
+                                 const ModelSelectionOptions& options,
+                                 ModelSelection* selection) {
+  int preferred = -1;
+  for (size_t k = 0; k < selection->candidates.size(); ++k) {
+    const ModelCandidate& c = selection->candidates[k];
+    if (!c.ok && c.error.rfind("skipped", 0) == 0) continue;
+    if (preferred < 0 || Preferred(c, selection->candidates[preferred],
+                                   selection->pinhole_field)) {
+      preferred = static_cast<int>(k);
+    }
+  }
+  if (preferred < 0 || selection->candidates[preferred].ok) return;
+  const ModelCandidate& c = selection->candidates[preferred];
+  CalibrationOptions all = calibration;
+  all.compute_covariance = false;
+  CalibrationResult result;
+  std::string why;
+  if (!Calibrate(views, c.model, width, height, all, &result, &why)) {
+    return;  // it fails on all views too: the comparison stands
+  }
+  selection->reason = StringPrintf(
+      "model selection could not compare the models: %s, the model for "
+      "corners %s %.0f deg of the axis, failed on %s%s; it calibrates on all "
+      "%zu views and is used without a comparison (more views, at other "
+      "positions and tilts, let every fold calibrate it)",
+      CameraModelName(c.model), selection->pinhole_field ? "within" : "beyond",
+      options.conventional_max_field_deg,
+      c.error.rfind("fold ", 0) == 0 ? "" : "a fold: ", c.error.c_str(),
+      views.size());
+  selection->chosen = preferred;
+  selection->compared = false;
+}
+
 bool SelectModel(const std::vector<CalibrationView>& views, int width,
                  int height, const CalibrationOptions& calibration,
                  const ModelSelectionOptions& options,
@@ -628,6 +674,8 @@ bool SelectModel(const std::vector<CalibrationView>& views, int width,
     CheckSplinedChoiceOnHalves(views, width, height, calibration, leader,
                                selection);
   }
+  FallBackToThePreferredModel(views, width, height, calibration, options,
+                              selection);
   if (selection->chosen < 0) {
     std::string reasons;
     for (const ModelCandidate& c : selection->candidates) {

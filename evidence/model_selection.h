@@ -119,6 +119,14 @@ struct ModelSelection {
   // Why `chosen` was chosen, in words ("lowest held-out RMS", or the
   // candidate with the lowest and why it was not enough).
   std::string reason;
+  // False when the comparison could not be made: the model preferred for
+  // the field (the conventional family's with the fewest parameters:
+  // pinhole-radtan within conventional_max_field_deg, kannala-brandt
+  // beyond) failed on a fold (with few views a fold's fit views can be too
+  // few or too alike) but calibrates on all the views. Then `chosen` is
+  // that model, without a held-out error of its own (its candidate is not
+  // ok), and `reason` says why no comparison was made.
+  bool compared = true;
 
   // The candidate of that model (nullptr when it was not a candidate).
   const ModelCandidate* Find(CameraModelId model) const;
@@ -128,7 +136,10 @@ struct ModelSelection {
 };
 
 // Splits the views, calibrates each candidate and chooses one (see the top
-// of this file). False when no candidate succeeds or the options are
+// of this file). When the model preferred for the field failed on a fold
+// but calibrates on all the views, it is chosen without a comparison
+// (ModelSelection::compared). False when no candidate succeeds (and the
+// preferred model does not calibrate on all views) or the options are
 // invalid.
 bool SelectModel(const std::vector<CalibrationView>& views, int width,
                  int height, const CalibrationOptions& calibration,

@@ -126,7 +126,12 @@ bool FieldReader::List(const YAML::Node& map, const std::string& path,
                        YAML::Node* list) {
   YAML::Node node;
   if (!Child(map, path, key, presence, &node)) return false;
-  if (!node) return true;
+  if (!node) {
+    // Absent: undefined, whatever *list held (a default YAML::Node is a
+    // defined null, which a caller's `if (list)` would take for a list).
+    list->reset(YAML::Node(YAML::NodeType::Undefined));
+    return true;
+  }
   if (!node.IsSequence()) return Fail(Join(path, key), "must be a list");
   list->reset(node);
   return true;

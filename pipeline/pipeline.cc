@@ -221,6 +221,16 @@ std::vector<ImageResult> ProcessImageFiles(
   return results;
 }
 
+bool FilesHoldSameBytes(const std::string& a, const std::string& b) {
+  std::error_code ec_a, ec_b;
+  const std::uintmax_t size_a = std::filesystem::file_size(a, ec_a);
+  const std::uintmax_t size_b = std::filesystem::file_size(b, ec_b);
+  if (ec_a || ec_b || size_a != size_b) return false;
+  std::string bytes_a, bytes_b;
+  return ReadFileBytes(a, &bytes_a) && ReadFileBytes(b, &bytes_b) &&
+         bytes_a == bytes_b;
+}
+
 int MarkRepeatedPhotos(std::vector<ImageResult>* images) {
   // The usable images by file size, in input order.
   std::map<std::uintmax_t, std::vector<size_t>> by_size;

@@ -96,6 +96,11 @@ std::vector<ImageResult> ProcessImageFiles(
     const PipelineOptions& options, int num_threads,
     const std::function<void(size_t, const ImageResult&)>& on_done = {});
 
+// Whether files `a` and `b` hold the same bytes (their sizes compared
+// first, so files of different sizes are not read); false when either
+// cannot be read.
+bool FilesHoldSameBytes(const std::string& a, const std::string& b);
+
 // Marks each usable image whose file holds the same bytes as an earlier
 // usable image's (a copy under another name: it adds no view, only weight)
 // as kRepeatedPhoto, reason "not used: the same photo as <earlier file

@@ -43,6 +43,61 @@ bool MatchByOrder(const std::vector<std::string>& camera_names,
   return true;
 }
 
+// Two cameras never take byte-identical photos: a camera folder whose
+// photos are copies of another's (one folder copied for the other) would
+// be calibrated as two cameras in one place, a rig with a baseline of 0.
+// False naming both cameras when any frame's files of two cameras hold the
+// same bytes (files are read only where their sizes agree).
+bool RefuseCopiedCameraPhotos(const std::vector<std::string>& camera_names,
+                              const std::vector<ImageListing>& listings,
+                              const RigFrames& frames, std::string* error) {
+  // Per camera, the file of each frame ("" where none).
+  std::vector<std::vector<std::string>> file_of_frame(listings.size());
+  for (size_t c = 0; c < listings.size(); ++c) {
+    file_of_frame[c].assign(frames.num_frames, "");
+    for (const auto& [file, frame] : frames.frame_of_file[c]) {
+      file_of_frame[c][frame] = file;
+    }
+  }
+  for (size_t a = 0; a < listings.size(); ++a) {
+    for (size_t b = a + 1; b < listings.size(); ++b) {
+      int both = 0;
+      std::vector<std::string> same;
+      for (int f = 0; f < frames.num_frames; ++f) {
+        const std::string& file_a = file_of_frame[a][f];
+        const std::string& file_b = file_of_frame[b][f];
+        if (file_a.empty() || file_b.empty()) continue;
+        ++both;
+        if (FilesHoldSameBytes(file_a, file_b)) {
+          same.push_back(fs::path(file_b).filename().string());
+        }
+      }
+      if (same.empty()) continue;
+      std::string which;
+      if (static_cast<int>(same.size()) < both) {
+        which = ": ";
+        for (size_t k = 0; k < same.size() && k < 3; ++k) {
+          which += (k > 0 ? ", " : "") + same[k];
+        }
+        if (same.size() > 3) which += ", ...";
+      }
+      return Fail(
+          StringPrintf("cameras '%s' and '%s' hold the same photos (%zu of %d "
+                       "byte-identical%s): a rig needs one folder per camera, "
+                       "each holding that camera's own photos",
+                       camera_names[a].c_str(), camera_names[b].c_str(),
+                       same.size(), both, which.c_str()) +
+              (static_cast<int>(same.size()) == both
+                   ? " (is '" + camera_names[b] + "' a copy of '" +
+                         camera_names[a] + "'?)"
+                   : "; replace the copies with the photos '" +
+                         camera_names[b] + "' took, or remove them"),
+          error);
+    }
+  }
+  return true;
+}
+
 // A view whose labels are relative (part of a plain checkerboard) is
 // labelled from its own first corner: the same corner of the board carries
 // other labels in the other cameras' views of the frame, so the joint solve
@@ -153,7 +208,10 @@ bool MatchRigFrames(const std::vector<std::string>& camera_names,
   }
   frames->num_frames = 0;
   frames->frame_of_file.assign(num_cameras, {});
-  if (by_order) return MatchByOrder(camera_names, listings, frames, error);
+  if (by_order) {
+    return MatchByOrder(camera_names, listings, frames, error) &&
+           RefuseCopiedCameraPhotos(camera_names, listings, *frames, error);
+  }
   std::map<std::string, int> frame_of_name;
   std::map<std::string, int> cameras_with_name;
   for (const ImageListing& listing : listings) {
@@ -194,7 +252,7 @@ bool MatchRigFrames(const std::vector<std::string>& camera_names,
     }
   }
   frames->num_frames = index;
-  return true;
+  return RefuseCopiedCameraPhotos(camera_names, listings, *frames, error);
 }
 
 int MakeRigCameraViews(const Board& board,

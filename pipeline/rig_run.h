@@ -46,8 +46,11 @@ struct RigFrames {
 // names of all listings in sorted order (the same name in different
 // listings is the same instant), and a camera whose names no other camera
 // has is refused with the rule and the ways out. By order: the n-th image
-// of every listing, which must then hold as many images. False with a
-// message naming the camera.
+// of every listing, which must then hold as many images. Either way two
+// cameras whose files of one frame hold the same bytes (a folder copied
+// for another camera's; no two cameras take byte-identical photos) are
+// refused, naming both and how many of the frames they share are copies.
+// False with a message naming the camera.
 bool MatchRigFrames(const std::vector<std::string>& camera_names,
                     const std::vector<ImageListing>& listings, bool by_order,
                     RigFrames* frames, std::string* error);

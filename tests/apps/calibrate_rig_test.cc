@@ -576,6 +576,28 @@ TEST(CalibrateRigTest, CameraThatNeverSharesAFrameIsNamedAndNothingWritten) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// cam1's folder a copy of cam0's (the same photos, byte for byte): refused
+// before any image is read, naming both cameras, instead of a rig of two
+// cameras in one place; nothing is written.
+TEST(CalibrateRigTest, CameraFolderCopiedFromAnotherIsRefused) {
+  const RenderedRig rig = Render(StereoPinholeRig(), "copied");
+  fs::remove_all(rig.images / "cam1");
+  fs::copy(rig.images / "cam0", rig.images / "cam1");
+  const int photos = rig.summary.images_per_camera[0];
+  const fs::path out = rig.root / "rig.yaml";
+  const ProgramRun run =
+      RunProgram("calibrate-rig --images " + rig.images.string() + " --board " +
+                 rig.board + " --model pinhole-radtan --out " + out.string());
+  EXPECT_EQ(run.exit_code, kExitBadInput) << run.all();
+  EXPECT_NE(run.err.find(StringPrintf(
+                "cameras 'cam0' and 'cam1' hold the same photos (%d of %d "
+                "byte-identical): a rig needs one folder per camera",
+                photos, photos)),
+            std::string::npos)
+      << run.all();
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // Folders whose file names differ per camera (left01.png, right01.png):
 // frames are matched by name, so the program says so and how to pair them
 // by order; --match_by_order then pairs the n-th images; --model auto

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -330,6 +331,108 @@ TEST_F(CheckDiffTest, DiffAcrossModelsAndFormats) {
   // The two models of one lens agree near the axis.
   EXPECT_LT(rows.begin()->second.median, 0.2);
   EXPECT_TRUE(fs::exists(out / "projection_difference.png"));
+}
+
+// `text` without the top-level YAML fields `keys` (each with the lines
+// indented under it), as a user trims a camera file by hand.
+std::string WithoutFields(const std::string& text,
+                          const std::vector<std::string>& keys) {
+  std::istringstream lines(text);
+  std::string out, line;
+  bool skipping = false;
+  while (std::getline(lines, line)) {
+    if (!line.empty() && line[0] != ' ' && line[0] != '-' && line[0] != '#') {
+      const std::string key = line.substr(0, line.find(':'));
+      skipping = std::find(keys.begin(), keys.end(), key) != keys.end();
+    }
+    if (!skipping) out += line + "\n";
+  }
+  return out;
+}
+
+// A puzzlecal camera file trimmed of its covariance (and of every
+// statistic: a hand-written camera) is still a camera: check, diff,
+// undistort and advise --camera read it as one whose uncertainty is
+// unknown, and check says in one line naming the file what that costs.
+// (Each refused it before: "field 'parameter_covariance': expected 9 rows
+// for pinhole-radtan, got 0".) Check on the changed lens still finds the
+// drift, diff of a file with its trimmed copy is 0.
+TEST_F(CheckDiffTest, CameraFilesWithoutCovarianceAreReadAsUncertaintyUnknown) {
+  Path("original.yaml");
+  const std::string written = testing_files::ReadFile(Root() / "original.yaml");
+  ASSERT_NE(written.find("\nparameter_covariance:"), std::string::npos);
+  const fs::path trimmed = Scratch() / "trimmed";
+  fs::create_directories(trimmed);
+  const fs::path no_covariance = trimmed / "no_covariance.yaml";
+  const fs::path bare = trimmed / "bare.yaml";
+  testing_files::WriteFile(no_covariance,
+                           WithoutFields(written, {"parameter_covariance"}));
+  testing_files::WriteFile(
+      bare, WithoutFields(written,
+                          {"parameter_stddev", "parameter_covariance", "rms_px",
+                           "views_used", "corners_used", "outliers",
+                           "max_field_angle_deg", "verdict", "views"}));
+  ASSERT_EQ(testing_files::ReadFile(bare).find("rms_px"), std::string::npos);
+
+  // check: still valid on new photos of the same lens, with the note.
+  ProgramRun run = RunPuzzlecal(
+      "check --camera " + Quote(no_covariance.string()) + " --images " +
+      Path("same") + " --board " + Path("board.yaml"));
+  EXPECT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_NE(run.out.find("verdict: still-valid"), std::string::npos);
+  EXPECT_NE(run.out.find("parameter sigmas but no covariance in the file"),
+            std::string::npos);
+  EXPECT_NE(run.err.find(no_covariance.string() +
+                         " has no parameter_covariance: the check cannot "
+                         "judge drift against its uncertainty"),
+            std::string::npos)
+      << run.err;
+  // ... and drifted on the changed lens, by the bare camera too.
+  run = RunPuzzlecal("check --camera " + Quote(bare.string()) + " --images " +
+                     Path("changed") + " --board " + Path("board.yaml"));
+  EXPECT_EQ(run.exit_code, kExitDrifted) << run.all();
+  EXPECT_NE(run.out.find("RMS not in the file, no uncertainty in the file"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.err.find(bare.string() + " has no parameter_covariance"),
+            std::string::npos)
+      << run.err;
+  // The file with its covariance needs no note.
+  run = RunPuzzlecal(Check("original.yaml", "same"));
+  EXPECT_EQ(run.err.find("has no parameter_covariance"), std::string::npos)
+      << run.err;
+
+  // diff: the same camera, so 0 everywhere; B's uncertainty is named.
+  run = RunPuzzlecal("diff " + Path("original.yaml") + " " +
+                     Quote(no_covariance.string()));
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_NE(run.out.find("parameter sigmas without their covariance"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("from A's covariance alone"), std::string::npos);
+  std::map<int, BandRow> rows = ParseBands(run.out);
+  ASSERT_GE(rows.size(), 3u);
+  for (const auto& [lo, row] : rows) EXPECT_EQ(row.max, 0.0) << lo;
+  run = RunPuzzlecal("diff " + Quote(bare.string()) + " " +
+                     Quote(no_covariance.string()));
+  ASSERT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_NE(run.out.find("(pinhole-radtan, 640 x 480), no uncertainty"),
+            std::string::npos)
+      << run.out;
+
+  // undistort and advise --camera take the camera as it is.
+  const fs::path undistorted = Scratch() / "undistorted";
+  run =
+      RunPuzzlecal("undistort --camera " + Quote(bare.string()) + " --images " +
+                   Path("same") + " --out " + Quote(undistorted.string()));
+  EXPECT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_TRUE(fs::exists(undistorted / "undistorted_camera.yaml"));
+  const fs::path advice = Scratch() / "advice";
+  run = RunPuzzlecal("advise --camera " + Quote(no_covariance.string()) +
+                     " --images " + Path("same") + " --board " +
+                     Path("board.yaml") + " --out " + Quote(advice.string()));
+  EXPECT_EQ(run.exit_code, kExitOk) << run.all();
+  EXPECT_TRUE(fs::exists(advice / "advice.yaml"));
 }
 
 TEST_F(CheckDiffTest, BadInputIsNamedWithTheReason) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
+#include <string>
 #include <vector>
 
 #include "sim/synthetic_views.h"
@@ -116,6 +118,76 @@ TEST(SelectModel, TooFewViewsAreSaidOnce) {
   SelectModel(four, truth.width, truth.height, CalibrationOptions(),
               ModelSelectionOptions(), &selection, &error);
   EXPECT_FALSE(selection.candidates.empty()) << error;
+}
+
+// Five views of a radtan lens, three of them of the board facing the camera
+// (one orientation): the first fold fits on those three alone, where no
+// pinhole model can find the focal length. Model selection cannot compare
+// pinhole-radtan with the others, so it chooses it without a comparison,
+// saying why, instead of the best of the models that happened to fit that
+// fold; it calibrates on all five views to the truth.
+TEST(SelectModel, PreferredModelFailingOnAFoldIsChosenWithoutAComparison) {
+  const Camera truth = sim::TruthRadtan();
+  SyntheticScene scene;
+  scene.camera = truth;
+  scene.noise_px = 0.1;
+  scene.max_direction_deg = 30;
+  scene.num_views = 2;
+  scene.min_tilt_deg = 35;
+  scene.seed = 3;
+  const SyntheticData tilted = MakeSyntheticData(scene);
+  scene.num_views = 3;
+  scene.fronto_parallel = true;
+  scene.seed = 4;
+  const SyntheticData facing = MakeSyntheticData(scene);
+  ASSERT_EQ(tilted.views.size(), 2u);
+  ASSERT_EQ(facing.views.size(), 3u);
+  // Fold 1 holds out the first and the fifth view.
+  const std::vector<CalibrationView> views = {tilted.views[0], facing.views[0],
+                                              facing.views[1], facing.views[2],
+                                              tilted.views[1]};
+  ModelSelection selection;
+  std::string error;
+  ASSERT_TRUE(SelectModel(views, truth.width, truth.height,
+                          CalibrationOptions(), ModelSelectionOptions(),
+                          &selection, &error))
+      << error;
+  std::cout << selection.Table();
+  ASSERT_GE(selection.chosen, 0);
+  const ModelCandidate& chosen = selection.candidates[selection.chosen];
+  EXPECT_EQ(chosen.model, CameraModelId::kPinholeRadtan);
+  EXPECT_FALSE(selection.compared);
+  EXPECT_FALSE(chosen.ok);
+  EXPECT_EQ(chosen.error.rfind("fold 1 (3 views fitted): calibration failed: "
+                               "all views show the board at nearly the same "
+                               "orientation",
+                               0),
+            0u)
+      << chosen.error;
+  EXPECT_EQ(selection.reason.rfind(
+                "model selection could not compare the models: "
+                "pinhole-radtan, the model for corners within 55 deg of the "
+                "axis, failed on fold 1 (3 views fitted)",
+                0),
+            0u)
+      << selection.reason;
+  EXPECT_NE(selection.reason.find("it calibrates on all 5 views and is used "
+                                  "without a comparison"),
+            std::string::npos)
+      << selection.reason;
+  EXPECT_NE(selection.Table().find("chosen: pinhole-radtan (model selection "
+                                   "could not compare"),
+            std::string::npos);
+  // The chosen model on all the views: the truth.
+  CalibrationResult result;
+  ASSERT_TRUE(Calibrate(views, chosen.model, truth.width, truth.height,
+                        CalibrationOptions(), &result, &error))
+      << error;
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NEAR(result.camera.params[k], truth.params[k],
+                4 * result.param_stddev[k] + 1e-3 * truth.params[k])
+        << k;
+  }
 }
 
 // Radtan lens: radtan (the rational model fits as well, with more

@@ -142,6 +142,48 @@ TEST_F(CameraYamlTest, PuzzlecalFormatCarriesTheStatistics) {
   EXPECT_EQ(root["outliers"].as<int>(), 3);
 }
 
+// A puzzlecal file without parameter_covariance (trimmed or hand-written)
+// reads as a camera whose uncertainty is unknown: the covariance empty, the
+// other statistics as written. Without parameter_stddev too, the sigmas
+// are empty as well. (A missing covariance list was read as a list of 0
+// rows: "field 'parameter_covariance': expected 8 rows ..., got 0".)
+TEST_F(CameraYamlTest, PuzzlecalFileWithoutCovarianceHasNoUncertainty) {
+  CalibrationResult result;
+  result.camera = MakeCamera(CameraModelId::kKannalaBrandt);
+  result.param_stddev = {0.1, 0.2, 0.3, 0.4, 1e-4, 2e-4, 3e-4, 4e-5};
+  result.covariance = Eigen::MatrixXd::Identity(8, 8) * 1e-4;
+  result.covariance_ok = true;
+  result.rms_px = 0.0961;
+  result.num_views_used = 20;
+  std::string text, error;
+  CameraFileStats written = CameraFileStatsOfResult(
+      result, std::vector<std::string>(), Eigen::Vector3d::Zero());
+  ASSERT_TRUE(FormatCameraFile(result.camera, written,
+                               CameraFileFormat::kPuzzlecal, &text, &error))
+      << error;
+  YAML::Node root = YAML::Load(text);
+  ASSERT_TRUE(root["parameter_covariance"]);
+  root.remove("parameter_covariance");
+  Camera camera;
+  CameraFileStats stats;
+  ASSERT_TRUE(ParseCameraFile(YAML::Dump(root), "trimmed.yaml", &camera,
+                              nullptr, &error, &stats))
+      << error;
+  EXPECT_EQ(camera.params, result.camera.params);
+  EXPECT_TRUE(stats.has_stats);
+  EXPECT_EQ(stats.covariance.size(), 0);
+  EXPECT_EQ(stats.param_stddev, result.param_stddev);
+  EXPECT_EQ(stats.rms_px, 0.0961);
+  EXPECT_EQ(stats.num_views_used, 20);
+  root.remove("parameter_stddev");
+  ASSERT_TRUE(ParseCameraFile(YAML::Dump(root), "trimmed.yaml", &camera,
+                              nullptr, &error, &stats))
+      << error;
+  EXPECT_EQ(stats.covariance.size(), 0);
+  EXPECT_TRUE(stats.param_stddev.empty());
+  EXPECT_EQ(stats.rms_px, 0.0961);
+}
+
 TEST_F(CameraYamlTest, OpenCvFormatIsReadableByFileStorage) {
   for (CameraModelId id : kAllCameraModels) {
     // What the file holds (the far-field part of a non-central camera, the

@@ -91,6 +91,78 @@ TEST(RigRunTest, ListingsThatCannotBePairedAreRefusedNamingTheCamera) {
       << error;
 }
 
+// Rendered photos of the stereo rig, cam1's folder then made a copy of
+// cam0's (the same files, byte for byte): refused naming both cameras and
+// how many of the frames are copies, by name and by order, not calibrated
+// into a rig with a baseline of 0. Two copied photos among cam1's own are
+// named. The rendered folders as they are pass.
+TEST(RigRunTest, CameraFoldersHoldingTheSamePhotosAreRefused) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() /
+                        ("puzzlecal_rig_copies_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  RigRenderSummary summary;
+  std::string error;
+  ASSERT_TRUE(
+      RenderRigScene(StereoPinholeRig(), root.string(), &summary, &error))
+      << error;
+  const std::vector<std::string> names = {"cam0", "cam1"};
+  auto list = [&](std::vector<ImageListing>* listings) {
+    listings->assign(2, ImageListing());
+    for (size_t c = 0; c < 2; ++c) {
+      ASSERT_TRUE(
+          ListImages((root / names[c]).string(), &(*listings)[c], &error))
+          << error;
+    }
+  };
+  std::vector<ImageListing> listings;
+  list(&listings);
+  // The frames both cameras saw.
+  std::vector<std::string> both;
+  for (int f = 0; f < summary.num_frames; ++f) {
+    const std::string name = RigFrameFileName(f);
+    if (fs::exists(root / "cam0" / name) && fs::exists(root / "cam1" / name)) {
+      both.push_back(name);
+    }
+  }
+  ASSERT_GE(both.size(), 6u);
+  RigFrames frames;
+  ASSERT_TRUE(MatchRigFrames(names, listings, false, &frames, &error)) << error;
+
+  // Two of cam1's photos replaced by cam0's of the same frames.
+  for (size_t k : {2, 5}) {
+    fs::copy_file(root / "cam0" / both[k], root / "cam1" / both[k],
+                  fs::copy_options::overwrite_existing);
+  }
+  list(&listings);
+  EXPECT_FALSE(MatchRigFrames(names, listings, false, &frames, &error));
+  EXPECT_EQ(
+      error.rfind("cameras 'cam0' and 'cam1' hold the same photos (2 of " +
+                      std::to_string(both.size()) +
+                      " byte-identical: " + both[2] + ", " + both[5] + ")",
+                  0),
+      0u)
+      << error;
+  EXPECT_NE(error.find("replace the copies"), std::string::npos) << error;
+
+  // cam1 a copy of cam0.
+  fs::remove_all(root / "cam1");
+  fs::copy(root / "cam0", root / "cam1");
+  list(&listings);
+  const std::string expected =
+      "cameras 'cam0' and 'cam1' hold the same photos (" +
+      std::to_string(listings[0].images.size()) + " of " +
+      std::to_string(listings[0].images.size()) +
+      " byte-identical): a rig needs one folder per camera";
+  for (bool by_order : {false, true}) {
+    EXPECT_FALSE(MatchRigFrames(names, listings, by_order, &frames, &error));
+    EXPECT_EQ(error.rfind(expected, 0), 0u) << error;
+    EXPECT_NE(error.find("is 'cam1' a copy of 'cam0'?"), std::string::npos)
+        << error;
+  }
+  fs::remove_all(root);
+}
+
 // Per camera, the file name of each frame it saw ("" where none).
 std::vector<std::vector<std::string>> FrameFiles(
     const std::vector<RigCameraInput>& inputs) {
