@@ -290,12 +290,27 @@ RigVerdict MakeRigVerdict(const RigCalibrationResult& result,
       return verdict;
     }
   }
-  for (size_t c = 0; c < camera_verdicts.size(); ++c) {
-    if (camera_verdicts[c].kind == VerdictKind::kGood) continue;
-    verdict.kind = VerdictKindName(camera_verdicts[c].kind);
-    verdict.reason =
-        "camera '" + result.cameras[c].name + "': " + camera_verdicts[c].reason;
-    verdict.next_step = camera_verdicts[c].next_step;
+  // The first camera that is not good gives the kind, its reason and next
+  // step; every other one is named with its kind, so that a user reading
+  // the rig's line does not take them for good.
+  std::vector<size_t> not_good;
+  for (size_t c = 0; c < camera_verdicts.size() && c < result.cameras.size();
+       ++c) {
+    if (camera_verdicts[c].kind != VerdictKind::kGood) not_good.push_back(c);
+  }
+  if (!not_good.empty()) {
+    const size_t first = not_good.front();
+    verdict.kind = VerdictKindName(camera_verdicts[first].kind);
+    verdict.reason = "camera '" + result.cameras[first].name +
+                     "': " + camera_verdicts[first].reason;
+    for (size_t k = 1; k < not_good.size(); ++k) {
+      const size_t c = not_good[k];
+      verdict.reason += std::string(k == 1 ? "; and " : ", ") + "camera '" +
+                        result.cameras[c].name + "' is " +
+                        VerdictKindName(camera_verdicts[c].kind);
+    }
+    if (not_good.size() > 1) verdict.reason += " (their own verdicts say why)";
+    verdict.next_step = camera_verdicts[first].next_step;
     return verdict;
   }
   double worst = 0;

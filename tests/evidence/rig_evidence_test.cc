@@ -103,6 +103,44 @@ TEST(RigEvidenceTest, FramesMovedByMoreThanTwoMillimetresAreNamed) {
   EXPECT_EQ(false_named, 0);
 }
 
+// A clean rig whose cameras' own verdicts are not all good: the rig's
+// verdict takes the first one's kind, reason and next step, and names every
+// other camera that is not good with its kind.
+TEST(RigEvidenceTest, EveryCameraThatIsNotGoodIsNamed) {
+  const JudgedRig judged = JudgeRig(Scene(0, 7), 7);
+  ASSERT_EQ(judged.verdict.kind, "good") << judged.verdict.Line();
+  ASSERT_EQ(judged.result.cameras.size(), 2u);
+  const std::string name0 = judged.result.cameras[0].name;
+  const std::string name1 = judged.result.cameras[1].name;
+  auto verdict = [](VerdictKind kind, const std::string& reason) {
+    Verdict v;
+    v.kind = kind;
+    v.reason = reason;
+    v.next_step = reason + " next";
+    return v;
+  };
+  const RigVerdict both =
+      MakeRigVerdict(judged.result, judged.evidence,
+                     {verdict(VerdictKind::kInsufficientData, "few views"),
+                      verdict(VerdictKind::kModelError, "halves differ")},
+                     {}, RigEvidenceOptions());
+  EXPECT_EQ(both.kind, "insufficient-data");
+  EXPECT_EQ(both.reason.find("camera '" + name0 + "': few views"), 0u)
+      << both.reason;
+  EXPECT_NE(both.reason.find("camera '" + name1 + "' is model-error"),
+            std::string::npos)
+      << both.reason;
+  EXPECT_EQ(both.next_step, "few views next");
+
+  const RigVerdict second =
+      MakeRigVerdict(judged.result, judged.evidence,
+                     {verdict(VerdictKind::kGood, "fine"),
+                      verdict(VerdictKind::kModelError, "halves differ")},
+                     {}, RigEvidenceOptions());
+  EXPECT_EQ(second.kind, "model-error");
+  EXPECT_EQ(second.reason, "camera '" + name1 + "': halves differ");
+}
+
 TEST(RigEvidenceTest, OptionsCheckNamesTheField) {
   RigEvidenceOptions options;
   options.moved_factor = 1;
